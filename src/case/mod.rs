@@ -1,0 +1,1 @@
+//! Case files: serde schema (units mm, N, t, s) and validation. (Being written.)

@@ -1,0 +1,558 @@
+//! `Shell4`: flat 4-node shell with 6 DOF per node.
+//!
+//! The element is the superposition of three independent parts in a local frame
+//! `(e1, e2, n)` on the element's plane (the shell is flat: a warped quadrilateral is an error):
+//!
+//! **Membrane** — bilinear plane stress with Wilson's incompatible modes in Taylor's form
+//! (QM6): `u = Σ N_i u_i + (1 − r²) a_1 + (1 − s²) a_2` (likewise v); the incompatible
+//! derivatives use the Jacobian at the element centre scaled by `det J0 / det J`, so the
+//! constant-strain patch test passes on distorted meshes, and in-plane bending of a
+//! rectangle is exact. The four internal DOF are condensed statically:
+//! `K_m = K_cc − K_ca K_aa⁻¹ K_ac`, with `D_m = E t / (1 − ν²) [1 ν 0; ν 1 0; 0 0 (1−ν)/2]`.
+//!
+//! **Plate bending** — Reissner–Mindlin with the MITC4 assumed transverse shear strains of
+//! Bathe & Dvorkin (1985), free of shear locking. With the local rotations θ1 (about e1) and
+//! θ2 (about e2) the fibre rotations are `β_x = θ2`, `β_y = −θ1`; curvatures
+//! `κ = [β_x,x, β_y,y, β_x,y + β_y,x]`, `D_b = E t³ / (12 (1 − ν²)) [...]`. The covariant shear
+//! strains `γ_r = w_,r + β·x_,r` are sampled at the mid-edges A (0, 1), C (0, −1) and
+//! `γ_s = w_,s + β·x_,s` at B (−1, 0), D (1, 0) and interpolated
+//! `γ_r = ½(1+s) γ_r^A + ½(1−s) γ_r^C`, `γ_s = ½(1+r) γ_s^D + ½(1−r) γ_s^B`; Cartesian
+//! `[γ_xz, γ_yz] = J⁻¹ [γ_r, γ_s]`, `D_s = κ G t` with κ = 5/6.
+//!
+//! **Drilling** — the rotation θ3 about the normal has no stiffness of its own in shell theory;
+//! a small penalty ties it to the in-plane rotation of the membrane field (Hughes & Brezzi):
+//! `U_d = ½ ∫ α G t (θ3 − ω)² dA` with `ω = ½ (v_,x − u_,y)` (compatible part) and
+//! α = [`Shell4::DEFAULT_DRILLING_FACTOR`] = 1e-3. It vanishes for rigid-body rotation, so the
+//! element keeps exactly six zero-energy modes, and it restrains a weld beam's spin about the
+//! sheet normal. With α = 1e-3 its effect on membrane stiffness is below 0.1 %.
+//!
+//! All parts use 2×2 Gauss quadrature.
+//!
+//! **Mass** — consistent: `ρ t ∫ N_i N_j dA` for the three translations and the rotary inertia
+//! `ρ t³/12 ∫ N_i N_j dA` for θ1 and θ2; the drilling rotation θ3 gets the same rotary inertia
+//! (a modelling choice: it keeps M positive definite; its modes lie above 100 kHz here).
+//!
+//! Units: coordinates and thickness mm, E and G N/mm², ρ t/mm³; stiffness N/mm, N, N·mm/rad;
+//! mass t, t·mm².
+
+use faer::Mat;
+
+use super::Material;
+use crate::error::Error;
+
+const NODE_R: [f64; 4] = [-1.0, 1.0, 1.0, -1.0];
+const NODE_S: [f64; 4] = [-1.0, -1.0, 1.0, 1.0];
+const GAUSS: f64 = 0.577_350_269_189_625_8; // 1/sqrt(3)
+const GAUSS_POINTS: [(f64, f64); 4] = [
+    (-GAUSS, -GAUSS),
+    (GAUSS, -GAUSS),
+    (GAUSS, GAUSS),
+    (-GAUSS, GAUSS),
+];
+
+/// Local DOF indices within a node: translations along e1, e2, n, rotations about e1, e2, n.
+const U: usize = 0;
+const V: usize = 1;
+const W: usize = 2;
+const T1: usize = 3;
+const T2: usize = 4;
+const T3: usize = 5;
+
+type Mat24 = [[f64; 24]; 24];
+
+/// A flat 4-node shell element (see the module docs for the formulation).
+#[derive(Clone, Debug)]
+pub struct Shell4 {
+    /// Node coordinates in the local frame, mm.
+    local: [[f64; 2]; 4],
+    /// Rows e1, e2, n of the local frame (global components).
+    frame: [[f64; 3]; 3],
+    /// Thickness, mm.
+    thickness: f64,
+    material: Material,
+    /// Drilling penalty factor α (dimensionless).
+    drilling_factor: f64,
+}
+
+/// Shape functions and their derivatives at one point.
+struct ShapeAt {
+    n: [f64; 4],
+    /// dN/dx, dN/dy (local Cartesian).
+    dx: [f64; 4],
+    dy: [f64; 4],
+    det_j: f64,
+    /// Inverse Jacobian, `[dr/dx, ds/dx; dr/dy, ds/dy]` (so `d/dx = inv[0][0] d/dr + inv[0][1] d/ds`).
+    inv_j: [[f64; 2]; 2],
+}
+
+fn shape_functions(r: f64, s: f64) -> ([f64; 4], [f64; 4], [f64; 4]) {
+    let mut n = [0.0; 4];
+    let mut dr = [0.0; 4];
+    let mut ds = [0.0; 4];
+    for i in 0..4 {
+        n[i] = 0.25 * (1.0 + r * NODE_R[i]) * (1.0 + s * NODE_S[i]);
+        dr[i] = 0.25 * NODE_R[i] * (1.0 + s * NODE_S[i]);
+        ds[i] = 0.25 * NODE_S[i] * (1.0 + r * NODE_R[i]);
+    }
+    (n, dr, ds)
+}
+
+fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+fn norm(a: [f64; 3]) -> f64 {
+    dot(a, a).sqrt()
+}
+fn scale(a: [f64; 3], f: f64) -> [f64; 3] {
+    [a[0] * f, a[1] * f, a[2] * f]
+}
+
+impl Shell4 {
+    /// Default drilling penalty factor α in `½ ∫ α G t (θ3 − ω)² dA`.
+    pub const DEFAULT_DRILLING_FACTOR: f64 = 1e-3;
+    /// Shear correction factor of the transverse shear stiffness.
+    pub const SHEAR_CORRECTION: f64 = 5.0 / 6.0;
+
+    /// A shell through the four nodes (mm, counter-clockwise seen from either side), with
+    /// thickness `thickness` (mm). Errors: non-finite or coincident coordinates, a warped or
+    /// non-convex quadrilateral, non-positive thickness, invalid material.
+    pub fn new(nodes: [[f64; 3]; 4], thickness: f64, material: Material) -> Result<Shell4, Error> {
+        material.validate()?;
+        if !(thickness.is_finite() && thickness > 0.0) {
+            return Err(Error::Element(format!(
+                "Shell4 thickness must be positive and finite, got {thickness} mm"
+            )));
+        }
+        if nodes.iter().flatten().any(|c| !c.is_finite()) {
+            return Err(Error::Element(format!(
+                "Shell4 node coordinates are not finite: {nodes:?}"
+            )));
+        }
+        let centre = scale(
+            [0, 1, 2].map(|k| nodes.iter().map(|p| p[k]).sum::<f64>()),
+            0.25,
+        );
+        let d13 = sub(nodes[2], nodes[0]);
+        let d24 = sub(nodes[3], nodes[1]);
+        let normal = cross(d13, d24);
+        let size = norm(d13).max(norm(d24));
+        let area2 = norm(normal);
+        if size == 0.0 || area2 <= 1e-12 * size * size {
+            return Err(Error::Element(format!(
+                "Shell4 is degenerate (zero area): {nodes:?}"
+            )));
+        }
+        let n = scale(normal, 1.0 / area2);
+        for p in &nodes {
+            let off = dot(sub(*p, centre), n);
+            if off.abs() > 1e-6 * size {
+                return Err(Error::Element(format!(
+                    "Shell4 is warped: node {p:?} lies {off:.3e} mm off the element plane (flat elements only)"
+                )));
+            }
+        }
+        let mut e1 = sub(
+            [0, 1, 2].map(|k| nodes[1][k] + nodes[2][k]),
+            [0, 1, 2].map(|k| nodes[0][k] + nodes[3][k]),
+        );
+        e1 = sub(e1, scale(n, dot(e1, n)));
+        let e1n = norm(e1);
+        if e1n <= 1e-12 * size {
+            return Err(Error::Element(format!(
+                "Shell4 has no usable edge direction: {nodes:?}"
+            )));
+        }
+        let e1 = scale(e1, 1.0 / e1n);
+        let e2 = cross(n, e1);
+        let local = nodes.map(|p| {
+            let d = sub(p, centre);
+            [dot(d, e1), dot(d, e2)]
+        });
+        let shell = Shell4 {
+            local,
+            frame: [e1, e2, n],
+            thickness,
+            material,
+            drilling_factor: Self::DEFAULT_DRILLING_FACTOR,
+        };
+        for &(r, s) in GAUSS_POINTS.iter().chain(&[(0.0, 0.0)]) {
+            if shell.shape_at(r, s).det_j <= 0.0 {
+                return Err(Error::Element(format!(
+                    "Shell4 is not convex or its nodes are not in cyclic order: {nodes:?}"
+                )));
+            }
+        }
+        Ok(shell)
+    }
+
+    /// The same element with drilling factor α (dimensionless, ≥ 0).
+    pub fn with_drilling_factor(mut self, alpha: f64) -> Shell4 {
+        self.drilling_factor = alpha;
+        self
+    }
+
+    /// Unit normal of the element plane (global components).
+    pub fn normal(&self) -> [f64; 3] {
+        self.frame[2]
+    }
+
+    /// Element area, mm².
+    pub fn area(&self) -> f64 {
+        GAUSS_POINTS
+            .iter()
+            .map(|&(r, s)| self.shape_at(r, s).det_j)
+            .sum()
+    }
+
+    fn jacobian(&self, dr: &[f64; 4], ds: &[f64; 4]) -> [[f64; 2]; 2] {
+        let mut j = [[0.0; 2]; 2];
+        for i in 0..4 {
+            j[0][0] += dr[i] * self.local[i][0];
+            j[0][1] += dr[i] * self.local[i][1];
+            j[1][0] += ds[i] * self.local[i][0];
+            j[1][1] += ds[i] * self.local[i][1];
+        }
+        j
+    }
+
+    fn shape_at(&self, r: f64, s: f64) -> ShapeAt {
+        let (n, dr, ds) = shape_functions(r, s);
+        let j = self.jacobian(&dr, &ds);
+        let det_j = j[0][0] * j[1][1] - j[0][1] * j[1][0];
+        // J = [x_r y_r; x_s y_s]; [d/dx; d/dy] = J⁻¹ [d/dr; d/ds].
+        let inv_j = [
+            [j[1][1] / det_j, -j[0][1] / det_j],
+            [-j[1][0] / det_j, j[0][0] / det_j],
+        ];
+        let mut dx = [0.0; 4];
+        let mut dy = [0.0; 4];
+        for i in 0..4 {
+            dx[i] = inv_j[0][0] * dr[i] + inv_j[0][1] * ds[i];
+            dy[i] = inv_j[1][0] * dr[i] + inv_j[1][1] * ds[i];
+        }
+        ShapeAt {
+            n,
+            dx,
+            dy,
+            det_j,
+            inv_j,
+        }
+    }
+
+    /// Covariant transverse shear strain rows at a tying point: returns (B_r, B_s), the rows
+    /// giving γ_r and γ_s in terms of the 24 local DOF.
+    fn covariant_shear_rows(&self, r: f64, s: f64) -> ([f64; 24], [f64; 24]) {
+        let (n, dr, ds) = shape_functions(r, s);
+        let j = self.jacobian(&dr, &ds);
+        let (x_r, y_r, x_s, y_s) = (j[0][0], j[0][1], j[1][0], j[1][1]);
+        let mut br = [0.0; 24];
+        let mut bs = [0.0; 24];
+        for i in 0..4 {
+            // γ_r = w_,r + β_x x_,r + β_y y_,r with β_x = θ2, β_y = −θ1.
+            br[6 * i + W] = dr[i];
+            br[6 * i + T2] = n[i] * x_r;
+            br[6 * i + T1] = -n[i] * y_r;
+            bs[6 * i + W] = ds[i];
+            bs[6 * i + T2] = n[i] * x_s;
+            bs[6 * i + T1] = -n[i] * y_s;
+        }
+        (br, bs)
+    }
+
+    fn membrane_d(&self) -> [[f64; 3]; 3] {
+        let e = self.material.youngs_modulus;
+        let nu = self.material.poisson_ratio;
+        let c = e * self.thickness / (1.0 - nu * nu);
+        [
+            [c, c * nu, 0.0],
+            [c * nu, c, 0.0],
+            [0.0, 0.0, c * (1.0 - nu) / 2.0],
+        ]
+    }
+
+    /// Stiffness in the local frame (24×24, local DOF order per node u, v, w, θ1, θ2, θ3).
+    fn local_stiffness(&self) -> Mat24 {
+        let mut k = [[0.0; 24]; 24];
+        let t = self.thickness;
+        let dm = self.membrane_d();
+        let db = {
+            let f = t * t / 12.0;
+            dm.map(|row| row.map(|v| v * f))
+        };
+        let g = self.material.shear_modulus();
+        let ds = Self::SHEAR_CORRECTION * g * t;
+        let dd = self.drilling_factor * g * t;
+
+        // Incompatible-mode derivatives use the centre Jacobian (Taylor's correction).
+        let centre = self.shape_at(0.0, 0.0);
+        let det0 = centre.det_j;
+        let inv0 = centre.inv_j;
+
+        // Tying-point rows for MITC4.
+        let (ra, _) = self.covariant_shear_rows(0.0, 1.0);
+        let (rc, _) = self.covariant_shear_rows(0.0, -1.0);
+        let (_, sb) = self.covariant_shear_rows(-1.0, 0.0);
+        let (_, sd) = self.covariant_shear_rows(1.0, 0.0);
+
+        let mut kcc = [[0.0; 8]; 8]; // membrane compatible, DOF (u_i, v_i) → 2i, 2i+1
+        let mut kca = [[0.0; 4]; 8];
+        let mut kaa = [[0.0; 4]; 4];
+
+        for &(r, s) in &GAUSS_POINTS {
+            let sh = self.shape_at(r, s);
+            let w = sh.det_j;
+
+            // Membrane, compatible part: rows ε_x, ε_y, γ_xy over 8 DOF.
+            let mut bm = [[0.0; 8]; 3];
+            for i in 0..4 {
+                bm[0][2 * i] = sh.dx[i];
+                bm[1][2 * i + 1] = sh.dy[i];
+                bm[2][2 * i] = sh.dy[i];
+                bm[2][2 * i + 1] = sh.dx[i];
+            }
+            // Incompatible part: P1 = 1 − r², P2 = 1 − s²; a = [u1, u2, v1, v2].
+            let f = det0 / sh.det_j;
+            let p_dr = [-2.0 * r, 0.0];
+            let p_ds = [0.0, -2.0 * s];
+            let mut ba = [[0.0; 4]; 3];
+            for m in 0..2 {
+                let px = f * (inv0[0][0] * p_dr[m] + inv0[0][1] * p_ds[m]);
+                let py = f * (inv0[1][0] * p_dr[m] + inv0[1][1] * p_ds[m]);
+                ba[0][m] = px;
+                ba[1][2 + m] = py;
+                ba[2][m] = py;
+                ba[2][2 + m] = px;
+            }
+            let dbm = mat3_times(&dm, &bm);
+            let dba = mat3_times(&dm, &ba);
+            for a in 0..8 {
+                for b in 0..8 {
+                    kcc[a][b] += w * (0..3).map(|q| bm[q][a] * dbm[q][b]).sum::<f64>();
+                }
+                for b in 0..4 {
+                    kca[a][b] += w * (0..3).map(|q| bm[q][a] * dba[q][b]).sum::<f64>();
+                }
+            }
+            for a in 0..4 {
+                for b in 0..4 {
+                    kaa[a][b] += w * (0..3).map(|q| ba[q][a] * dba[q][b]).sum::<f64>();
+                }
+            }
+
+            // Bending: κ rows over 24 DOF.
+            let mut bb = [[0.0; 24]; 3];
+            for i in 0..4 {
+                // β_x = θ2, β_y = −θ1.
+                bb[0][6 * i + T2] = sh.dx[i];
+                bb[1][6 * i + T1] = -sh.dy[i];
+                bb[2][6 * i + T2] = sh.dy[i];
+                bb[2][6 * i + T1] = -sh.dx[i];
+            }
+            let dbb = mat3_times(&db, &bb);
+            add_btdb(&mut k, &bb, &dbb, w);
+
+            // MITC4 transverse shear.
+            let mut gr = [0.0; 24];
+            let mut gs = [0.0; 24];
+            for d in 0..24 {
+                gr[d] = 0.5 * (1.0 + s) * ra[d] + 0.5 * (1.0 - s) * rc[d];
+                gs[d] = 0.5 * (1.0 + r) * sd[d] + 0.5 * (1.0 - r) * sb[d];
+            }
+            let mut bsh = [[0.0; 24]; 2];
+            for d in 0..24 {
+                bsh[0][d] = sh.inv_j[0][0] * gr[d] + sh.inv_j[0][1] * gs[d];
+                bsh[1][d] = sh.inv_j[1][0] * gr[d] + sh.inv_j[1][1] * gs[d];
+            }
+            for a in 0..24 {
+                if bsh[0][a] == 0.0 && bsh[1][a] == 0.0 {
+                    continue;
+                }
+                for b in 0..24 {
+                    k[a][b] += w * ds * (bsh[0][a] * bsh[0][b] + bsh[1][a] * bsh[1][b]);
+                }
+            }
+
+            // Drilling: θ3 − ½ (v_,x − u_,y).
+            let mut bd = [0.0; 24];
+            for i in 0..4 {
+                bd[6 * i + T3] = sh.n[i];
+                bd[6 * i + V] = -0.5 * sh.dx[i];
+                bd[6 * i + U] = 0.5 * sh.dy[i];
+            }
+            for a in 0..24 {
+                if bd[a] == 0.0 {
+                    continue;
+                }
+                for b in 0..24 {
+                    k[a][b] += w * dd * bd[a] * bd[b];
+                }
+            }
+        }
+
+        // Condense the incompatible modes: K_m = K_cc − K_ca K_aa⁻¹ K_ac.
+        let kaa_inv = invert4(&kaa);
+        let mut km = kcc;
+        for a in 0..8 {
+            for b in 0..8 {
+                let mut corr = 0.0;
+                for p in 0..4 {
+                    for q in 0..4 {
+                        corr += kca[a][p] * kaa_inv[p][q] * kca[b][q];
+                    }
+                }
+                km[a][b] -= corr;
+            }
+        }
+        let mdof = |a: usize| 6 * (a / 2) + if a % 2 == 0 { U } else { V };
+        for a in 0..8 {
+            for b in 0..8 {
+                k[mdof(a)][mdof(b)] += km[a][b];
+            }
+        }
+        symmetrize(&mut k);
+        k
+    }
+
+    /// Mass in the local frame.
+    fn local_mass(&self) -> Mat24 {
+        let rho = self.material.density;
+        let t = self.thickness;
+        let mt = rho * t;
+        let mr = rho * t * t * t / 12.0;
+        let mut m = [[0.0; 24]; 24];
+        for &(r, s) in &GAUSS_POINTS {
+            let sh = self.shape_at(r, s);
+            for i in 0..4 {
+                for j in 0..4 {
+                    let nn = sh.n[i] * sh.n[j] * sh.det_j;
+                    for d in [U, V, W] {
+                        m[6 * i + d][6 * j + d] += mt * nn;
+                    }
+                    for d in [T1, T2, T3] {
+                        m[6 * i + d][6 * j + d] += mr * nn;
+                    }
+                }
+            }
+        }
+        m
+    }
+
+    /// Rotates a local 24×24 matrix to global axes: `Tᵀ A T` with `T = diag(R, …, R)`,
+    /// R's rows the local frame vectors.
+    fn to_global(&self, a: &Mat24) -> Mat<f64> {
+        let r = &self.frame;
+        // (A T): for each row a, block column j: sum_k A[a][3j+k] R[k][c].
+        let mut at = [[0.0; 24]; 24];
+        for (a, row) in a.iter().enumerate() {
+            for blk in 0..8 {
+                for c in 0..3 {
+                    at[a][3 * blk + c] = (0..3).map(|k| row[3 * blk + k] * r[k][c]).sum();
+                }
+            }
+        }
+        Mat::from_fn(24, 24, |i, j| {
+            let blk = i / 3;
+            let c = i % 3;
+            (0..3).map(|k| r[k][c] * at[3 * blk + k][j]).sum()
+        })
+    }
+
+    /// Global local-DOF transformation of a global displacement vector: `u_local = T u_global`.
+    fn to_local_vector(&self, u: &[f64; 24]) -> [f64; 24] {
+        let r = &self.frame;
+        let mut out = [0.0; 24];
+        for blk in 0..8 {
+            for k in 0..3 {
+                out[3 * blk + k] = (0..3).map(|c| r[k][c] * u[3 * blk + c]).sum();
+            }
+        }
+        out
+    }
+
+    /// 24×24 stiffness in global axes, DOF per node `[ux, uy, uz, rx, ry, rz]`.
+    pub fn stiffness(&self) -> Mat<f64> {
+        self.to_global(&self.local_stiffness())
+    }
+
+    /// 24×24 consistent mass in global axes.
+    pub fn mass(&self) -> Mat<f64> {
+        self.to_global(&self.local_mass())
+    }
+
+    /// Strain energy `½ uᵀ K u` (N·mm) of a global displacement vector, evaluated from the
+    /// local stiffness without forming the global matrix (an independent path for tests).
+    pub fn strain_energy(&self, u: &[f64; 24]) -> f64 {
+        let ul = self.to_local_vector(u);
+        let k = self.local_stiffness();
+        0.5 * (0..24)
+            .map(|a| ul[a] * (0..24).map(|b| k[a][b] * ul[b]).sum::<f64>())
+            .sum::<f64>()
+    }
+}
+
+fn mat3_times<const N: usize>(d: &[[f64; 3]; 3], b: &[[f64; N]; 3]) -> [[f64; N]; 3] {
+    let mut out = [[0.0; N]; 3];
+    for q in 0..3 {
+        for c in 0..N {
+            out[q][c] = (0..3).map(|p| d[q][p] * b[p][c]).sum();
+        }
+    }
+    out
+}
+
+fn add_btdb(k: &mut Mat24, b: &[[f64; 24]; 3], db: &[[f64; 24]; 3], w: f64) {
+    for a in 0..24 {
+        if b[0][a] == 0.0 && b[1][a] == 0.0 && b[2][a] == 0.0 {
+            continue;
+        }
+        for c in 0..24 {
+            k[a][c] += w * (b[0][a] * db[0][c] + b[1][a] * db[1][c] + b[2][a] * db[2][c]);
+        }
+    }
+}
+
+fn symmetrize(k: &mut Mat24) {
+    for a in 0..24 {
+        for b in (a + 1)..24 {
+            let v = 0.5 * (k[a][b] + k[b][a]);
+            k[a][b] = v;
+            k[b][a] = v;
+        }
+    }
+}
+
+/// Inverse of a symmetric positive definite 4×4 matrix by Gauss–Jordan elimination.
+fn invert4(a: &[[f64; 4]; 4]) -> [[f64; 4]; 4] {
+    let mut m = *a;
+    let mut inv = [[0.0; 4]; 4];
+    for (i, row) in inv.iter_mut().enumerate() {
+        row[i] = 1.0;
+    }
+    for col in 0..4 {
+        let p = m[col][col];
+        for c in 0..4 {
+            m[col][c] /= p;
+            inv[col][c] /= p;
+        }
+        for r in 0..4 {
+            if r != col {
+                let f = m[r][col];
+                for c in 0..4 {
+                    m[r][c] -= f * m[col][c];
+                    inv[r][c] -= f * inv[col][c];
+                }
+            }
+        }
+    }
+    inv
+}

@@ -1,0 +1,40 @@
+//! The crate's error type: one enum, a variant per layer, each naming what was wrong and where.
+
+use std::path::PathBuf;
+
+/// Everything that can go wrong in jointrom. Bad input is an error, never a panic.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum Error {
+    /// A case file could not be read.
+    #[error("{file}: cannot read: {source}")]
+    Io {
+        file: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    /// A case file is malformed or violates the schema; `path` is the JSON path (e.g.
+    /// `sheets[1].thickness`).
+    #[error("{file}: at `{path}`: {reason}")]
+    Case {
+        file: String,
+        path: String,
+        reason: String,
+    },
+    /// An element could not be built (degenerate geometry, bad material).
+    #[error("element: {0}")]
+    Element(String),
+    /// A linear-algebra failure: singular or indefinite matrix, failed factorization.
+    #[error("linear algebra: {0}")]
+    LinearAlgebra(String),
+    /// A request that does not fit the model (too many modes, unknown DOF, ...).
+    #[error("invalid request: {0}")]
+    Invalid(String),
+    /// A failure reported by SUNDIALS.
+    #[error("SUNDIALS: {function} returned {flag} at t = {time} s")]
+    Sundials {
+        function: &'static str,
+        flag: String,
+        time: f64,
+    },
+}

@@ -1,0 +1,38 @@
+//! # jointrom
+//!
+//! Transient dynamics of jointed sheet structures (leaf springs, spot-welded panels, lap joints)
+//! with contact and friction in the joints, by model order reduction with trial vector
+//! derivatives (Witteveen & Pichler 2014, `shared/paper`).
+//!
+//! The pipeline:
+//!
+//! 1. [`case`]: a JSON case file (units mm, N, t, s) is parsed and validated;
+//! 2. [`mesh`]: the sheets, weld beams, clamps, rigid ties and joint pairs are generated;
+//! 3. [`element`]: `Shell4` and `Beam2` element matrices;
+//! 4. [`assembly`]: sparse global K and M on the independent DOF (clamp and rigid tie eliminated);
+//! 5. [`modes`] and [`statics`]: eigenmodes (master free or fixed) and linear static solutions.
+//!
+//! ```no_run
+//! let model = jointrom::Model::from_case_name("friction_bar")?;
+//! assert_eq!(model.dofs(), 906);
+//! let modes = model.modes(10, jointrom::Interface::Fixed)?;
+//! println!("10th fixed-interface mode: {:.1} Hz", modes.frequencies_hz[9]);
+//! # Ok::<(), jointrom::Error>(())
+//! ```
+
+// Index loops mirror the element and matrix formulas (B_ij, K_ab) more clearly than iterator
+// chains; clippy's style lint against them is switched off for the numerical code.
+#![allow(clippy::needless_range_loop)]
+
+pub mod assembly;
+pub mod case;
+pub mod element;
+pub mod error;
+pub mod mesh;
+pub mod model;
+pub mod modes;
+pub mod statics;
+pub mod sundials;
+
+pub use error::Error;
+pub use model::{Interface, Model};

@@ -1,0 +1,1 @@
+//! Safe wrapper over SUNDIALS (the only module with `unsafe`). (Being written.)
