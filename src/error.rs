@@ -30,11 +30,20 @@ pub enum Error {
     /// A request that does not fit the model (too many modes, unknown DOF, ...).
     #[error("invalid request: {0}")]
     Invalid(String),
-    /// A failure reported by SUNDIALS.
-    #[error("SUNDIALS: {function} returned {flag} at t = {time} s")]
+    /// A failure reported by SUNDIALS: the C function, the flag's name and the time reached
+    /// (NaN outside a time integration, e.g. when creating a context).
+    #[error("SUNDIALS: {function} returned {flag}{}", time_suffix(*time))]
     Sundials {
         function: &'static str,
         flag: String,
         time: f64,
     },
+}
+
+fn time_suffix(time: f64) -> String {
+    if time.is_finite() {
+        format!(" at t = {time} s")
+    } else {
+        String::new()
+    }
 }

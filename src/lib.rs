@@ -23,6 +23,8 @@
 // Index loops mirror the element and matrix formulas (B_ij, K_ab) more clearly than iterator
 // chains; clippy's style lint against them is switched off for the numerical code.
 #![allow(clippy::needless_range_loop)]
+// All FFI `unsafe` lives in `sundials`.
+#![deny(unsafe_code)]
 
 pub mod assembly;
 pub mod case;
@@ -32,6 +34,7 @@ pub mod mesh;
 pub mod model;
 pub mod modes;
 pub mod statics;
+#[allow(unsafe_code)]
 pub mod sundials;
 
 pub use error::Error;

@@ -1,0 +1,207 @@
+//! Whole-model tests on the two paper scenes: DOF counts, constraint elimination, rigid-body
+//! modes of the free structure, eigen-solver agreement, statics, and the CLI's JSON contract.
+
+use std::process::Command;
+
+use faer::Side;
+use jointrom::assembly::assemble_structure;
+use jointrom::case::Case;
+use jointrom::modes::dense_modes;
+use jointrom::{Interface, Model};
+
+#[test]
+fn paper_dof_counts() {
+    let fb = Model::from_case_name("friction_bar").unwrap();
+    assert_eq!(fb.dofs(), 906);
+    assert_eq!(fb.joint_dofs(), 648);
+    assert_eq!(fb.mesh.pairs.len(), 54);
+    let ml = Model::from_case_name("multilayer_sheet").unwrap();
+    assert_eq!(ml.dofs(), 834);
+    assert_eq!(ml.joint_dofs(), 828);
+    assert_eq!(ml.mesh.pairs.len(), 92);
+}
+
+#[test]
+fn free_structure_has_exactly_six_rigid_body_modes() {
+    for name in Case::BUILTIN {
+        let case = Case::load(name).unwrap();
+        let mut mesh = case.build_mesh().unwrap();
+        mesh.clamped.clear();
+        let s = assemble_structure(&mesh).unwrap();
+        let k = s.stiffness.to_dense();
+        let eig = k.self_adjoint_eigenvalues(Side::Lower).unwrap();
+        let largest = eig[eig.len() - 1];
+        let zero = eig.iter().filter(|&&l| l.abs() <= 1e-10 * largest).count();
+        assert_eq!(zero, 6, "{name}: smallest eigenvalues {:?}", &eig[..8]);
+        assert!(eig[6] > 1e-10 * largest, "{name}: {:?}", &eig[..8]);
+    }
+}
+
+#[test]
+fn clamp_and_rigid_tie_are_exact() {
+    let model = Model::from_case_name("friction_bar").unwrap();
+    let load = model.case.master_load();
+    let sol = model.static_linear(&[load]).unwrap().remove(0);
+    let u = model.dof_map.expand(&sol.displacement);
+    for &c in &model.mesh.clamped {
+        assert!(u[6 * c..6 * c + 6].iter().all(|&v| v == 0.0));
+    }
+    let m = model.mesh.tie.master;
+    let xm = model.mesh.nodes[m];
+    let (um, th) = (&u[6 * m..6 * m + 3], &u[6 * m + 3..6 * m + 6]);
+    for &s in &model.mesh.tie.slaves {
+        let r: Vec<f64> = (0..3).map(|k| model.mesh.nodes[s][k] - xm[k]).collect();
+        let rigid = [
+            um[0] + th[1] * r[2] - th[2] * r[1],
+            um[1] + th[2] * r[0] - th[0] * r[2],
+            um[2] + th[0] * r[1] - th[1] * r[0],
+        ];
+        for k in 0..3 {
+            assert!((u[6 * s + k] - rigid[k]).abs() <= 1e-12 * um[1].abs());
+            assert_eq!(u[6 * s + 3 + k], th[k]);
+        }
+    }
+    // Equilibrium: the work of the load equals the strain energy (Clapeyron), 2U = fᵀu.
+    let mut ku = vec![0.0; model.dofs()];
+    model.stiffness.mul_vec(&sol.displacement, &mut ku);
+    let two_u: f64 = ku.iter().zip(&sol.displacement).map(|(a, b)| a * b).sum();
+    let work: f64 = (0..6).map(|k| load[k] * sol.master_displacement[k]).sum();
+    assert!(
+        (two_u - work).abs() <= 1e-6 * work.abs(),
+        "2U = {two_u}, work = {work}"
+    );
+    // The load pushes the tip down and twists it negatively about x.
+    assert!(sol.master_displacement[1] < 0.0 && sol.master_displacement[3] < 0.0);
+}
+
+#[test]
+fn lanczos_and_dense_agree_on_both_scenes_and_interfaces() {
+    for name in Case::BUILTIN {
+        let model = Model::from_case_name(name).unwrap();
+        for iface in [Interface::Fixed, Interface::Free] {
+            let lanczos = model.modes(20, iface).unwrap();
+            let (k, m) = match iface {
+                Interface::Free => (model.stiffness.clone(), model.mass.clone()),
+                Interface::Fixed => {
+                    let n = model.dofs() - 6;
+                    (model.stiffness.leading(n), model.mass.leading(n))
+                }
+            };
+            let dense = dense_modes(&k, &m, 20).unwrap();
+            for i in 0..20 {
+                let (a, b) = (lanczos.frequencies_hz[i], dense.frequencies_hz[i]);
+                assert!(
+                    (a - b).abs() <= 1e-7 * b,
+                    "{name} {iface:?} mode {i}: {a} vs {b}"
+                );
+            }
+            // Φᵀ M Φ = I.
+            let n = k.n;
+            let mut mphi = vec![0.0; n];
+            for i in 0..20 {
+                m.mul_vec(lanczos.shapes.col_as_slice(i), &mut mphi);
+                for j in 0..20 {
+                    let v: f64 = lanczos
+                        .shapes
+                        .col_as_slice(j)
+                        .iter()
+                        .zip(&mphi)
+                        .map(|(x, y)| x * y)
+                        .sum();
+                    let e = if i == j { 1.0 } else { 0.0 };
+                    assert!((v - e).abs() < 1e-8, "{name}: phi_{j}' M phi_{i} = {v}");
+                }
+            }
+            // Fixed-interface frequencies lie above the free ones (interlacing, Rayleigh).
+            if iface == Interface::Fixed {
+                let free = model.modes(20, Interface::Free).unwrap();
+                for i in 0..20 {
+                    assert!(lanczos.frequencies_hz[i] >= free.frequencies_hz[i] * (1.0 - 1e-9));
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn too_many_modes_is_an_error_not_a_panic() {
+    let model = Model::from_case_name("multilayer_sheet").unwrap();
+    let err = model.modes(5000, Interface::Fixed).unwrap_err();
+    assert!(err.to_string().contains("5000"), "{err}");
+    assert!(model.modes(0, Interface::Free).is_err());
+}
+
+fn cli(args: &[&str]) -> (bool, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_jointrom"))
+        .args(args)
+        .output()
+        .expect("binary runs");
+    (
+        out.status.success(),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+#[test]
+fn cli_json_contract() {
+    let (ok, out, err) = cli(&["info", "friction_bar", "--json"]);
+    assert!(ok, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(v["dofs"], 906);
+    assert_eq!(v["joint_pairs"], 54);
+    assert_eq!(v["joint_dofs"], 648);
+    assert_eq!(v["nodes"], 157);
+    assert_eq!(v["elements"], 102);
+
+    let (ok, out, err) = cli(&[
+        "modes",
+        "multilayer_sheet",
+        "--count",
+        "5",
+        "--interface",
+        "free",
+        "--json",
+    ]);
+    assert!(ok, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let f = v["frequencies_hz"].as_array().unwrap();
+    assert_eq!(f.len(), 5);
+    assert!(f.windows(2).all(|w| w[0].as_f64() <= w[1].as_f64()));
+
+    let (ok, out, err) = cli(&["static", "friction_bar", "--linear", "--json"]);
+    assert!(ok, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let u = v["master_displacement"].as_array().unwrap();
+    assert_eq!(u.len(), 6);
+    let (ok, out2, _) = cli(&[
+        "static",
+        "friction_bar",
+        "--linear",
+        "--scale",
+        "-2",
+        "--json",
+    ]);
+    assert!(ok);
+    let v2: serde_json::Value = serde_json::from_str(&out2).unwrap();
+    let uy = u[1].as_f64().unwrap();
+    let uy2 = v2["master_displacement"][1].as_f64().unwrap();
+    assert!((uy2 + 2.0 * uy).abs() <= 1e-9 * uy.abs(), "{uy} {uy2}");
+}
+
+#[test]
+fn cli_errors_name_the_problem() {
+    let (ok, _, err) = cli(&["info", "no_such_case"]);
+    assert!(!ok);
+    assert!(err.contains("no_such_case"), "{err}");
+    let (ok, _, err) = cli(&["static", "friction_bar"]);
+    assert!(!ok);
+    assert!(err.contains("--linear"), "{err}");
+    let dir = std::env::temp_dir().join("jointrom-cli-test");
+    std::fs::create_dir_all(&dir).unwrap();
+    let bad = dir.join("bad.json");
+    std::fs::write(&bad, "{\"name\": 3}").unwrap();
+    let (ok, _, err) = cli(&["info", bad.to_str().unwrap()]);
+    assert!(!ok);
+    assert!(err.contains("bad.json"), "{err}");
+}
