@@ -30,6 +30,7 @@ pub mod assembly;
 pub mod case;
 pub mod element;
 pub mod error;
+pub mod joint;
 pub mod mesh;
 pub mod model;
 pub mod modes;

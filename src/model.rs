@@ -3,6 +3,7 @@
 use crate::assembly::{assemble_structure, DofMap, Structure, SymCsc};
 use crate::case::Case;
 use crate::error::Error;
+use crate::joint::JointOperator;
 use crate::mesh::Mesh;
 use crate::modes::{self, Modes};
 use crate::statics::{self, StaticSolution};
@@ -29,6 +30,8 @@ pub struct Model {
     pub stiffness: SymCsc,
     /// Mass on the independent DOF, t (t·mm² for rotations).
     pub mass: SymCsc,
+    /// The joint operator B (3 rows per pair: normal gap, slip x, slip z).
+    pub joint: JointOperator,
 }
 
 impl Model {
@@ -45,12 +48,14 @@ impl Model {
             stiffness,
             mass,
         } = assemble_structure(&mesh)?;
+        let joint = JointOperator::new(&mesh, &dof_map)?;
         Ok(Model {
             case,
             mesh,
             dof_map,
             stiffness,
             mass,
+            joint,
         })
     }
 
