@@ -1,1 +1,366 @@
-//! Case files: serde schema (units mm, N, t, s) and validation. (Being written.)
+//! Case files: the serde schema of a jointed sheet structure (units mm, N, t, s), its validation
+//! with JSON paths, and the generation of the [`Mesh`].
+//!
+//! A case file describes flat sheets parallel to the x–z plane, the clamps that support them, one
+//! rigid tie (NASTRAN RBE2) from the free end to a master node that carries the load, weld spots
+//! (beams through a stack of sheets), the joints (sheet interfaces with node-to-node contact and
+//! friction, zero initial clearance) and the load history. The two structures of Witteveen &
+//! Pichler (2014), Section 4, ship as built-in cases: [`Case::builtin`]`("friction_bar")`
+//! (Section 4.1, 906 DOF, 648 of them in the joint) and `"multilayer_sheet"` (Section 4.2, 834 DOF,
+//! all in the joints).
+//!
+//! ```json
+//! {
+//!   "name": "friction_bar",
+//!   "material": {"youngs_modulus": 210000.0, "poisson_ratio": 0.3, "density": 7.85e-9},
+//!   "sheets": [
+//!     {"name": "A", "x": [0.0, 125.0], "z": [0.0, 25.0], "y": 0.0, "thickness": 0.5, "elements": [25, 2]},
+//!     {"name": "B", "x": [40.0, 165.0], "z": [0.0, 25.0], "y": 0.5, "thickness": 0.5, "elements": [25, 2]}
+//!   ],
+//!   "clamps": [{"x": 0.0, "sheets": ["A"]}],
+//!   "rigid_tie": {"x": 165.0, "sheets": ["B"], "master": [165.0, 0.5, 12.5]},
+//!   "welds": [{"x": 60.0, "z": 12.5, "sheets": ["A", "B"], "diameter": 5.0}],
+//!   "joints": [{"lower": "A", "upper": "B"}],
+//!   "contact": {"normal_stiffness": 1.0e4, "friction_coefficient": 0.25, "stick_stiffness": 1.0e4},
+//!   "load": {"master": {"fy": -0.7, "mx": -20.0}, "ramp": {"shape": "half_cosine", "duration": 0.05}},
+//!   "end_time": 0.2
+//! }
+//! ```
+//!
+//! # Geometry and numbering
+//!
+//! Sheet `s` spans `x ∈ [x0, x1]`, `z ∈ [z0, z1]` at height `y` (its mid-surface) and is meshed
+//! with `elements = [nx, nz]` 4-node shells. Its node `(i, k)`, `0 ≤ i ≤ nx`, `0 ≤ k ≤ nz`, lies at
+//! `(x0 + i·(x1−x0)/nx, y, z0 + k·(z1−z0)/nz)` and has index `first_node + i·(nz+1) + k`; sheets
+//! are numbered in file order and the master node comes last. Two points are the same node when
+//! they agree within [`NODE_TOLERANCE`] (1e-6 mm) in each coordinate.
+//!
+//! # Validation
+//!
+//! [`Case::from_json_str`] (and so [`Case::from_file`], [`Case::builtin`], [`Case::load`])
+//! rejects, as [`Error::Case`] with the file, the JSON path and the reason:
+//!
+//! - malformed JSON, unknown or missing fields and wrong types (path from `serde_path_to_error`;
+//!   a missing field's path names the field itself, the document root is `$`);
+//! - non-finite numbers; E, density, thickness, diameter, element counts, sheet lengths
+//!   (`x[1] > x[0]`, `z[1] > z[0]`), contact stiffnesses, ramp duration and end time that are
+//!   not positive; a negative friction coefficient; ν outside (−1, 0.5);
+//! - empty or duplicate sheet names, an unknown sheet name anywhere, a sheet listed twice;
+//! - a clamp or tie `x` that is not a node line of each listed sheet; no clamp at all; a node
+//!   that is both clamped and tied;
+//! - a weld whose (x, z) is not a node of each listed sheet, with fewer than two sheets, or with
+//!   sheets not in strictly increasing y;
+//! - a joint whose sheets are the same, are declared twice, have a clearance
+//!   (`upper.y − lower.y ≠ (t_lower + t_upper)/2` within 1e-9 of the scale), do not overlap in
+//!   (x, z), or overlap without coinciding nodes; an explicit joint point that is not a node of
+//!   both sheets, is listed twice, or is clamped or tied; a joint left without pairs.
+//!
+//! [`Case::build_mesh`] re-runs the same checks, so a `Case` edited in code cannot produce a
+//! broken mesh either.
+
+mod build;
+mod parse;
+
+use std::path::Path;
+
+use serde::{Deserialize, Serialize};
+
+use crate::element::Material;
+use crate::error::Error;
+use crate::mesh::Mesh;
+
+/// Two coordinates closer than this (mm) in each axis denote the same node.
+pub const NODE_TOLERANCE: f64 = 1e-6;
+
+/// A validated case: the structure, the contact law and the load history.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Case {
+    /// Name of the case (free text, used in reports).
+    pub name: String,
+    /// Optional description (free text).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub description: Option<String>,
+    /// Material of all sheets and welds.
+    pub material: MaterialSpec,
+    /// The sheets, in the order their nodes are numbered.
+    pub sheets: Vec<SheetSpec>,
+    /// Clamps (all 6 DOF fixed) along lines x = const; at least one node must be clamped.
+    pub clamps: Vec<ClampSpec>,
+    /// The rigid tie of one line x = const to the master node that carries the load.
+    pub rigid_tie: RigidTieSpec,
+    /// Weld spots: beams through a stack of sheets.
+    pub welds: Vec<WeldSpec>,
+    /// Joints: interfaces between two sheets with node-to-node contact and friction.
+    pub joints: Vec<JointSpec>,
+    /// Contact and friction law of all joints.
+    pub contact: ContactSpec,
+    /// The load on the master node and its time history.
+    pub load: LoadSpec,
+    /// End of the simulated time span, s (> 0).
+    pub end_time: f64,
+    /// Where the case came from: the file path as given, or `builtin:<name>`. Not part of the
+    /// file; set by the loaders and used as `file` in errors.
+    #[serde(skip)]
+    pub source: String,
+}
+
+/// Linear elastic isotropic material (see [`Material`]).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MaterialSpec {
+    /// Young's modulus E, N/mm² (> 0).
+    pub youngs_modulus: f64,
+    /// Poisson's ratio ν, dimensionless (−1 < ν < 0.5).
+    pub poisson_ratio: f64,
+    /// Mass density ρ, t/mm³ (> 0).
+    pub density: f64,
+}
+
+/// A flat rectangular sheet parallel to the x–z plane.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SheetSpec {
+    /// Unique, non-empty name, used by clamps, ties, welds and joints.
+    pub name: String,
+    /// Extent along x, `[x0, x1]` with `x1 > x0`, mm.
+    pub x: [f64; 2],
+    /// Extent along z, `[z0, z1]` with `z1 > z0`, mm.
+    pub z: [f64; 2],
+    /// Height of the mid-surface, mm.
+    pub y: f64,
+    /// Thickness, mm (> 0).
+    pub thickness: f64,
+    /// Number of shell elements `[nx, nz]` along x and z (each ≥ 1; the whole mesh may have at
+    /// most 10 000 000 nodes).
+    pub elements: [usize; 2],
+}
+
+/// A clamp: all nodes of the listed sheets on the line `x` have all 6 DOF fixed.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ClampSpec {
+    /// The clamped node line, mm; must be a node line of every listed sheet.
+    pub x: f64,
+    /// Names of the clamped sheets (at least one).
+    pub sheets: Vec<String>,
+}
+
+/// The rigid tie (RBE2, all 6 DOF): the nodes of the listed sheets on the line `x` move with
+/// the master node as one rigid body.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RigidTieSpec {
+    /// The tied node line, mm; must be a node line of every listed sheet.
+    pub x: f64,
+    /// Names of the tied sheets (at least one).
+    pub sheets: Vec<String>,
+    /// Position (x, y, z) of the master node, mm. It belongs to no sheet and carries the load.
+    pub master: [f64; 3],
+}
+
+/// A weld spot at (x, z) through a stack of sheets `[s0, s1, s2, …]`, modelled as the beams
+/// s0–s1, s1–s2, … between the sheets' nodes there.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WeldSpec {
+    /// Position along x, mm; with `z` a node of every listed sheet.
+    pub x: f64,
+    /// Position along z, mm.
+    pub z: f64,
+    /// Names of the welded sheets in strictly increasing y (at least two).
+    pub sheets: Vec<String>,
+    /// Diameter of the circular beam section, mm (> 0).
+    pub diameter: f64,
+}
+
+/// A joint: the interface between two stacked sheets with zero initial clearance,
+/// `upper.y − lower.y = (t_lower + t_upper)/2`, where the sheets' nodes pair up node to node.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct JointSpec {
+    /// Name of the lower sheet (smaller y).
+    pub lower: String,
+    /// Name of the upper sheet (larger y).
+    pub upper: String,
+    /// Optional (x, z) locations of the node pairs, mm; each must be a node of both sheets that
+    /// is neither clamped nor tied. Without it, every node of the lower sheet that coincides in
+    /// (x, z) with a node of the upper sheet forms a pair, except clamped or tied nodes (on
+    /// either side).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub points: Option<Vec<[f64; 2]>>,
+}
+
+/// Penalty contact and elastic–slip friction, the same for every node pair.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ContactSpec {
+    /// Normal penalty stiffness of a closed pair, N/mm (> 0).
+    pub normal_stiffness: f64,
+    /// Coulomb friction coefficient μ, dimensionless (≥ 0).
+    pub friction_coefficient: f64,
+    /// Tangential (stick) stiffness of a closed pair, N/mm (> 0).
+    pub stick_stiffness: f64,
+}
+
+/// The load on the master node: constant components times a ramp in time.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LoadSpec {
+    /// Final values of the master-node load.
+    pub master: MasterLoadSpec,
+    /// How the load rises from zero to its final values.
+    pub ramp: RampSpec,
+}
+
+impl LoadSpec {
+    /// The master-node load at time `t` (s): `[Fx, Fy, Fz (N), Mx, My, Mz (N·mm)]` times
+    /// [`RampSpec::factor`].
+    pub fn master_at(&self, t: f64) -> [f64; 6] {
+        let f = self.ramp.factor(t);
+        self.master.to_array().map(|v| v * f)
+    }
+}
+
+/// Final master-node load components; a missing key means zero.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MasterLoadSpec {
+    /// Force along x, N.
+    #[serde(default)]
+    pub fx: f64,
+    /// Force along y, N.
+    #[serde(default)]
+    pub fy: f64,
+    /// Force along z, N.
+    #[serde(default)]
+    pub fz: f64,
+    /// Moment about x, N·mm.
+    #[serde(default)]
+    pub mx: f64,
+    /// Moment about y, N·mm.
+    #[serde(default)]
+    pub my: f64,
+    /// Moment about z, N·mm.
+    #[serde(default)]
+    pub mz: f64,
+}
+
+impl MasterLoadSpec {
+    /// `[fx, fy, fz, mx, my, mz]` (N, N·mm).
+    pub fn to_array(&self) -> [f64; 6] {
+        [self.fx, self.fy, self.fz, self.mx, self.my, self.mz]
+    }
+}
+
+/// The load's rise in time.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RampSpec {
+    /// Shape of the rise.
+    pub shape: RampShape,
+    /// Rise time T, s (> 0): the load is at its final value from `t = T` on.
+    pub duration: f64,
+}
+
+impl RampSpec {
+    /// The load factor at time `t` (s): 0 for `t ≤ 0`, 1 for `t ≥ T`, and for
+    /// [`RampShape::HalfCosine`] `½(1 − cos(π t / T))` in between.
+    pub fn factor(&self, t: f64) -> f64 {
+        if t <= 0.0 {
+            0.0
+        } else if t >= self.duration {
+            1.0
+        } else {
+            match self.shape {
+                RampShape::HalfCosine => {
+                    0.5 * (1.0 - (std::f64::consts::PI * t / self.duration).cos())
+                }
+            }
+        }
+    }
+}
+
+/// Ramp shapes, spelled in snake case in the file (`"half_cosine"`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum RampShape {
+    /// `F(t) = F·½(1 − cos(π t / T))` for `t < T`, then `F`: smooth start, zero rate at `T`.
+    HalfCosine,
+}
+
+impl Case {
+    /// Names of the built-in cases (files `cases/<name>.json` compiled into the crate).
+    pub const BUILTIN: &'static [&'static str] = &["friction_bar", "multilayer_sheet"];
+
+    /// Parses a case from JSON text (unknown fields rejected) and validates it. `file` labels
+    /// the text in errors and becomes [`Case::source`].
+    pub fn from_json_str(text: &str, file: &str) -> Result<Case, Error> {
+        let mut case = parse::parse(text, file)?;
+        case.source = file.to_string();
+        build::build(&case)?;
+        Ok(case)
+    }
+
+    /// Reads, parses and validates a case file; [`Error::Io`] if it cannot be read.
+    pub fn from_file(path: &Path) -> Result<Case, Error> {
+        let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
+            file: path.to_path_buf(),
+            source,
+        })?;
+        Case::from_json_str(&text, &path.display().to_string())
+    }
+
+    /// The built-in case `name` (one of [`Case::BUILTIN`]), or `None` for an unknown name. Its
+    /// errors, if any, name the file `builtin:<name>`.
+    pub fn builtin(name: &str) -> Option<Result<Case, Error>> {
+        let text = match name {
+            "friction_bar" => include_str!("../../cases/friction_bar.json"),
+            "multilayer_sheet" => include_str!("../../cases/multilayer_sheet.json"),
+            _ => return None,
+        };
+        Some(Case::from_json_str(text, &format!("builtin:{name}")))
+    }
+
+    /// Loads `arg` as a file if such a path exists, else as a built-in name. Anything else is an
+    /// [`Error::Io`] (not found) whose message lists the built-in cases.
+    pub fn load(arg: &str) -> Result<Case, Error> {
+        let path = Path::new(arg);
+        if path.exists() {
+            return Case::from_file(path);
+        }
+        if let Some(case) = Case::builtin(arg) {
+            return case;
+        }
+        Err(Error::Io {
+            file: path.to_path_buf(),
+            source: std::io::Error::new(
+                std::io::ErrorKind::NotFound,
+                format!(
+                    "no such file, and not a built-in case (built-in cases: {})",
+                    Case::BUILTIN.join(", ")
+                ),
+            ),
+        })
+    }
+
+    /// Validates the case and generates its mesh (see [`Mesh`] and the module docs for the
+    /// numbering). Errors are those of [`Case::from_json_str`], labelled with [`Case::source`].
+    pub fn build_mesh(&self) -> Result<Mesh, Error> {
+        build::build(self)
+    }
+
+    /// The material of all sheets and welds.
+    pub fn material(&self) -> Material {
+        Material {
+            youngs_modulus: self.material.youngs_modulus,
+            poisson_ratio: self.material.poisson_ratio,
+            density: self.material.density,
+        }
+    }
+
+    /// The final master-node load `[Fx, Fy, Fz (N), Mx, My, Mz (N·mm)]`, before the ramp.
+    pub fn master_load(&self) -> [f64; 6] {
+        self.load.master.to_array()
+    }
+}

@@ -1,0 +1,62 @@
+//! JSON text to [`Case`], with serde errors turned into [`Error::Case`] that name the JSON path.
+
+use super::Case;
+use crate::error::Error;
+
+/// Parses `text` (the whole text must be one JSON object; unknown fields are rejected).
+pub(super) fn parse(text: &str, file: &str) -> Result<Case, Error> {
+    // serde's derived structs also accept a JSON array (fields by position); a case file is an
+    // object.
+    let first = text.trim_start().chars().next();
+    if first.is_some_and(|c| c != '{') {
+        return Err(Error::Case {
+            file: file.to_string(),
+            path: "$".to_string(),
+            reason: "a case file must be one JSON object `{ ... }`".to_string(),
+        });
+    }
+    let mut de = serde_json::Deserializer::from_str(text);
+    let case: Case = serde_path_to_error::deserialize(&mut de).map_err(|e| {
+        let path = e.path().to_string();
+        serde_error(file, &path, e.inner())
+    })?;
+    de.end().map_err(|e| serde_error(file, ".", &e))?;
+    Ok(case)
+}
+
+/// One serde_json error as [`Error::Case`]: the path as `serde_path_to_error` renders it (its
+/// root `.` and an unknown top-level segment `?` are shown as `$`), extended by the field's name
+/// for a missing field; the reason is the message with its line and column.
+fn serde_error(file: &str, path: &str, e: &serde_json::Error) -> Error {
+    let full = e.to_string();
+    let position = format!(" at line {} column {}", e.line(), e.column());
+    let message = full.strip_suffix(&position).unwrap_or(&full);
+    let missing = message
+        .strip_prefix("missing field `")
+        .and_then(|rest| rest.strip_suffix('`'));
+    let path = match (path, missing) {
+        (".", Some(field)) => field.to_string(),
+        (_, Some(field)) => format!("{path}.{field}"),
+        (".", None) | ("?", None) => "$".to_string(),
+        (_, None) => path.to_string(),
+    };
+    let message = if e.line() == 0 {
+        message.to_string()
+    } else {
+        format!("{message} (line {}, column {})", e.line(), e.column())
+    };
+    let reason = match e.classify() {
+        _ if message.starts_with("number out of range") => {
+            format!("not a finite number: {message}")
+        }
+        serde_json::error::Category::Syntax | serde_json::error::Category::Eof => {
+            format!("invalid JSON: {message}")
+        }
+        _ => message,
+    };
+    Error::Case {
+        file: file.to_string(),
+        path,
+        reason,
+    }
+}
