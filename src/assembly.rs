@@ -234,6 +234,18 @@ impl SymCsc {
         }
     }
 
+    /// `‖A‖∞`, the largest absolute row sum (= column sum, A being symmetric).
+    pub fn inf_norm(&self) -> f64 {
+        (0..self.n)
+            .map(|j| {
+                self.values[self.col_ptr[j]..self.col_ptr[j + 1]]
+                    .iter()
+                    .map(|v| v.abs())
+                    .sum::<f64>()
+            })
+            .fold(0.0, f64::max)
+    }
+
     /// Entry (i, j) (zero where not stored).
     pub fn get(&self, i: usize, j: usize) -> f64 {
         let rows = &self.row_idx[self.col_ptr[j]..self.col_ptr[j + 1]];

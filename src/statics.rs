@@ -58,15 +58,7 @@ pub fn solve_spd(a: &SymCsc, rhs: &[Vec<f64>]) -> Result<Vec<Vec<f64>>, Error> {
     chol.solve_in_place(&mut b);
     let mut out = Vec::with_capacity(rhs.len());
     let mut ax = vec![0.0; n];
-    // ‖A‖∞ (max row sum; A is symmetric, so max column sum) for the backward-error check.
-    let a_norm = (0..n)
-        .map(|j| {
-            a.values[a.col_ptr[j]..a.col_ptr[j + 1]]
-                .iter()
-                .map(|v| v.abs())
-                .sum::<f64>()
-        })
-        .fold(0.0, f64::max);
+    let a_norm = a.inf_norm();
     for (j, r) in rhs.iter().enumerate() {
         let x: Vec<f64> = (0..n).map(|i| b[(i, j)]).collect();
         if x.iter().any(|v| !v.is_finite()) {
