@@ -34,6 +34,7 @@ pub mod joint;
 pub mod mesh;
 pub mod model;
 pub mod modes;
+pub mod reduction;
 pub mod statics;
 #[allow(unsafe_code)]
 pub mod sundials;

@@ -1,0 +1,512 @@
+//! Basis construction of Witteveen & Pichler (2014), Algorithm 2: Craig–Bampton, trial vector
+//! derivatives, POD and the final M-orthonormal basis, on the two built-in cases.
+
+// Index loops mirror the matrix formulas, as in the library.
+#![allow(clippy::needless_range_loop)]
+
+use std::time::Instant;
+
+use faer::{Mat, MatRef};
+use jointrom::assembly::SymCsc;
+use jointrom::case::Case;
+use jointrom::joint::NORMAL;
+use jointrom::reduction::{
+    active_pairs, build_basis, craig_bampton, final_basis, pod, trial_vector_derivatives,
+    BasisKind, BasisOptions, ReducedModel, TvdOptions, DEFAULT_THRESHOLD,
+};
+use jointrom::Model;
+
+fn col(a: MatRef<'_, f64>, c: usize) -> Vec<f64> {
+    a.col(c).iter().copied().collect()
+}
+
+fn mul(a: &SymCsc, x: &[f64]) -> Vec<f64> {
+    let mut y = vec![0.0; a.n];
+    a.mul_vec(x, &mut y);
+    y
+}
+
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
+fn inf(a: &[f64]) -> f64 {
+    a.iter().fold(0.0f64, |m, v| m.max(v.abs()))
+}
+
+/// ‖A‖∞ of a symmetric sparse matrix.
+fn norm_inf(a: &SymCsc) -> f64 {
+    (0..a.n)
+        .map(|j| {
+            a.values[a.col_ptr[j]..a.col_ptr[j + 1]]
+                .iter()
+                .map(|v| v.abs())
+                .sum::<f64>()
+        })
+        .fold(0.0, f64::max)
+}
+
+/// `Xᵀ A Y` for sparse symmetric A.
+fn gram(a: &SymCsc, x: MatRef<'_, f64>, y: MatRef<'_, f64>) -> Mat<f64> {
+    let ay: Vec<Vec<f64>> = (0..y.ncols()).map(|c| mul(a, &col(y, c))).collect();
+    Mat::from_fn(x.ncols(), y.ncols(), |i, j| dot(&col(x, i), &ay[j]))
+}
+
+fn max_dev_from_identity(g: &Mat<f64>) -> f64 {
+    let mut d = 0.0f64;
+    for i in 0..g.nrows() {
+        for j in 0..g.ncols() {
+            let e = if i == j { 1.0 } else { 0.0 };
+            d = d.max((g[(i, j)] - e).abs());
+        }
+    }
+    d
+}
+
+#[test]
+fn craig_bampton_constraint_modes_and_k_orthogonality() {
+    for name in Case::BUILTIN {
+        let model = Model::from_case_name(name).unwrap();
+        let n = model.dofs();
+        let master = model.master_dofs();
+        let nu = 10;
+        let phi = craig_bampton(&model, nu).unwrap();
+        assert_eq!((phi.nrows(), phi.ncols()), (n, 6 + nu));
+        // Unit master displacement of each constraint mode; Φ_V zero on the master.
+        for c in 0..6 + nu {
+            for (d, &dof) in master.iter().enumerate() {
+                let expect = if c < 6 && c == d { 1.0 } else { 0.0 };
+                assert_eq!(phi[(dof, c)], expect, "{name}: column {c}, master DOF {d}");
+            }
+        }
+        // K Φ_S vanishes on the interior (backward error of the interior solve).
+        let knorm = norm_inf(&model.stiffness);
+        for c in 0..6 {
+            let x = col(phi.as_ref(), c);
+            let kx = mul(&model.stiffness, &x);
+            let interior = inf(&kx[..n - 6]);
+            let be = interior / (knorm * inf(&x));
+            assert!(
+                be < 1e-12,
+                "{name}: constraint mode {c}: interior residual {be:e}"
+            );
+        }
+        // Φ_Sᵀ K Φ_V = 0, relative to the energies.
+        let g = gram(&model.stiffness, phi.as_ref(), phi.as_ref());
+        for s in 0..6 {
+            for v in 6..6 + nu {
+                let rel = g[(s, v)].abs() / (g[(s, s)] * g[(v, v)]).sqrt();
+                // Exact in theory (K Φ_S is zero on the interior, Φ_V on the master); in floating
+                // point limited by K's conditioning (stiff short welds), so 1e-8, while the
+                // interior residual above is held to a backward error of 1e-12.
+                assert!(rel < 1e-8, "{name}: Φ_S[{s}]ᵀKΦ_V[{v}] relative {rel:e}");
+            }
+        }
+        // The M-orthonormal basis of CB alone needs no dropped direction.
+        let (q, dropped) = final_basis(&[phi.as_ref()], &model.mass, 1e-8).unwrap();
+        assert_eq!(dropped, 0, "{name}");
+        assert_eq!(q.ncols(), 6 + nu);
+        let dev = max_dev_from_identity(&gram(&model.mass, q.as_ref(), q.as_ref()));
+        assert!(dev < 1e-10, "{name}: ΦᵀMΦ − I = {dev:e}");
+    }
+}
+
+#[test]
+fn active_pairs_zero_rule() {
+    let opts = TvdOptions::default();
+    let off = TvdOptions {
+        zero_gap_active: false,
+        ..opts
+    };
+    // All gaps exactly zero: all active for both signs, or none.
+    let z = [0.0; 4];
+    assert_eq!(active_pairs(&z, 1.0, &opts), vec![true; 4]);
+    assert_eq!(active_pairs(&z, -1.0, &opts), vec![true; 4]);
+    assert_eq!(active_pairs(&z, 1.0, &off), vec![false; 4]);
+    // Round-off gaps relative to the vector's own scale count as zero.
+    let g = [1.0, -2.0, 1e-9, -1e-9];
+    assert_eq!(active_pairs(&g, 1.0, &opts), vec![false, true, true, true]);
+    assert_eq!(active_pairs(&g, -1.0, &opts), vec![true, false, true, true]);
+    assert_eq!(active_pairs(&g, 1.0, &off), vec![false, true, false, false]);
+    // Tiny vectors are judged by their own scale, not an absolute one.
+    let t = [1e-12, -1e-12];
+    assert_eq!(active_pairs(&t, 1.0, &off), vec![false, true]);
+}
+
+#[test]
+fn tvd_count_residual_sign_flip_and_normalization() {
+    let model = Model::from_case_name("friction_bar").unwrap();
+    let n = model.dofs();
+    let w = model.joint.pairs();
+    let kn = model.case.contact.normal_stiffness;
+    let base = craig_bampton(&model, 10).unwrap();
+    let opts = TvdOptions::default();
+    let tvd = trial_vector_derivatives(&model, base.as_ref(), &opts).unwrap();
+    assert_eq!(tvd.total, 2 * 16 * 16);
+    assert_eq!(tvd.total, 512);
+    assert_eq!(
+        tvd.nonzero() + tvd.zero_columns + tvd.negligible_columns,
+        tvd.total
+    );
+    assert_eq!(tvd.index.len(), tvd.nonzero());
+    // Active sets, recomputed here from the gaps: they flip with k where the gap is nonzero.
+    let mut flipped = 0;
+    for j in 0..base.ncols() {
+        let mut g = vec![0.0; w];
+        model.joint.gaps(&col(base.as_ref(), j), &mut g);
+        let scale = inf(&g);
+        for z in 0..w {
+            let zero = g[z].abs() <= opts.tol * scale;
+            let neg = tvd.active[j][0][z];
+            let pos = tvd.active[j][1][z];
+            if zero {
+                assert!(
+                    neg && pos,
+                    "j {j} pair {z}: zero gap must be active for both signs"
+                );
+            } else {
+                assert_eq!(pos, g[z] < 0.0, "j {j} pair {z}, k = +1");
+                assert_eq!(neg, !pos, "j {j} pair {z}: active set must flip with k");
+                flipped += 1;
+            }
+        }
+    }
+    assert!(flipped > 0);
+    // Residual: K (s φ_{i,k,j}) = Bₙᵀ(kₙ Bₙ φ_i) on the active pairs, built from B's rows here.
+    let knorm = norm_inf(&model.stiffness);
+    let mut worst = 0.0f64;
+    for (c, idx) in tvd.index.iter().enumerate() {
+        let phi_i = col(base.as_ref(), idx.i);
+        let act = &tvd.active[idx.j][if idx.k < 0 { 0 } else { 1 }];
+        let mut f = vec![0.0; n];
+        for z in (0..w).filter(|&z| act[z]) {
+            let r = 3 * z + NORMAL;
+            let bn: f64 = model.joint.row(r).map(|(d, v)| v * phi_i[d]).sum();
+            for (d, v) in model.joint.row(r) {
+                f[d] += kn * bn * v;
+            }
+        }
+        let x: Vec<f64> = col(tvd.vectors.as_ref(), c)
+            .iter()
+            .map(|v| v * tvd.k_norms[c])
+            .collect();
+        let kx = mul(&model.stiffness, &x);
+        let res: Vec<f64> = kx.iter().zip(&f).map(|(a, b)| a - b).collect();
+        let be = inf(&res) / (knorm * inf(&x) + inf(&f));
+        worst = worst.max(be);
+        // K-normalization.
+        let xn = col(tvd.vectors.as_ref(), c);
+        let e = dot(&xn, &mul(&model.stiffness, &xn));
+        // φᵀKφ sums large cancelling terms (ill-conditioned K): 1e-8, not 1e-14.
+        assert!((e - 1.0).abs() < 1e-8, "column {c}: φᵀKφ = {e}");
+    }
+    assert!(worst < 1e-12, "worst TVD backward error {worst:e}");
+    println!(
+        "friction_bar TVD: total {}, nonzero {}, zero {}, negligible {}, worst backward error {worst:.2e}",
+        tvd.total,
+        tvd.nonzero(),
+        tvd.zero_columns,
+        tvd.negligible_columns
+    );
+}
+
+#[test]
+fn tvd_zero_gap_rule_counts() {
+    for name in Case::BUILTIN {
+        let model = Model::from_case_name(name).unwrap();
+        let base = craig_bampton(&model, 10).unwrap();
+        let mut nonzero = [0usize; 2];
+        for (a, zero_gap_active) in [true, false].into_iter().enumerate() {
+            let opts = TvdOptions {
+                zero_gap_active,
+                ..TvdOptions::default()
+            };
+            let tvd = trial_vector_derivatives(&model, base.as_ref(), &opts).unwrap();
+            let all_zero: Vec<usize> = (0..base.ncols())
+                .filter(|&j| {
+                    let mut g = vec![0.0; model.joint.pairs()];
+                    model.joint.gaps(&col(base.as_ref(), j), &mut g);
+                    inf(&g) == 0.0
+                })
+                .collect();
+            if zero_gap_active {
+                let bphi = model.joint.reduce(base.as_ref());
+                let ratios: Vec<String> = (0..base.ncols())
+                    .map(|j| {
+                        let gmax = (0..model.joint.pairs())
+                            .fold(0.0f64, |m, z| m.max(bphi[(3 * z + NORMAL, j)].abs()));
+                        let all =
+                            (0..model.joint.rows()).fold(0.0f64, |m, r| m.max(bphi[(r, j)].abs()));
+                        format!("{:.1e}", gmax / all)
+                    })
+                    .collect();
+                println!(
+                    "{name}: max|gap| / max|Bφ_j| per base vector: [{}]",
+                    ratios.join(", ")
+                );
+                let zero_gaps: usize = (0..base.ncols())
+                    .map(|j| {
+                        let g: Vec<f64> = (0..model.joint.pairs())
+                            .map(|z| bphi[(3 * z + NORMAL, j)])
+                            .collect();
+                        let scale = inf(&g);
+                        g.iter().filter(|v| v.abs() <= 1e-6 * scale).count()
+                    })
+                    .sum();
+                println!(
+                    "{name}: gaps counted as zero (|g| ≤ 1e-6 max|g|): {zero_gaps} of {}",
+                    base.ncols() * model.joint.pairs()
+                );
+            }
+            println!(
+                "{name}: zero_gap_active = {zero_gap_active}: total {}, nonzero {}, zero {}, negligible {}; base vectors with all gaps exactly zero: {all_zero:?}",
+                tvd.total,
+                tvd.nonzero(),
+                tvd.zero_columns,
+                tvd.negligible_columns
+            );
+            assert_eq!(tvd.total, 512);
+            nonzero[a] = tvd.nonzero();
+            for weighted in [true, false] {
+                let p = pod(tvd.vectors.as_ref(), weighted.then_some(&model.stiffness)).unwrap();
+                println!(
+                    "{name}: zero_gap_active = {zero_gap_active}, {}: rank {}, g(w ≥ {DEFAULT_THRESHOLD}) = {}",
+                    if weighted { "K-weighted" } else { "plain" },
+                    p.lambda.len(),
+                    p.choose_g(DEFAULT_THRESHOLD)
+                );
+            }
+        }
+        // Treating zero gaps as inactive can only remove pairs, so never adds columns.
+        assert!(nonzero[1] <= nonzero[0], "{name}: {nonzero:?}");
+    }
+}
+
+#[test]
+fn pod_optimality_and_orthonormality() {
+    let model = Model::from_case_name("friction_bar").unwrap();
+    let base = craig_bampton(&model, 10).unwrap();
+    let tvd = trial_vector_derivatives(&model, base.as_ref(), &TvdOptions::default()).unwrap();
+    let y = tvd.vectors.as_ref();
+    let p = y.ncols();
+    let k = &model.stiffness;
+
+    let wp = pod(y, Some(k)).unwrap();
+    // Trace of YᵀKY = p for K-normalized columns.
+    let sum: f64 = wp.lambda.iter().sum();
+    assert!(
+        (sum - p as f64).abs() < 1e-8 * p as f64,
+        "Σλ = {sum}, p = {p}"
+    );
+    // Rank bound without k_t: one direction per pair at most.
+    assert!(
+        wp.lambda.len() <= model.joint.pairs(),
+        "rank {}",
+        wp.lambda.len()
+    );
+    // w(p) = 1, nondecreasing, in [0, 1]; λ descending.
+    assert_eq!(wp.w.len(), p);
+    assert_eq!(*wp.w.last().unwrap(), 1.0);
+    assert!(wp.w.windows(2).all(|a| a[1] >= a[0]));
+    assert!(wp.w.iter().all(|&v| (0.0..=1.0).contains(&v)));
+    assert!(wp.lambda.windows(2).all(|a| a[1] <= a[0]));
+    assert_eq!(wp.dropped + wp.lambda.len(), p);
+    // POMs are K-orthonormal.
+    // POMs are K-orthonormal. u_i = Y û_i / sqrt(λ_i) amplifies the eigenvector and K-product
+    // round-off by λ_max / λ_i, so entry (i, j) is held to 1e-8 · λ_max / sqrt(λ_i λ_j).
+    let u = wp.poms.as_ref();
+    let uku = gram(k, u, u);
+    let lmax = wp.lambda[0];
+    let mut worst = 0.0f64;
+    for i in 0..u.ncols() {
+        for j in 0..u.ncols() {
+            let e = if i == j { 1.0 } else { 0.0 };
+            let scaled = (uku[(i, j)] - e).abs() * (wp.lambda[i] * wp.lambda[j]).sqrt() / lmax;
+            worst = worst.max(scaled);
+        }
+    }
+    assert!(worst < 1e-8, "UᵀKU − I scaled by λ: {worst:e}");
+    let lead = 25.min(u.ncols());
+    let dev = max_dev_from_identity(&gram(k, u.subcols(0, lead), u.subcols(0, lead)));
+    println!("K-weighted POD: first {lead} POMs: UᵀKU − I = {dev:.2e}; scaled worst {worst:.2e}");
+    assert!(dev < 1e-8, "first {lead} POMs: UᵀKU − I = {dev:e}");
+    // Captured energy of the first g POMs: Σ_j ‖P y_j‖²_K = ‖Uᵀ K Y‖²_F = λ_1 + … + λ_g.
+    let uky = gram(k, u, y);
+    for g in [1, 5, 25, wp.lambda.len()] {
+        let g = g.min(wp.lambda.len());
+        let captured: f64 = (0..g)
+            .map(|i| (0..p).map(|j| uky[(i, j)].powi(2)).sum::<f64>())
+            .sum();
+        let lam: f64 = wp.lambda[..g].iter().sum();
+        assert!(
+            (captured - lam).abs() <= 1e-8 * lam,
+            "g = {g}: captured {captured}, Σλ {lam}"
+        );
+        assert!((wp.w[g - 1] - lam / sum).abs() < 1e-12);
+    }
+
+    // Plain POD: Euclidean-orthonormal POMs, same properties of w.
+    let pp = pod(y, None).unwrap();
+    let u = pp.poms.as_ref();
+    let utu = u.transpose() * u;
+    let lmax = pp.lambda[0];
+    let mut worst = 0.0f64;
+    for i in 0..u.ncols() {
+        for j in 0..u.ncols() {
+            let e = if i == j { 1.0 } else { 0.0 };
+            let scaled = (utu[(i, j)] - e).abs() * (pp.lambda[i] * pp.lambda[j]).sqrt() / lmax;
+            worst = worst.max(scaled);
+        }
+    }
+    assert!(worst < 1e-8, "UᵀU − I scaled by λ: {worst:e}");
+    assert_eq!(*pp.w.last().unwrap(), 1.0);
+    assert!(pp.w.windows(2).all(|a| a[1] >= a[0]));
+    let uy = u.transpose() * y;
+    let g = 10.min(pp.lambda.len());
+    let captured: f64 = (0..g)
+        .map(|i| (0..p).map(|j| uy[(i, j)].powi(2)).sum::<f64>())
+        .sum();
+    let lam: f64 = pp.lambda[..g].iter().sum();
+    assert!((captured - lam).abs() <= 1e-8 * lam);
+}
+
+#[test]
+fn energy_ratio_and_chosen_g_report() {
+    for name in Case::BUILTIN {
+        let model = Model::from_case_name(name).unwrap();
+        let base = craig_bampton(&model, 10).unwrap();
+        let tvd = trial_vector_derivatives(&model, base.as_ref(), &TvdOptions::default()).unwrap();
+        for weighted in [true, false] {
+            let weight = weighted.then_some(&model.stiffness);
+            let p = pod(tvd.vectors.as_ref(), weight).unwrap();
+            let g = p.choose_g(DEFAULT_THRESHOLD);
+            let first: Vec<String> = p.w.iter().take(30).map(|v| format!("{v:.5}")).collect();
+            println!(
+                "{name} {}: rank {}, dropped λ {}, g(w ≥ {DEFAULT_THRESHOLD}) = {g}, g(0.95) = {}, g(0.9999) = {}\n  w(1..30) = [{}]",
+                if weighted { "K-weighted" } else { "plain" },
+                p.lambda.len(),
+                p.dropped,
+                p.choose_g(0.95),
+                p.choose_g(0.9999),
+                first.join(", ")
+            );
+            assert!(g >= 1 && g <= p.lambda.len());
+            assert!(p.w[g - 1] >= DEFAULT_THRESHOLD);
+            assert!(g == 1 || p.w[g - 2] < DEFAULT_THRESHOLD);
+        }
+    }
+}
+
+#[test]
+fn build_basis_and_reduced_model() {
+    let model = Model::from_case_name("friction_bar").unwrap();
+    let t0 = Instant::now();
+    let basis = build_basis(&model, BasisKind::Tvd, &BasisOptions::default()).unwrap();
+    let elapsed = t0.elapsed();
+    println!(
+        "friction_bar Tvd basis: r = {} (16 + g = {}), dropped {}, TVD {}/{} nonzero, built in {:.1} ms",
+        basis.phi.ncols(),
+        basis.g,
+        basis.dropped,
+        basis.tvd_nonzero,
+        basis.tvd_total,
+        elapsed.as_secs_f64() * 1e3
+    );
+    assert_eq!(basis.phi.ncols() + basis.dropped, 16 + basis.g);
+    let rm = ReducedModel::new(&model, basis.phi.clone()).unwrap();
+    let r = rm.dim();
+    let dev = max_dev_from_identity(&rm.m);
+    assert!(dev < 1e-10, "M̃ − I = {dev:e}");
+    for i in 0..r {
+        assert!(rm.k[(i, i)] > 0.0);
+        for j in 0..r {
+            assert_eq!(rm.k[(i, j)], rm.k[(j, i)]);
+        }
+    }
+    assert_eq!(
+        (rm.b_phi.nrows(), rm.b_phi.ncols()),
+        (model.joint.rows(), r)
+    );
+    let f = model.case.load.master.to_array();
+    let mut full = vec![0.0; model.dofs()];
+    for (d, &dof) in model.master_dofs().iter().enumerate() {
+        full[dof] = f[d];
+    }
+    for c in 0..r {
+        let expect = dot(&col(rm.phi.as_ref(), c), &full);
+        assert!((rm.load[c] - expect).abs() <= 1e-12 * expect.abs().max(1e-300));
+    }
+
+    for kind in [BasisKind::TvdPlain, BasisKind::Modes] {
+        let t0 = Instant::now();
+        let b = build_basis(&model, kind, &BasisOptions::default()).unwrap();
+        println!(
+            "friction_bar {kind:?} basis: r = {}, g = {}, dropped {}, built in {:.1} ms",
+            b.phi.ncols(),
+            b.g,
+            b.dropped,
+            t0.elapsed().as_secs_f64() * 1e3
+        );
+        let dev = max_dev_from_identity(&gram(&model.mass, b.phi.as_ref(), b.phi.as_ref()));
+        assert!(dev < 1e-10, "{kind:?}: ΦᵀMΦ − I = {dev:e}");
+        if kind == BasisKind::Modes {
+            assert_eq!(b.phi.ncols(), 16 + b.g);
+        }
+    }
+}
+
+#[test]
+fn tangential_stiffness_widens_the_tvd_space() {
+    let model = Model::from_case_name("friction_bar").unwrap();
+    let w = model.joint.pairs();
+    let base = craig_bampton(&model, 10).unwrap();
+    let normal = trial_vector_derivatives(&model, base.as_ref(), &TvdOptions::default()).unwrap();
+    let opts = TvdOptions {
+        tangential: true,
+        ..TvdOptions::default()
+    };
+    let tang = trial_vector_derivatives(&model, base.as_ref(), &opts).unwrap();
+    let pn = pod(normal.vectors.as_ref(), Some(&model.stiffness)).unwrap();
+    let pt = pod(tang.vectors.as_ref(), Some(&model.stiffness)).unwrap();
+    println!(
+        "friction_bar rank of the TVD space: normal only {}, with k_t {} (pairs {w}); g(0.999) {} / {}",
+        pn.lambda.len(),
+        pt.lambda.len(),
+        pn.choose_g(DEFAULT_THRESHOLD),
+        pt.choose_g(DEFAULT_THRESHOLD)
+    );
+    assert!(pn.lambda.len() <= w);
+    assert!(pt.lambda.len() <= 3 * w);
+    assert!(pt.lambda.len() > pn.lambda.len());
+}
+
+#[test]
+fn final_basis_drops_dependent_directions_and_keeps_the_span() {
+    let model = Model::from_case_name("multilayer_sheet").unwrap();
+    let cb = craig_bampton(&model, 10).unwrap();
+    let n = model.dofs();
+    // Duplicates and a combination of earlier columns must be dropped.
+    let extra = Mat::from_fn(n, 3, |r, c| match c {
+        0 => cb[(r, 2)],
+        1 => 3.0 * cb[(r, 7)],
+        _ => cb[(r, 0)] - 2.0 * cb[(r, 12)],
+    });
+    let (q, dropped) = final_basis(&[cb.as_ref(), extra.as_ref()], &model.mass, 1e-8).unwrap();
+    assert_eq!(dropped, 3);
+    assert_eq!(q.ncols(), 16);
+    let dev = max_dev_from_identity(&gram(&model.mass, q.as_ref(), q.as_ref()));
+    assert!(dev < 1e-10, "ΦᵀMΦ − I = {dev:e}");
+    // span(Φ) = span(CB): the M-orthogonal projection of each CB column reproduces it.
+    let qmc = gram(&model.mass, q.as_ref(), cb.as_ref());
+    for c in 0..cb.ncols() {
+        let x = col(cb.as_ref(), c);
+        let mut res = x.clone();
+        for k in 0..q.ncols() {
+            for r in 0..n {
+                res[r] -= q[(r, k)] * qmc[(k, c)];
+            }
+        }
+        let rel = inf(&res) / inf(&x);
+        assert!(rel < 1e-9, "column {c}: projection residual {rel:e}");
+    }
+}
