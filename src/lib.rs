@@ -28,6 +28,7 @@
 
 pub mod assembly;
 pub mod case;
+pub mod contact;
 pub mod element;
 pub mod error;
 pub mod joint;

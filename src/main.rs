@@ -7,7 +7,7 @@ use std::time::Instant;
 use clap::{Parser, Subcommand, ValueEnum};
 use serde_json::{json, Value};
 
-use jointrom::{Error, Interface, Model};
+use jointrom::{contact, Error, Interface, Model};
 
 #[derive(Parser)]
 #[command(
@@ -56,7 +56,8 @@ enum Command {
     Static {
         /// Case file path or built-in name.
         case: String,
-        /// Linear analysis without contact (the joint may interpenetrate).
+        /// Linear analysis without contact (the joint may interpenetrate); default: full FE
+        /// model with frictionless penalty contact in the joint pairs.
         #[arg(long)]
         linear: bool,
         /// Factor on the case's load (e.g. -1 reverses it).
@@ -125,6 +126,20 @@ fn static_json(model: &Model, scale: f64) -> Result<Value, Error> {
     }))
 }
 
+fn contact_json(model: &Model, scale: f64) -> Result<Value, Error> {
+    let load = model.case.master_load().map(|v| v * scale);
+    let sol = contact::contact_static_full(model, load, &contact::ContactOptions::default())?;
+    Ok(json!({
+        "case": model.case.name,
+        "linear": false,
+        "load": load,
+        "master_displacement": sol.master_displacement,
+        "contact_force_norm": sol.state.contact_force_norm,
+        "pairs_in_contact": sol.state.pairs_in_contact,
+        "iterations": sol.state.iterations,
+    }))
+}
+
 fn run(command: Command) -> Result<(), Error> {
     match command {
         Command::Info { case, json } => {
@@ -189,28 +204,40 @@ fn run(command: Command) -> Result<(), Error> {
             scale,
             json,
         } => {
-            if !linear {
-                return Err(Error::Invalid(
-                    "static analysis with contact is not available yet; pass --linear for the linear (contact-free) solution".into(),
-                ));
-            }
             if !scale.is_finite() {
                 return Err(Error::Invalid(format!(
                     "--scale must be finite, got {scale}"
                 )));
             }
             let model = Model::from_case_name(&case)?;
-            let v = static_json(&model, scale)?;
+            let v = if linear {
+                static_json(&model, scale)?
+            } else {
+                contact_json(&model, scale)?
+            };
             if json {
                 print_json(&v);
             } else {
                 let u = &v["master_displacement"];
-                println!("{} — linear static, load × {scale}:", model.case.name);
+                let kind = if linear {
+                    "linear"
+                } else {
+                    "with contact (frictionless)"
+                };
+                println!("{} — static {kind}, load × {scale}:", model.case.name);
                 for (k, name) in ["ux", "uy", "uz", "rx", "ry", "rz"].iter().enumerate() {
                     let unit = if k < 3 { "mm" } else { "rad" };
                     println!(
                         "  {name} = {:>14.6e} {unit}",
                         u[k].as_f64().unwrap_or(f64::NAN)
+                    );
+                }
+                if !linear {
+                    println!(
+                        "  ‖f_c‖ = {:.6} N, {} of {} pairs in contact",
+                        v["contact_force_norm"].as_f64().unwrap_or(f64::NAN),
+                        v["pairs_in_contact"],
+                        model.mesh.pairs.len()
                     );
                 }
             }

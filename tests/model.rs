@@ -187,6 +187,19 @@ fn cli_json_contract() {
     let uy = u[1].as_f64().unwrap();
     let uy2 = v2["master_displacement"][1].as_f64().unwrap();
     assert!((uy2 + 2.0 * uy).abs() <= 1e-9 * uy.abs(), "{uy} {uy2}");
+
+    // With contact (the default): the joint stiffens the bar, some but not all pairs close.
+    let (ok, out3, err) = cli(&["static", "friction_bar", "--json"]);
+    assert!(ok, "{err}");
+    let v3: serde_json::Value = serde_json::from_str(&out3).unwrap();
+    assert!(v3["contact_force_norm"].as_f64().unwrap() > 0.0);
+    let n = v3["pairs_in_contact"].as_u64().unwrap();
+    assert!(n > 0 && n < 54, "{n}");
+    let uy3 = v3["master_displacement"][1].as_f64().unwrap();
+    assert!(
+        uy3 < 0.0 && uy3.abs() < uy.abs(),
+        "contact must stiffen: {uy3} vs {uy}"
+    );
 }
 
 #[test]
@@ -194,9 +207,9 @@ fn cli_errors_name_the_problem() {
     let (ok, _, err) = cli(&["info", "no_such_case"]);
     assert!(!ok);
     assert!(err.contains("no_such_case"), "{err}");
-    let (ok, _, err) = cli(&["static", "friction_bar"]);
+    let (ok, _, err) = cli(&["static", "friction_bar", "--scale", "nan"]);
     assert!(!ok);
-    assert!(err.contains("--linear"), "{err}");
+    assert!(err.contains("--scale"), "{err}");
     let dir = std::env::temp_dir().join("jointrom-cli-test");
     std::fs::create_dir_all(&dir).unwrap();
     let bad = dir.join("bad.json");
