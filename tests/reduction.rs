@@ -34,18 +34,6 @@ fn inf(a: &[f64]) -> f64 {
     a.iter().fold(0.0f64, |m, v| m.max(v.abs()))
 }
 
-/// ‖A‖∞ of a symmetric sparse matrix.
-fn norm_inf(a: &SymCsc) -> f64 {
-    (0..a.n)
-        .map(|j| {
-            a.values[a.col_ptr[j]..a.col_ptr[j + 1]]
-                .iter()
-                .map(|v| v.abs())
-                .sum::<f64>()
-        })
-        .fold(0.0, f64::max)
-}
-
 /// `Xᵀ A Y` for sparse symmetric A.
 fn gram(a: &SymCsc, x: MatRef<'_, f64>, y: MatRef<'_, f64>) -> Mat<f64> {
     let ay: Vec<Vec<f64>> = (0..y.ncols()).map(|c| mul(a, &col(y, c))).collect();
@@ -80,7 +68,7 @@ fn craig_bampton_constraint_modes_and_k_orthogonality() {
             }
         }
         // K Φ_S vanishes on the interior (backward error of the interior solve).
-        let knorm = norm_inf(&model.stiffness);
+        let knorm = model.stiffness.inf_norm();
         for c in 0..6 {
             let x = col(phi.as_ref(), c);
             let kx = mul(&model.stiffness, &x);
@@ -173,7 +161,7 @@ fn tvd_count_residual_sign_flip_and_normalization() {
     }
     assert!(flipped > 0);
     // Residual: K (s φ_{i,k,j}) = Bₙᵀ(kₙ Bₙ φ_i) on the active pairs, built from B's rows here.
-    let knorm = norm_inf(&model.stiffness);
+    let knorm = model.stiffness.inf_norm();
     let mut worst = 0.0f64;
     for (c, idx) in tvd.index.iter().enumerate() {
         let phi_i = col(base.as_ref(), idx.i);
