@@ -35,6 +35,7 @@ pub mod joint;
 pub mod mesh;
 pub mod model;
 pub mod modes;
+pub mod ode;
 pub mod reduction;
 pub mod statics;
 #[allow(unsafe_code)]
