@@ -31,6 +31,7 @@ pub mod case;
 pub mod contact;
 pub mod element;
 pub mod error;
+pub mod friction;
 pub mod joint;
 pub mod mesh;
 pub mod model;
@@ -40,6 +41,8 @@ pub mod reduction;
 pub mod statics;
 #[allow(unsafe_code)]
 pub mod sundials;
+pub mod system;
+pub mod transient;
 
 pub use error::Error;
 pub use model::{Interface, Model};

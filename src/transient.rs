@@ -1,0 +1,500 @@
+//! The transient mechanical problem as a first-order ODE ([`crate::ode::OdeProblem`]) for any
+//! [`SecondOrderSystem`], full or reduced.
+//!
+//! ## State
+//!
+//! ```text
+//! y = [q (n), v (n), s (2w, friction on only), W, D]
+//! q' = v
+//! M v' = f(t) − K q − Bᵀ p(B q, s)                 (paper eq. 6 / eq. 7)
+//! s' = ṡ(B q, s)                                   (viscoplastic slip memory, crate::friction)
+//! W' = f(t) · v                                    (external work, N·mm)
+//! D' = Σ_pairs p_t · ṡ                             (dissipated energy, N·mm)
+//! ```
+//!
+//! With friction off the state has no `s` block (the tangential forces are zero and there is no
+//! memory to carry) and `D' = 0`. `W` and `D` are integrated by the integrator itself (so they
+//! are as accurate as the motion, independent of the output spacing); they do not feed back into
+//! the motion. The energy balance
+//! `E_kin + E_strain + E_pair − W + D = 0` (from rest, [`EnergySample::balance`]) then closes up
+//! to the integration error and the viscoplastic lag of [`crate::friction`].
+//!
+//! ## The Newton solve
+//!
+//! CVODE's Newton matrix is `I − γJ`. With `P_u = ∂p/∂(Bq)`, `P_s = ∂p/∂s = −[0; T]`
+//! (`T = ∂p_t/∂u_t`), `D_s = ∂ṡ/∂u_t = −∂ṡ/∂s`, `φ_g = ∂ṡ/∂g`, the system
+//! `(I − γJ) [a; b; c; z_W; z_D] = [r_q; r_v; r_s; r_W; r_D]` reads
+//!
+//! ```text
+//! a − γ b = r_q
+//! M b + γ K a + γ Bᵀ (P_u B a + P_s c) = M r_v
+//! (I + γ D_s) c = r_s + γ D_s B_t a + γ φ_g B_n a          (per pair, 2×2)
+//! ```
+//!
+//! Eliminating `b = (a − r_q)/γ` and `c` gives (the `φ_g` term drops out: `T φ_g = 0`)
+//!
+//! ```text
+//! (M + γ² (K + Bᵀ K_c B)) a = M r_q + γ M r_v + γ² Bᵀ [0; T (I + γ D_s)⁻¹ r_s]
+//! K_c per pair = [[∂p_n/∂g, 0], [0, T (I + γ D_s)⁻¹]]
+//! ```
+//!
+//! `T (I + γD_s)⁻¹` is symmetric for every branch (stick: `k_t I`, open: 0, slip:
+//! `μ|p_n|/|e| / (1 + γρ/τ) · (I − n nᵀ)`, `ρ = (|e| − c)/|e|`). The only term dropped is the
+//! non-symmetric `∂p_t/∂g = −μ k_n n` of sliding pairs (the friction force follows the normal
+//! force), so that the matrix stays symmetric positive definite for a Cholesky factorization:
+//! the solve is exact when no pair slides, otherwise a modified Newton direction that CVODE's
+//! iteration corrects. `z_W = r_W + γ f(t)·b` and `z_D = r_D + γ ∇D'·[a; c]` are exact.
+
+use crate::error::Error;
+use crate::friction::{evaluate_pairs, PairLaw, PairState, DEFAULT_TAU};
+use crate::ode::{CallbackError, OdeProblem};
+use crate::system::SecondOrderSystem;
+
+/// Options of the mechanical problem.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct ProblemOptions {
+    /// Friction (tangential forces and slip memory) on.
+    pub friction: bool,
+    /// Root functions: gaps (w) and, with friction, stick/slip switches (w).
+    pub events: bool,
+    /// Relaxation time τ of the slip memory, s.
+    pub tau: f64,
+}
+
+impl Default for ProblemOptions {
+    fn default() -> Self {
+        ProblemOptions {
+            friction: true,
+            events: false,
+            tau: DEFAULT_TAU,
+        }
+    }
+}
+
+/// One pair's linearization kept between Newton setup and solves.
+#[derive(Clone, Copy, Debug, Default)]
+struct PairLin {
+    /// `(I + γ D_s)⁻¹`.
+    inv: [[f64; 2]; 2],
+    /// `D_s = ∂ṡ/∂u_t`.
+    sdot_u: [[f64; 2]; 2],
+    /// `φ_g = ∂ṡ/∂g`.
+    sdot_g: [f64; 2],
+    /// `T (I + γ D_s)⁻¹` (symmetric).
+    t_eff: [[f64; 2]; 2],
+    /// `T = ∂p_t/∂u_t`.
+    pt_u: [[f64; 2]; 2],
+    /// `∂p_n/∂g`.
+    pn_g: f64,
+    /// `∂d/∂u_t`, `∂d/∂g`.
+    diss_u: [f64; 2],
+    diss_g: f64,
+}
+
+/// The mechanical ODE of a second-order system with joint pairs.
+pub struct MechanicalOde<S: SecondOrderSystem> {
+    sys: S,
+    law: PairLaw,
+    events: bool,
+    n: usize,
+    w: usize,
+    /// Work buffers (no allocation in callbacks).
+    u: Vec<f64>,
+    p: Vec<f64>,
+    srate: Vec<f64>,
+    f: Vec<f64>,
+    tmp: Vec<f64>,
+    tmp2: Vec<f64>,
+    kc: Vec<f64>,
+    lin: Vec<PairLin>,
+    lin_gamma: f64,
+    have_lin: bool,
+    /// Sliding pairs at the last Newton setup.
+    slipping_at_setup: usize,
+}
+
+impl<S: SecondOrderSystem> MechanicalOde<S> {
+    /// Wraps a system with the case's contact law.
+    pub fn new(sys: S, opts: &ProblemOptions) -> Result<MechanicalOde<S>, Error> {
+        let c = sys.contact();
+        if !(opts.tau.is_finite() && opts.tau > 0.0) {
+            return Err(Error::Invalid(format!(
+                "tau (slip relaxation time) must be finite and positive, got {} s",
+                opts.tau
+            )));
+        }
+        let law = PairLaw {
+            k_n: c.normal_stiffness,
+            friction: opts.friction,
+            mu: c.friction_coefficient,
+            k_t: c.stick_stiffness,
+            tau: opts.tau,
+        };
+        let n = sys.dim();
+        let w = sys.pairs();
+        Ok(MechanicalOde {
+            law,
+            events: opts.events,
+            n,
+            w,
+            u: vec![0.0; 3 * w],
+            p: vec![0.0; 3 * w],
+            srate: vec![0.0; 2 * w],
+            f: vec![0.0; n],
+            tmp: vec![0.0; n],
+            tmp2: vec![0.0; n],
+            kc: vec![0.0; 9 * w],
+            lin: vec![PairLin::default(); w],
+            lin_gamma: f64::NAN,
+            have_lin: false,
+            slipping_at_setup: 0,
+            sys,
+        })
+    }
+
+    /// The system.
+    pub fn system(&self) -> &S {
+        &self.sys
+    }
+
+    /// The pair law in use.
+    pub fn law(&self) -> &PairLaw {
+        &self.law
+    }
+
+    /// Number of structural coordinates n.
+    pub fn coords(&self) -> usize {
+        self.n
+    }
+
+    /// Number of slip-memory states (2w with friction, else 0).
+    fn ns(&self) -> usize {
+        if self.law.friction {
+            2 * self.w
+        } else {
+            0
+        }
+    }
+
+    /// Index of the external-work state W (D follows).
+    pub fn work_index(&self) -> usize {
+        2 * self.n + self.ns()
+    }
+
+    /// Pairs sliding at the last Newton setup.
+    pub fn slipping_at_setup(&self) -> usize {
+        self.slipping_at_setup
+    }
+
+    /// The initial state: at rest, undeformed, no slip, no work.
+    pub fn initial_state(&self) -> Vec<f64> {
+        vec![0.0; self.dim()]
+    }
+
+    /// Outputs at `(t, y)`: force norms, master displacement, energies.
+    pub fn sample(&mut self, t: f64, y: &[f64]) -> EnergySample {
+        let n = self.n;
+        let (q, rest) = y.split_at(n);
+        let (v, rest) = rest.split_at(n);
+        let (s, rest) = rest.split_at(self.ns());
+        self.sys.joint_apply_into(q, &mut self.u);
+        evaluate_pairs(&self.law, &self.u, s, &mut self.p, &mut self.srate);
+        let mut fc = 0.0;
+        let mut fr = 0.0;
+        let mut pair = 0.0;
+        for k in 0..self.w {
+            fc += self.p[3 * k].powi(2);
+            fr += self.p[3 * k + 1].powi(2) + self.p[3 * k + 2].powi(2);
+            let sk = if self.law.friction {
+                [s[2 * k], s[2 * k + 1]]
+            } else {
+                [0.0; 2]
+            };
+            pair += self
+                .law
+                .stored_energy([self.u[3 * k], self.u[3 * k + 1], self.u[3 * k + 2]], sk);
+        }
+        self.sys.mul_m_into(v, &mut self.tmp);
+        let kinetic = 0.5 * dot(v, &self.tmp);
+        self.sys.mul_k_into(q, &mut self.tmp);
+        let strain = 0.5 * dot(q, &self.tmp);
+        EnergySample {
+            t,
+            contact_force_norm: fc.sqrt(),
+            friction_force_norm: fr.sqrt(),
+            master: self.sys.master_displacement(q),
+            kinetic,
+            strain,
+            pair,
+            external_work: rest[0],
+            dissipated: rest[1],
+        }
+    }
+}
+
+/// Outputs at one time.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct EnergySample {
+    /// Time, s.
+    pub t: f64,
+    /// ‖f_c‖: Euclidean norm of all pair normal forces, N.
+    pub contact_force_norm: f64,
+    /// ‖f_R‖: Euclidean norm of all tangential (x, z) pair forces, N.
+    pub friction_force_norm: f64,
+    /// Master node `[ux, uy, uz (mm), rx, ry, rz (rad)]`.
+    pub master: [f64; 6],
+    /// `½ vᵀ M v`, N·mm.
+    pub kinetic: f64,
+    /// `½ qᵀ K q`, N·mm.
+    pub strain: f64,
+    /// Pair (penalty + elastic stick) energy, N·mm.
+    pub pair: f64,
+    /// `∫ f · v dt`, N·mm.
+    pub external_work: f64,
+    /// `∫ Σ p_t · ṡ dt`, N·mm.
+    pub dissipated: f64,
+}
+
+impl EnergySample {
+    /// `E_kin + E_strain + E_pair + D − W` (zero for an exact solution from rest), N·mm.
+    pub fn balance(&self) -> f64 {
+        self.kinetic + self.strain + self.pair + self.dissipated - self.external_work
+    }
+}
+
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
+fn mul2(a: &[[f64; 2]; 2], x: [f64; 2]) -> [f64; 2] {
+    [
+        a[0][0] * x[0] + a[0][1] * x[1],
+        a[1][0] * x[0] + a[1][1] * x[1],
+    ]
+}
+
+fn matmul2(a: &[[f64; 2]; 2], b: &[[f64; 2]; 2]) -> [[f64; 2]; 2] {
+    let mut c = [[0.0; 2]; 2];
+    for i in 0..2 {
+        for j in 0..2 {
+            c[i][j] = a[i][0] * b[0][j] + a[i][1] * b[1][j];
+        }
+    }
+    c
+}
+
+fn non_finite(what: &str, x: &[f64]) -> Result<(), CallbackError> {
+    if x.iter().all(|v| v.is_finite()) {
+        Ok(())
+    } else {
+        Err(CallbackError::Recoverable(format!("{what} is not finite")))
+    }
+}
+
+impl<S: SecondOrderSystem> MechanicalOde<S> {
+    /// Builds K_c and the per-pair data for γ from the stored linearization.
+    fn apply_gamma(&mut self, gamma: f64) {
+        for (k, l) in self.lin.iter_mut().enumerate() {
+            let a = [
+                [1.0 + gamma * l.sdot_u[0][0], gamma * l.sdot_u[0][1]],
+                [gamma * l.sdot_u[1][0], 1.0 + gamma * l.sdot_u[1][1]],
+            ];
+            let det = a[0][0] * a[1][1] - a[0][1] * a[1][0];
+            l.inv = [
+                [a[1][1] / det, -a[0][1] / det],
+                [-a[1][0] / det, a[0][0] / det],
+            ];
+            let te = matmul2(&l.pt_u, &l.inv);
+            let off = 0.5 * (te[0][1] + te[1][0]);
+            l.t_eff = [[te[0][0], off], [off, te[1][1]]];
+            let b = &mut self.kc[9 * k..9 * k + 9];
+            b.fill(0.0);
+            b[0] = l.pn_g;
+            b[4] = l.t_eff[0][0];
+            b[5] = l.t_eff[0][1];
+            b[7] = l.t_eff[1][0];
+            b[8] = l.t_eff[1][1];
+        }
+        self.lin_gamma = gamma;
+    }
+}
+
+impl<S: SecondOrderSystem> OdeProblem for MechanicalOde<S> {
+    fn dim(&self) -> usize {
+        2 * self.n + self.ns() + 2
+    }
+
+    fn rhs(&mut self, t: f64, y: &[f64], ydot: &mut [f64]) -> Result<(), CallbackError> {
+        let n = self.n;
+        let ns = self.ns();
+        let (q, rest) = y.split_at(n);
+        let (v, rest) = rest.split_at(n);
+        let s = &rest[..ns];
+        self.sys.joint_apply_into(q, &mut self.u);
+        let tot = evaluate_pairs(&self.law, &self.u, s, &mut self.p, &mut self.srate);
+        self.sys.load_into(t, &mut self.f);
+        self.sys.mul_k_into(q, &mut self.tmp);
+        self.sys.joint_transpose_add(&self.p, &mut self.tmp);
+        let (dq, drest) = ydot.split_at_mut(n);
+        let (dv, drest) = drest.split_at_mut(n);
+        dq.copy_from_slice(v);
+        for ((o, fi), ki) in dv.iter_mut().zip(&self.f).zip(&self.tmp) {
+            *o = fi - ki;
+        }
+        self.sys.solve_m_in_place(dv);
+        drest[..ns].copy_from_slice(&self.srate[..ns]);
+        drest[ns] = dot(&self.f, v);
+        drest[ns + 1] = tot.dissipation;
+        non_finite("the right-hand side", ydot)
+    }
+
+    fn num_roots(&self) -> usize {
+        if !self.events {
+            0
+        } else if self.law.friction {
+            2 * self.w
+        } else {
+            self.w
+        }
+    }
+
+    fn roots(&mut self, _t: f64, y: &[f64], g: &mut [f64]) -> Result<(), CallbackError> {
+        let n = self.n;
+        self.sys.joint_apply_into(&y[..n], &mut self.u);
+        for k in 0..self.w {
+            g[k] = self.u[3 * k];
+        }
+        if self.law.friction {
+            let s = &y[2 * n..2 * n + 2 * self.w];
+            for k in 0..self.w {
+                g[self.w + k] = self.law.switch(
+                    [self.u[3 * k], self.u[3 * k + 1], self.u[3 * k + 2]],
+                    [s[2 * k], s[2 * k + 1]],
+                );
+            }
+        }
+        Ok(())
+    }
+
+    fn has_newton_solver(&self) -> bool {
+        true
+    }
+
+    fn newton_setup(
+        &mut self,
+        _t: f64,
+        y: &[f64],
+        _fy: &[f64],
+        jok: bool,
+        gamma: f64,
+    ) -> Result<bool, CallbackError> {
+        let n = self.n;
+        let jcur = !(jok && self.have_lin);
+        if jcur {
+            self.sys.joint_apply_into(&y[..n], &mut self.u);
+            let s = &y[2 * n..2 * n + self.ns()];
+            let mut slipping = 0;
+            for k in 0..self.w {
+                let uk = [self.u[3 * k], self.u[3 * k + 1], self.u[3 * k + 2]];
+                let sk = if self.law.friction {
+                    [s[2 * k], s[2 * k + 1]]
+                } else {
+                    [0.0; 2]
+                };
+                let tg = self.law.tangent(uk, sk);
+                if self.law.friction && self.law.eval(uk, sk).state == PairState::Slip {
+                    slipping += 1;
+                }
+                self.lin[k] = PairLin {
+                    sdot_u: tg.sdot_u,
+                    sdot_g: tg.sdot_g,
+                    pt_u: tg.pt_u,
+                    pn_g: tg.pn_g,
+                    diss_u: tg.diss_u,
+                    diss_g: tg.diss_g,
+                    ..PairLin::default()
+                };
+            }
+            self.slipping_at_setup = slipping;
+            self.have_lin = true;
+        }
+        self.apply_gamma(gamma);
+        self.sys
+            .newton_factor(gamma, &self.kc)
+            .map_err(|e| CallbackError::Recoverable(e.to_string()))?;
+        Ok(jcur)
+    }
+
+    fn newton_solve(
+        &mut self,
+        t: f64,
+        _y: &[f64],
+        r: &[f64],
+        z: &mut [f64],
+        gamma: f64,
+    ) -> Result<(), CallbackError> {
+        if !self.have_lin {
+            return Err(CallbackError::Fatal(
+                "newton_solve called before newton_setup".into(),
+            ));
+        }
+        // CVODE re-runs the setup only when γ has changed by more than ~30 %; between setups
+        // the current γ is used in the elimination (so `a − γ b = r_q` holds exactly) with the
+        // factorization and `(I + γ D_s)⁻¹` of the setup's γ.
+        let g = gamma;
+        let n = self.n;
+        let ns = self.ns();
+        let fr = self.law.friction;
+        let (rq, rest) = r.split_at(n);
+        let (rv, rest) = rest.split_at(n);
+        let (rs, rest) = rest.split_at(ns);
+        // rhs_a = M (r_q + γ r_v) + γ² Bᵀ [0; T_eff r_s]
+        for ((o, a), b) in self.tmp2.iter_mut().zip(rq).zip(rv) {
+            *o = a + g * b;
+        }
+        self.sys.mul_m_into(&self.tmp2, &mut self.tmp);
+        if fr {
+            for k in 0..self.w {
+                let l = &self.lin[k];
+                let x = mul2(&l.inv, [rs[2 * k], rs[2 * k + 1]]);
+                let h = mul2(&l.pt_u, x);
+                self.p[3 * k] = 0.0;
+                self.p[3 * k + 1] = g * g * h[0];
+                self.p[3 * k + 2] = g * g * h[1];
+            }
+            self.sys.joint_transpose_add(&self.p, &mut self.tmp);
+        }
+        let (za, zrest) = z.split_at_mut(n);
+        za.copy_from_slice(&self.tmp);
+        self.sys.newton_solve_in_place(za);
+        let (zb, zrest) = zrest.split_at_mut(n);
+        for ((b, a), q) in zb.iter_mut().zip(za.iter()).zip(rq) {
+            *b = (a - q) / g;
+        }
+        let (zs, ze) = zrest.split_at_mut(ns);
+        let mut zd = rest[1];
+        if fr {
+            self.sys.joint_apply_into(za, &mut self.u);
+            for k in 0..self.w {
+                let l = &self.lin[k];
+                let ba = [self.u[3 * k], self.u[3 * k + 1], self.u[3 * k + 2]];
+                let du = mul2(&l.sdot_u, [ba[1], ba[2]]);
+                let rhs = [
+                    rs[2 * k] + g * (du[0] + l.sdot_g[0] * ba[0]),
+                    rs[2 * k + 1] + g * (du[1] + l.sdot_g[1] * ba[0]),
+                ];
+                let c = mul2(&l.inv, rhs);
+                zs[2 * k] = c[0];
+                zs[2 * k + 1] = c[1];
+                zd += g
+                    * (l.diss_u[0] * (ba[1] - c[0])
+                        + l.diss_u[1] * (ba[2] - c[1])
+                        + l.diss_g * ba[0]);
+            }
+        }
+        self.sys.load_into(t, &mut self.f);
+        ze[0] = rest[0] + g * dot(&self.f, zb);
+        ze[1] = zd;
+        non_finite("the Newton correction", z)
+    }
+}
