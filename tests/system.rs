@@ -1,0 +1,488 @@
+//! The second-order systems (`jointrom::system`) and the mechanical ODE (`jointrom::transient`):
+//! right-hand side against a direct computation, the structured Newton solve against
+//! `I − γJ` by differences, and a Φ = I reduced system against the full one.
+
+use faer::Mat;
+use jointrom::friction::{PairLaw, PairState};
+use jointrom::ode::OdeProblem;
+use jointrom::reduction::ReducedModel;
+use jointrom::system::{FullSystem, ReducedSystem, SecondOrderSystem};
+use jointrom::transient::{MechanicalOde, ProblemOptions};
+use jointrom::Model;
+
+struct Rng(u64);
+impl Rng {
+    /// Uniform in [−1, 1).
+    fn next(&mut self) -> f64 {
+        self.0 ^= self.0 << 13;
+        self.0 ^= self.0 >> 7;
+        self.0 ^= self.0 << 17;
+        (self.0 >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+    }
+}
+
+fn inf_norm(x: &[f64]) -> f64 {
+    x.iter().fold(0.0, |m, v| m.max(v.abs()))
+}
+
+fn opts(friction: bool) -> ProblemOptions {
+    ProblemOptions {
+        friction,
+        events: true,
+        ..ProblemOptions::default()
+    }
+}
+
+/// A state with q random (mm scale `qs`), v random, and slip memory s = u_t − e where e = 0
+/// (all closed pairs stick) or, for `slip`, |e| = 2c on closed pairs (they slide).
+fn state<S: SecondOrderSystem>(
+    ode: &MechanicalOde<S>,
+    rng: &mut Rng,
+    qs: f64,
+    slip: bool,
+    t_load: f64,
+) -> Vec<f64> {
+    let _ = t_load;
+    let n = ode.coords();
+    let w = ode.system().pairs();
+    let mut y = vec![0.0; ode.dim()];
+    for v in &mut y[..n] {
+        *v = qs * rng.next();
+    }
+    for v in &mut y[n..2 * n] {
+        *v = rng.next();
+    }
+    let mut u = vec![0.0; 3 * w];
+    ode.system().joint_apply_into(&y[..n], &mut u);
+    if ode.law().friction {
+        let law = *ode.law();
+        for k in 0..w {
+            let c = law.mu * law.k_n * (-u[3 * k]).max(0.0) / law.k_t;
+            let (e1, e2) = if slip && c > 0.0 {
+                let th = std::f64::consts::PI * rng.next();
+                (2.0 * c * th.cos(), 2.0 * c * th.sin())
+            } else {
+                (0.0, 0.0)
+            };
+            y[2 * n + 2 * k] = u[3 * k + 1] - e1;
+            y[2 * n + 2 * k + 1] = u[3 * k + 2] - e2;
+        }
+    }
+    let wi = ode.work_index();
+    y[wi] = 0.3;
+    y[wi + 1] = 0.1;
+    y
+}
+
+fn pair_states<S: SecondOrderSystem>(ode: &MechanicalOde<S>, y: &[f64]) -> Vec<PairState> {
+    let n = ode.coords();
+    let w = ode.system().pairs();
+    let mut u = vec![0.0; 3 * w];
+    ode.system().joint_apply_into(&y[..n], &mut u);
+    (0..w)
+        .map(|k| {
+            let s = if ode.law().friction {
+                [y[2 * n + 2 * k], y[2 * n + 2 * k + 1]]
+            } else {
+                [0.0; 2]
+            };
+            ode.law()
+                .eval([u[3 * k], u[3 * k + 1], u[3 * k + 2]], s)
+                .state
+        })
+        .collect()
+}
+
+/// `(I − γJ) z` by a central difference of F along z with step ε.
+fn newton_matvec<S: SecondOrderSystem>(
+    ode: &mut MechanicalOde<S>,
+    t: f64,
+    y: &[f64],
+    z: &[f64],
+    gamma: f64,
+    eps: f64,
+) -> Vec<f64> {
+    let d = ode.dim();
+    let yp: Vec<f64> = (0..d).map(|i| y[i] + eps * z[i]).collect();
+    let ym: Vec<f64> = (0..d).map(|i| y[i] - eps * z[i]).collect();
+    let mut fp = vec![0.0; d];
+    let mut fm = vec![0.0; d];
+    ode.rhs(t, &yp, &mut fp).unwrap();
+    ode.rhs(t, &ym, &mut fm).unwrap();
+    (0..d)
+        .map(|i| z[i] - gamma * (fp[i] - fm[i]) / (2.0 * eps))
+        .collect()
+}
+
+/// `(I − γJ) z` assembled from the block Jacobian (system operators and the pair law's exact
+/// derivatives, `∂p_t/∂g` included): no elimination, unlike the structured solve under test.
+fn newton_matvec_exact<S: SecondOrderSystem>(
+    ode: &mut MechanicalOde<S>,
+    t: f64,
+    y: &[f64],
+    z: &[f64],
+    gamma: f64,
+    with_pt_g: bool,
+) -> Vec<f64> {
+    let n = ode.coords();
+    let w = ode.system().pairs();
+    let law = *ode.law();
+    let fr = law.friction;
+    let ns = if fr { 2 * w } else { 0 };
+    let mut u = vec![0.0; 3 * w];
+    let mut bz = vec![0.0; 3 * w];
+    ode.system().joint_apply_into(&y[..n], &mut u);
+    ode.system().joint_apply_into(&z[..n], &mut bz);
+    let mut dp = vec![0.0; 3 * w];
+    let mut jz = vec![0.0; ode.dim()];
+    let mut dd = 0.0;
+    for k in 0..w {
+        let sk = if fr {
+            [y[2 * n + 2 * k], y[2 * n + 2 * k + 1]]
+        } else {
+            [0.0; 2]
+        };
+        let zs = if fr {
+            [z[2 * n + 2 * k], z[2 * n + 2 * k + 1]]
+        } else {
+            [0.0; 2]
+        };
+        let mut tg = law.tangent([u[3 * k], u[3 * k + 1], u[3 * k + 2]], sk);
+        if !with_pt_g {
+            tg.pt_g = [0.0; 2];
+        }
+        let de = [bz[3 * k + 1] - zs[0], bz[3 * k + 2] - zs[1]];
+        let dg = bz[3 * k];
+        dp[3 * k] = tg.pn_g * dg;
+        for i in 0..2 {
+            dp[3 * k + 1 + i] = tg.pt_u[i][0] * de[0] + tg.pt_u[i][1] * de[1] + tg.pt_g[i] * dg;
+            if fr {
+                jz[2 * n + 2 * k + i] =
+                    tg.sdot_u[i][0] * de[0] + tg.sdot_u[i][1] * de[1] + tg.sdot_g[i] * dg;
+            }
+        }
+        dd += tg.diss_u[0] * de[0] + tg.diss_u[1] * de[1] + tg.diss_g * dg;
+    }
+    let mut acc = vec![0.0; n];
+    ode.system().mul_k_into(&z[..n], &mut acc);
+    ode.system().joint_transpose_add(&dp, &mut acc);
+    let mut f = vec![0.0; n];
+    ode.system().load_into(t, &mut f);
+    jz[..n].copy_from_slice(&z[n..2 * n]);
+    // J_v z = −M⁻¹ (K z_q + Bᵀ dp): checked as M (z_v − r_v) form by the caller via `mass_times`.
+    for (o, a) in jz[n..2 * n].iter_mut().zip(&acc) {
+        *o = -a;
+    }
+    let _ = ns;
+    let wi = ode.work_index();
+    jz[wi] = f.iter().zip(&z[n..2 * n]).map(|(a, b)| a * b).sum();
+    jz[wi + 1] = dd;
+    // (I − γJ) z with the v rows left multiplied by M: M z_v − γ (−K z_q − Bᵀ dp).
+    let mut mzv = vec![0.0; n];
+    ode.system().mul_m_into(&z[n..2 * n], &mut mzv);
+    let mut out: Vec<f64> = z.iter().zip(&jz).map(|(a, b)| a - gamma * b).collect();
+    for i in 0..n {
+        out[n + i] = mzv[i] - gamma * jz[n + i];
+    }
+    // Size of the largest term entering each row (for a backward error).
+    let mut scale: Vec<f64> = z
+        .iter()
+        .zip(&jz)
+        .map(|(a, b)| a.abs().max((gamma * b).abs()))
+        .collect();
+    for i in 0..n {
+        scale[n + i] = mzv[i].abs().max((gamma * jz[n + i]).abs());
+    }
+    out.extend(scale);
+    out
+}
+
+/// Solves `(I − γJ) z = r` with the problem's solver and returns the relative residuals
+/// `‖(I − γJ) z − r‖∞ / ‖r‖∞`, (1) with the exact block operator (v rows times M), (2) with
+/// `(I − γJ) z` by differences with a step that keeps every pair on
+/// its branch (the law is piecewise affine off the sliding branch, so the difference is exact to
+/// round-off there).
+fn newton_residual<S: SecondOrderSystem>(
+    ode: &mut MechanicalOde<S>,
+    t: f64,
+    y: &[f64],
+    gamma: f64,
+    rng: &mut Rng,
+    with_pt_g: bool,
+) -> (f64, f64, f64) {
+    let d = ode.dim();
+    let r: Vec<f64> = (0..d).map(|_| rng.next()).collect();
+    let mut fy = vec![0.0; d];
+    ode.rhs(t, y, &mut fy).unwrap();
+    assert!(ode.newton_setup(t, y, &fy, false, gamma).unwrap());
+    let mut z = vec![0.0; d];
+    ode.newton_solve(t, y, &r, &mut z, gamma).unwrap();
+    let base = pair_states(ode, y);
+    let mut eps = 1e-2 * inf_norm(y) / inf_norm(&z);
+    loop {
+        let yp: Vec<f64> = (0..d).map(|i| y[i] + eps * z[i]).collect();
+        let ym: Vec<f64> = (0..d).map(|i| y[i] - eps * z[i]).collect();
+        if pair_states(ode, &yp) == base && pair_states(ode, &ym) == base {
+            break;
+        }
+        eps *= 0.25;
+        assert!(eps > 1e-30, "no step keeps the pairs on their branches");
+    }
+    // Exact block operator (v rows multiplied by M, so no M-solve enters the check).
+    let mut ez = newton_matvec_exact(ode, t, y, &z, gamma, with_pt_g);
+    let terms = ez.split_off(d);
+    let mut mrv = vec![0.0; ode.coords()];
+    ode.system()
+        .mul_m_into(&r[ode.coords()..2 * ode.coords()], &mut mrv);
+    let mut rr = r.clone();
+    rr[ode.coords()..2 * ode.coords()].copy_from_slice(&mrv);
+    let eres: Vec<f64> = ez.iter().zip(&rr).map(|(a, b)| a - b).collect();
+    let exact_rel = inf_norm(&eres) / inf_norm(&rr);
+    let backward = inf_norm(&eres) / (inf_norm(&terms) + inf_norm(&rr));
+    println!("  block operator: residual/‖r‖ {exact_rel:.2e}, backward error {backward:.2e}");
+    let az = newton_matvec(ode, t, y, &z, gamma, eps);
+    let res: Vec<f64> = az.iter().zip(&r).map(|(a, b)| a - b).collect();
+    let n = ode.coords();
+    println!(
+        "  eps {eps:.2e}: block residuals q {:.2e} v {:.2e} rest {:.2e}; |z| q {:.2e} v {:.2e}",
+        inf_norm(&res[..n]),
+        inf_norm(&res[n..2 * n]),
+        inf_norm(&res[2 * n..]),
+        inf_norm(&z[..n]),
+        inf_norm(&z[n..2 * n])
+    );
+    (exact_rel, backward, inf_norm(&res) / inf_norm(&r))
+}
+
+/// The pair forces, computed independently of `jointrom::friction` (the law written out).
+fn pair_forces_direct(law: &PairLaw, u: &[f64], s: &[f64]) -> Vec<f64> {
+    let w = u.len() / 3;
+    let mut p = vec![0.0; 3 * w];
+    for k in 0..w {
+        let g = u[3 * k];
+        if g >= 0.0 {
+            continue;
+        }
+        let pn = law.k_n * g;
+        p[3 * k] = pn;
+        if law.friction {
+            let e = [u[3 * k + 1] - s[2 * k], u[3 * k + 2] - s[2 * k + 1]];
+            let trial = [law.k_t * e[0], law.k_t * e[1]];
+            let norm = (trial[0] * trial[0] + trial[1] * trial[1]).sqrt();
+            let cap = law.mu * pn.abs();
+            let scale = if norm <= cap { 1.0 } else { cap / norm };
+            p[3 * k + 1] = scale * trial[0];
+            p[3 * k + 2] = scale * trial[1];
+        }
+    }
+    p
+}
+
+#[test]
+fn full_rhs_matches_a_direct_computation() {
+    let model = Model::from_case_name("friction_bar").unwrap();
+    let n = model.dofs();
+    let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
+    for (friction, slip) in [(false, false), (true, false), (true, true)] {
+        let mut ode =
+            MechanicalOde::new(FullSystem::new(&model).unwrap(), &opts(friction)).unwrap();
+        let y = state(&ode, &mut rng, 1e-3, slip, 0.0);
+        let t = 0.02; // inside the load ramp
+        let mut ydot = vec![0.0; ode.dim()];
+        ode.rhs(t, &y, &mut ydot).unwrap();
+        // Direct: r = f − K q − Bᵀp with the model's own matrices; M v' must equal r.
+        let q = &y[..n];
+        let mut u = vec![0.0; model.joint.rows()];
+        model.joint.apply(q, &mut u);
+        let s = &y[2 * n..2 * n + if friction { 2 * model.joint.pairs() } else { 0 }];
+        let law = *ode.law();
+        let p = pair_forces_direct(&law, &u, s);
+        let mut f = vec![0.0; n];
+        let fm = model.case.load.master_at(t);
+        for (d, &dof) in model.master_dofs().iter().enumerate() {
+            f[dof] += fm[d];
+        }
+        let mut kq = vec![0.0; n];
+        model.stiffness.mul_vec(q, &mut kq);
+        let mut btp = vec![0.0; n];
+        model.joint.apply_transpose_add(&p, &mut btp);
+        let mut ma = vec![0.0; n];
+        model.mass.mul_vec(&ydot[n..2 * n], &mut ma);
+        let scale = inf_norm(&kq) + inf_norm(&btp) + inf_norm(&f);
+        let err = (0..n)
+            .map(|i| (ma[i] - (f[i] - kq[i] - btp[i])).abs())
+            .fold(0.0, f64::max);
+        println!(
+            "friction {friction} slip {slip}: ‖M v' − (f − Kq − Bᵀp)‖∞ / scale = {:.2e}",
+            err / scale
+        );
+        assert!(
+            err <= 1e-8 * scale,
+            "M v' residual {err:.3e} (scale {scale:.3e})"
+        );
+        assert_eq!(&ydot[..n], &y[n..2 * n], "q' = v");
+        let closed = u.iter().step_by(3).filter(|&&g| g < 0.0).count();
+        assert!(
+            closed > 5 && closed < model.joint.pairs(),
+            "{closed} closed pairs"
+        );
+        let wi = ode.work_index();
+        let fv: f64 = f.iter().zip(&y[n..2 * n]).map(|(a, b)| a * b).sum();
+        assert!((ydot[wi] - fv).abs() <= 1e-12 * fv.abs().max(1e-300));
+        if friction {
+            let mut diss = 0.0;
+            for k in 0..model.joint.pairs() {
+                let r = law.eval(
+                    [u[3 * k], u[3 * k + 1], u[3 * k + 2]],
+                    [s[2 * k], s[2 * k + 1]],
+                );
+                assert_eq!([ydot[2 * n + 2 * k], ydot[2 * n + 2 * k + 1]], r.s_rate);
+                diss += r.dissipation;
+            }
+            assert_eq!(ydot[wi + 1], diss);
+            if slip {
+                assert!(diss > 0.0);
+            }
+        } else {
+            assert_eq!(ydot[wi + 1], 0.0);
+        }
+    }
+}
+
+fn reduced_model(model: &Model, r: usize) -> ReducedModel {
+    let basis = jointrom::reduction::build_basis(
+        model,
+        jointrom::reduction::BasisKind::Tvd,
+        &jointrom::reduction::BasisOptions {
+            g: Some(r.saturating_sub(16)),
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    ReducedModel::new(model, basis.phi).unwrap()
+}
+
+#[test]
+fn newton_solve_matches_i_minus_gamma_j() {
+    let model = Model::from_case_name("friction_bar").unwrap();
+    let rom = reduced_model(&model, 30);
+    let mut rng = Rng(0x2545_f491_4f6c_dd1d);
+    for gamma in [1e-6, 1e-5, 1e-4] {
+        for friction in [false, true] {
+            // Reduced (dense) system; q scale: reduced coordinates of a ~1e-3 mm deflection.
+            let mut ode =
+                MechanicalOde::new(ReducedSystem::new(&model, &rom).unwrap(), &opts(friction))
+                    .unwrap();
+            let y = state(&ode, &mut rng, 1e-3, false, 0.0);
+            let (exact, backward, fd) = newton_residual(&mut ode, 0.02, &y, gamma, &mut rng, true);
+            assert!(
+                backward < 1e-12,
+                "backward error {backward:.3e} of the Newton solve"
+            );
+            println!(
+                "reduced, γ = {gamma:e}, friction {friction}, no sliding: residual {exact:.2e} \
+                 (block operator), {fd:.2e} (differences)"
+            );
+            assert!(exact < 1e-8, "reduced Newton solve residual {exact:.3e}");
+            assert!(
+                fd < 1e-3,
+                "reduced Newton solve residual by differences {fd:.3e}"
+            );
+            // Full (sparse) system.
+            let mut ode =
+                MechanicalOde::new(FullSystem::new(&model).unwrap(), &opts(friction)).unwrap();
+            let y = state(&ode, &mut rng, 1e-3, false, 0.0);
+            let (exact, backward, fd) = newton_residual(&mut ode, 0.02, &y, gamma, &mut rng, true);
+            assert!(
+                backward < 1e-12,
+                "backward error {backward:.3e} of the Newton solve"
+            );
+            println!(
+                "full, γ = {gamma:e}, friction {friction}, no sliding: residual {exact:.2e} \
+                 (block operator), {fd:.2e} (differences)"
+            );
+            assert!(exact < 1e-8, "full Newton solve residual {exact:.3e}");
+            // (differences through the full model's M⁻¹ and K of norm ~1e10 lose ~all digits:
+            // printed, not asserted)
+        }
+        // Sliding pairs: the dropped ∂p_t/∂g makes the solve approximate; measure it.
+        let mut ode =
+            MechanicalOde::new(ReducedSystem::new(&model, &rom).unwrap(), &opts(true)).unwrap();
+        let y = state(&ode, &mut rng, 1e-3, true, 0.0);
+        // Against the operator without ∂p_t/∂g (what the solver factors): exact.
+        let (_, backward, _) = newton_residual(&mut ode, 0.02, &y, gamma, &mut rng, false);
+        assert!(
+            backward < 1e-12,
+            "backward error {backward:.3e} without ∂p_t/∂g"
+        );
+        // Against the true operator: a modified-Newton direction.
+        let (exact, backward, fd) = newton_residual(&mut ode, 0.02, &y, gamma, &mut rng, true);
+        println!(
+            "reduced, γ = {gamma:e}, {} sliding pairs: residual/‖r‖ {exact:.2e}, backward \
+             {backward:.2e} (block operator), {fd:.2e} (differences)",
+            ode.slipping_at_setup()
+        );
+        assert!(ode.slipping_at_setup() > 0);
+        assert!(
+            backward > 1e-10,
+            "∂p_t/∂g is dropped, the solve cannot be exact"
+        );
+    }
+}
+
+#[test]
+fn identity_reduction_agrees_with_the_full_system() {
+    let model = Model::from_case_name("friction_bar").unwrap();
+    let n = model.dofs();
+    let rom = ReducedModel::new(&model, Mat::identity(n, n)).unwrap();
+    let mut rng = Rng(0xdead_beef_cafe_f00d);
+    for (friction, slip) in [(false, false), (true, true)] {
+        let mut full =
+            MechanicalOde::new(FullSystem::new(&model).unwrap(), &opts(friction)).unwrap();
+        let mut red =
+            MechanicalOde::new(ReducedSystem::new(&model, &rom).unwrap(), &opts(friction)).unwrap();
+        assert_eq!(full.dim(), red.dim());
+        let y = state(&full, &mut rng, 1e-3, slip, 0.0);
+        let t = 0.03;
+        let d = full.dim();
+        let (mut a, mut b) = (vec![0.0; d], vec![0.0; d]);
+        full.rhs(t, &y, &mut a).unwrap();
+        red.rhs(t, &y, &mut b).unwrap();
+        let diff: Vec<f64> = a.iter().zip(&b).map(|(x, y)| x - y).collect();
+        let rel = inf_norm(&diff) / inf_norm(&a);
+        println!("Φ = I: rhs relative difference {rel:.2e}");
+        assert!(rel < 1e-8, "rhs differ by {rel:.3e}");
+        let (sa, sb) = (full.sample(t, &y), red.sample(t, &y));
+        for (x, z) in [
+            (sa.contact_force_norm, sb.contact_force_norm),
+            (sa.friction_force_norm, sb.friction_force_norm),
+            (sa.kinetic, sb.kinetic),
+            (sa.strain, sb.strain),
+            (sa.pair, sb.pair),
+            (sa.master[1], sb.master[1]),
+        ] {
+            assert!((x - z).abs() <= 1e-12 * x.abs().max(1e-300), "{x} vs {z}");
+        }
+        // Roots.
+        let m = full.num_roots();
+        assert_eq!(m, red.num_roots());
+        let (mut ga, mut gb) = (vec![0.0; m], vec![0.0; m]);
+        full.roots(t, &y, &mut ga).unwrap();
+        red.roots(t, &y, &mut gb).unwrap();
+        for (x, z) in ga.iter().zip(&gb) {
+            assert!((x - z).abs() <= 1e-12 * inf_norm(&ga));
+        }
+        // Newton solves of the same matrix.
+        let gamma = 1e-5;
+        full.newton_setup(t, &y, &a, false, gamma).unwrap();
+        red.newton_setup(t, &y, &b, false, gamma).unwrap();
+        let r: Vec<f64> = (0..d).map(|_| rng.next()).collect();
+        let (mut za, mut zb) = (vec![0.0; d], vec![0.0; d]);
+        full.newton_solve(t, &y, &r, &mut za, gamma).unwrap();
+        red.newton_solve(t, &y, &r, &mut zb, gamma).unwrap();
+        let diff: Vec<f64> = za.iter().zip(&zb).map(|(x, y)| x - y).collect();
+        let rel = inf_norm(&diff) / inf_norm(&za);
+        println!("Φ = I: Newton solve relative difference {rel:.2e}");
+        assert!(rel < 1e-8, "Newton solves differ by {rel:.3e}");
+    }
+}
