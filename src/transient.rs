@@ -12,6 +12,11 @@
 //! D' = Σ_pairs p_t · ṡ                             (dissipated energy, N·mm)
 //! ```
 //!
+//! The `s`, `W`, `D` states are stored in units of [`ProblemOptions::slip_scale`] (mm) and
+//! [`ProblemOptions::energy_scale`] (N·mm), 1e-3 by default, so that the integrator's scalar
+//! absolute tolerance (1e-6) means 1e-9 mm of slip: the stick radius `μ|p_n|/k_t` is ~1e-6 mm
+//! for a pair force of 0.04 N, and with s in mm the slip memory would be resolved to no digit.
+//!
 //! With friction off the state has no `s` block (the tangential forces are zero and there is no
 //! memory to carry) and `D' = 0`. `W` and `D` are integrated by the integrator itself (so they
 //! are as accurate as the motion, independent of the output spacing); they do not feed back into
@@ -59,6 +64,13 @@ pub struct ProblemOptions {
     pub events: bool,
     /// Relaxation time τ of the slip memory, s.
     pub tau: f64,
+    /// Unit of the slip-memory states, mm (state = s / slip_scale). The integrator's absolute
+    /// tolerance applies to the states, and the stick radius `μ|p_n|/k_t` is only ~1e-6 mm at
+    /// p_n = 0.04 N: with atol 1e-6 on s in mm the slip memory (and the dissipation) would be
+    /// resolved to no digit. Default 1e-3 (atol 1e-6 ↔ 1e-9 mm).
+    pub slip_scale: f64,
+    /// Unit of the energy states W and D, N·mm (default 1e-3: atol 1e-6 ↔ 1e-9 N·mm).
+    pub energy_scale: f64,
 }
 
 impl Default for ProblemOptions {
@@ -67,6 +79,8 @@ impl Default for ProblemOptions {
             friction: true,
             events: false,
             tau: DEFAULT_TAU,
+            slip_scale: 1e-3,
+            energy_scale: 1e-3,
         }
     }
 }
@@ -111,6 +125,10 @@ pub struct MechanicalOde<S: SecondOrderSystem> {
     have_lin: bool,
     /// Sliding pairs at the last Newton setup.
     slipping_at_setup: usize,
+    /// Slip memory in mm (the states times `s_scale`).
+    s_phys: Vec<f64>,
+    s_scale: f64,
+    e_scale: f64,
 }
 
 impl<S: SecondOrderSystem> MechanicalOde<S> {
@@ -122,6 +140,16 @@ impl<S: SecondOrderSystem> MechanicalOde<S> {
                 "tau (slip relaxation time) must be finite and positive, got {} s",
                 opts.tau
             )));
+        }
+        for (name, v) in [
+            ("slip_scale", opts.slip_scale),
+            ("energy_scale", opts.energy_scale),
+        ] {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(Error::Invalid(format!(
+                    "{name} must be finite and positive, got {v}"
+                )));
+            }
         }
         let law = PairLaw {
             k_n: c.normal_stiffness,
@@ -148,6 +176,9 @@ impl<S: SecondOrderSystem> MechanicalOde<S> {
             lin_gamma: f64::NAN,
             have_lin: false,
             slipping_at_setup: 0,
+            s_phys: vec![0.0; if opts.friction { 2 * w } else { 0 }],
+            s_scale: opts.slip_scale,
+            e_scale: opts.energy_scale,
             sys,
         })
     }
@@ -181,6 +212,24 @@ impl<S: SecondOrderSystem> MechanicalOde<S> {
         2 * self.n + self.ns()
     }
 
+    /// Unit of the slip-memory states, mm.
+    pub fn slip_scale(&self) -> f64 {
+        self.s_scale
+    }
+
+    /// Unit of the energy states, N·mm.
+    pub fn energy_scale(&self) -> f64 {
+        self.e_scale
+    }
+
+    /// Copies the slip memory of `y` into `s_phys` (mm).
+    fn load_slip(&mut self, y: &[f64]) {
+        let i0 = 2 * self.n;
+        for (o, &x) in self.s_phys.iter_mut().zip(&y[i0..]) {
+            *o = self.s_scale * x;
+        }
+    }
+
     /// Pairs sliding at the last Newton setup.
     pub fn slipping_at_setup(&self) -> usize {
         self.slipping_at_setup
@@ -194,9 +243,11 @@ impl<S: SecondOrderSystem> MechanicalOde<S> {
     /// Outputs at `(t, y)`: force norms, master displacement, energies.
     pub fn sample(&mut self, t: f64, y: &[f64]) -> EnergySample {
         let n = self.n;
+        self.load_slip(y);
         let (q, rest) = y.split_at(n);
         let (v, rest) = rest.split_at(n);
-        let (s, rest) = rest.split_at(self.ns());
+        let rest = &rest[self.ns()..];
+        let s = &self.s_phys;
         self.sys.joint_apply_into(q, &mut self.u);
         evaluate_pairs(&self.law, &self.u, s, &mut self.p, &mut self.srate);
         let mut fc = 0.0;
@@ -226,8 +277,8 @@ impl<S: SecondOrderSystem> MechanicalOde<S> {
             kinetic,
             strain,
             pair,
-            external_work: rest[0],
-            dissipated: rest[1],
+            external_work: self.e_scale * rest[0],
+            dissipated: self.e_scale * rest[1],
         }
     }
 }
@@ -327,11 +378,17 @@ impl<S: SecondOrderSystem> OdeProblem for MechanicalOde<S> {
     fn rhs(&mut self, t: f64, y: &[f64], ydot: &mut [f64]) -> Result<(), CallbackError> {
         let n = self.n;
         let ns = self.ns();
+        self.load_slip(y);
         let (q, rest) = y.split_at(n);
-        let (v, rest) = rest.split_at(n);
-        let s = &rest[..ns];
+        let v = &rest[..n];
         self.sys.joint_apply_into(q, &mut self.u);
-        let tot = evaluate_pairs(&self.law, &self.u, s, &mut self.p, &mut self.srate);
+        let tot = evaluate_pairs(
+            &self.law,
+            &self.u,
+            &self.s_phys,
+            &mut self.p,
+            &mut self.srate,
+        );
         self.sys.load_into(t, &mut self.f);
         self.sys.mul_k_into(q, &mut self.tmp);
         self.sys.joint_transpose_add(&self.p, &mut self.tmp);
@@ -342,9 +399,12 @@ impl<S: SecondOrderSystem> OdeProblem for MechanicalOde<S> {
             *o = fi - ki;
         }
         self.sys.solve_m_in_place(dv);
-        drest[..ns].copy_from_slice(&self.srate[..ns]);
-        drest[ns] = dot(&self.f, v);
-        drest[ns + 1] = tot.dissipation;
+        let inv_s = 1.0 / self.s_scale;
+        for (o, &r) in drest[..ns].iter_mut().zip(&self.srate) {
+            *o = inv_s * r;
+        }
+        drest[ns] = dot(&self.f, v) / self.e_scale;
+        drest[ns + 1] = tot.dissipation / self.e_scale;
         non_finite("the right-hand side", ydot)
     }
 
@@ -365,7 +425,8 @@ impl<S: SecondOrderSystem> OdeProblem for MechanicalOde<S> {
             g[k] = self.u[3 * k];
         }
         if self.law.friction {
-            let s = &y[2 * n..2 * n + 2 * self.w];
+            self.load_slip(y);
+            let s = &self.s_phys;
             for k in 0..self.w {
                 g[self.w + k] = self.law.switch(
                     [self.u[3 * k], self.u[3 * k + 1], self.u[3 * k + 2]],
@@ -392,7 +453,8 @@ impl<S: SecondOrderSystem> OdeProblem for MechanicalOde<S> {
         let jcur = !(jok && self.have_lin);
         if jcur {
             self.sys.joint_apply_into(&y[..n], &mut self.u);
-            let s = &y[2 * n..2 * n + self.ns()];
+            self.load_slip(y);
+            let s = &self.s_phys;
             let mut slipping = 0;
             for k in 0..self.w {
                 let uk = [self.u[3 * k], self.u[3 * k + 1], self.u[3 * k + 2]];
@@ -448,6 +510,8 @@ impl<S: SecondOrderSystem> OdeProblem for MechanicalOde<S> {
         let (rq, rest) = r.split_at(n);
         let (rv, rest) = rest.split_at(n);
         let (rs, rest) = rest.split_at(ns);
+        // Residuals and corrections of s, W, D in physical units (mm, N·mm) inside.
+        let ss = self.s_scale;
         // rhs_a = M (r_q + γ r_v) + γ² Bᵀ [0; T_eff r_s]
         for ((o, a), b) in self.tmp2.iter_mut().zip(rq).zip(rv) {
             *o = a + g * b;
@@ -456,7 +520,7 @@ impl<S: SecondOrderSystem> OdeProblem for MechanicalOde<S> {
         if fr {
             for k in 0..self.w {
                 let l = &self.lin[k];
-                let x = mul2(&l.inv, [rs[2 * k], rs[2 * k + 1]]);
+                let x = mul2(&l.inv, [ss * rs[2 * k], ss * rs[2 * k + 1]]);
                 let h = mul2(&l.pt_u, x);
                 self.p[3 * k] = 0.0;
                 self.p[3 * k + 1] = g * g * h[0];
@@ -472,7 +536,7 @@ impl<S: SecondOrderSystem> OdeProblem for MechanicalOde<S> {
             *b = (a - q) / g;
         }
         let (zs, ze) = zrest.split_at_mut(ns);
-        let mut zd = rest[1];
+        let mut zd = self.e_scale * rest[1];
         if fr {
             self.sys.joint_apply_into(za, &mut self.u);
             for k in 0..self.w {
@@ -480,12 +544,12 @@ impl<S: SecondOrderSystem> OdeProblem for MechanicalOde<S> {
                 let ba = [self.u[3 * k], self.u[3 * k + 1], self.u[3 * k + 2]];
                 let du = mul2(&l.sdot_u, [ba[1], ba[2]]);
                 let rhs = [
-                    rs[2 * k] + g * (du[0] + l.sdot_g[0] * ba[0]),
-                    rs[2 * k + 1] + g * (du[1] + l.sdot_g[1] * ba[0]),
+                    ss * rs[2 * k] + g * (du[0] + l.sdot_g[0] * ba[0]),
+                    ss * rs[2 * k + 1] + g * (du[1] + l.sdot_g[1] * ba[0]),
                 ];
                 let c = mul2(&l.inv, rhs);
-                zs[2 * k] = c[0];
-                zs[2 * k + 1] = c[1];
+                zs[2 * k] = c[0] / ss;
+                zs[2 * k + 1] = c[1] / ss;
                 zd += g
                     * (l.diss_u[0] * (ba[1] - c[0])
                         + l.diss_u[1] * (ba[2] - c[1])
@@ -493,8 +557,8 @@ impl<S: SecondOrderSystem> OdeProblem for MechanicalOde<S> {
             }
         }
         self.sys.load_into(t, &mut self.f);
-        ze[0] = rest[0] + g * dot(&self.f, zb);
-        ze[1] = zd;
+        ze[0] = rest[0] + g * dot(&self.f, zb) / self.e_scale;
+        ze[1] = zd / self.e_scale;
         non_finite("the Newton correction", z)
     }
 }

@@ -64,8 +64,9 @@ fn state<S: SecondOrderSystem>(
             } else {
                 (0.0, 0.0)
             };
-            y[2 * n + 2 * k] = u[3 * k + 1] - e1;
-            y[2 * n + 2 * k + 1] = u[3 * k + 2] - e2;
+            // states are s / slip_scale
+            y[2 * n + 2 * k] = (u[3 * k + 1] - e1) / ode.slip_scale();
+            y[2 * n + 2 * k + 1] = (u[3 * k + 2] - e2) / ode.slip_scale();
         }
     }
     let wi = ode.work_index();
@@ -82,7 +83,8 @@ fn pair_states<S: SecondOrderSystem>(ode: &MechanicalOde<S>, y: &[f64]) -> Vec<P
     (0..w)
         .map(|k| {
             let s = if ode.law().friction {
-                [y[2 * n + 2 * k], y[2 * n + 2 * k + 1]]
+                let ss = ode.slip_scale();
+                [ss * y[2 * n + 2 * k], ss * y[2 * n + 2 * k + 1]]
             } else {
                 [0.0; 2]
             };
@@ -129,6 +131,22 @@ fn newton_matvec_exact<S: SecondOrderSystem>(
     let law = *ode.law();
     let fr = law.friction;
     let ns = if fr { 2 * w } else { 0 };
+    // Work in physical units (s in mm, W and D in N·mm): D = diag(1, slip_scale, energy_scale)
+    // maps states to physical values, and the state operator is D⁻¹ (I − γJ_phys) D.
+    let d = ode.dim();
+    let unit: Vec<f64> = (0..d)
+        .map(|i| {
+            if i < 2 * n {
+                1.0
+            } else if i < 2 * n + ns {
+                ode.slip_scale()
+            } else {
+                ode.energy_scale()
+            }
+        })
+        .collect();
+    let y: Vec<f64> = y.iter().zip(&unit).map(|(a, b)| a * b).collect();
+    let z: Vec<f64> = z.iter().zip(&unit).map(|(a, b)| a * b).collect();
     let mut u = vec![0.0; 3 * w];
     let mut bz = vec![0.0; 3 * w];
     ode.system().joint_apply_into(&y[..n], &mut u);
@@ -173,7 +191,6 @@ fn newton_matvec_exact<S: SecondOrderSystem>(
     for (o, a) in jz[n..2 * n].iter_mut().zip(&acc) {
         *o = -a;
     }
-    let _ = ns;
     let wi = ode.work_index();
     jz[wi] = f.iter().zip(&z[n..2 * n]).map(|(a, b)| a * b).sum();
     jz[wi + 1] = dd;
@@ -192,6 +209,10 @@ fn newton_matvec_exact<S: SecondOrderSystem>(
         .collect();
     for i in 0..n {
         scale[n + i] = mzv[i].abs().max((gamma * jz[n + i]).abs());
+    }
+    for i in 2 * n..d {
+        out[i] /= unit[i];
+        scale[i] /= unit[i];
     }
     out.extend(scale);
     out
@@ -243,14 +264,6 @@ fn newton_residual<S: SecondOrderSystem>(
     let az = newton_matvec(ode, t, y, &z, gamma, eps);
     let res: Vec<f64> = az.iter().zip(&r).map(|(a, b)| a - b).collect();
     let n = ode.coords();
-    println!(
-        "  eps {eps:.2e}: block residuals q {:.2e} v {:.2e} rest {:.2e}; |z| q {:.2e} v {:.2e}",
-        inf_norm(&res[..n]),
-        inf_norm(&res[n..2 * n]),
-        inf_norm(&res[2 * n..]),
-        inf_norm(&z[..n]),
-        inf_norm(&z[n..2 * n])
-    );
     (exact_rel, backward, inf_norm(&res) / inf_norm(&r))
 }
 
@@ -294,9 +307,12 @@ fn full_rhs_matches_a_direct_computation() {
         let q = &y[..n];
         let mut u = vec![0.0; model.joint.rows()];
         model.joint.apply(q, &mut u);
-        let s = &y[2 * n..2 * n + if friction { 2 * model.joint.pairs() } else { 0 }];
+        let s: Vec<f64> = y[2 * n..2 * n + if friction { 2 * model.joint.pairs() } else { 0 }]
+            .iter()
+            .map(|x| x * ode.slip_scale())
+            .collect();
         let law = *ode.law();
-        let p = pair_forces_direct(&law, &u, s);
+        let p = pair_forces_direct(&law, &u, &s);
         let mut f = vec![0.0; n];
         let fm = model.case.load.master_at(t);
         for (d, &dof) in model.master_dofs().iter().enumerate() {
@@ -328,7 +344,8 @@ fn full_rhs_matches_a_direct_computation() {
         );
         let wi = ode.work_index();
         let fv: f64 = f.iter().zip(&y[n..2 * n]).map(|(a, b)| a * b).sum();
-        assert!((ydot[wi] - fv).abs() <= 1e-12 * fv.abs().max(1e-300));
+        let es = ode.energy_scale();
+        assert!((es * ydot[wi] - fv).abs() <= 1e-12 * fv.abs().max(1e-300));
         if friction {
             let mut diss = 0.0;
             for k in 0..model.joint.pairs() {
@@ -336,10 +353,14 @@ fn full_rhs_matches_a_direct_computation() {
                     [u[3 * k], u[3 * k + 1], u[3 * k + 2]],
                     [s[2 * k], s[2 * k + 1]],
                 );
-                assert_eq!([ydot[2 * n + 2 * k], ydot[2 * n + 2 * k + 1]], r.s_rate);
+                let ss = ode.slip_scale();
+                for i in 0..2 {
+                    let rate = ss * ydot[2 * n + 2 * k + i];
+                    assert!((rate - r.s_rate[i]).abs() <= 1e-14 * r.s_rate[i].abs());
+                }
                 diss += r.dissipation;
             }
-            assert_eq!(ydot[wi + 1], diss);
+            assert!((es * ydot[wi + 1] - diss).abs() <= 1e-14 * diss);
             if slip {
                 assert!(diss > 0.0);
             }
@@ -426,6 +447,28 @@ fn newton_solve_matches_i_minus_gamma_j() {
         assert!(
             backward > 1e-10,
             "∂p_t/∂g is dropped, the solve cannot be exact"
+        );
+        // The solver as the approximate inverse in z ← z + P (r − A z) (what a modified Newton
+        // iteration does): measure the contraction rate (M̃ = I here, so the block operator is
+        // exactly I − γJ).
+        let d = ode.dim();
+        let r: Vec<f64> = (0..d).map(|_| rng.next()).collect();
+        let mut z = vec![0.0; d];
+        let mut steps = Vec::new();
+        for _ in 0..4 {
+            let mut az = newton_matvec_exact(&mut ode, 0.02, &y, &z, gamma, true);
+            az.truncate(d);
+            let res: Vec<f64> = r.iter().zip(&az).map(|(a, b)| a - b).collect();
+            let mut dz = vec![0.0; d];
+            ode.newton_solve(0.02, &y, &res, &mut dz, gamma).unwrap();
+            z.iter_mut().zip(&dz).for_each(|(a, b)| *a += b);
+            steps.push(inf_norm(&dz) / inf_norm(&z));
+        }
+        let shown: Vec<String> = steps.iter().map(|x| format!("{x:.1e}")).collect();
+        println!("  relative corrections of z ← z + P(r − (I − γJ) z): {shown:?}");
+        assert!(
+            steps[1] < 0.1 * steps[0] && steps[2] < 0.1 * steps[1].max(1e-14),
+            "the approximate Newton solve contracts too slowly: {shown:?}"
         );
     }
 }
