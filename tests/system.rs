@@ -263,7 +263,6 @@ fn newton_residual<S: SecondOrderSystem>(
     println!("  block operator: residual/‖r‖ {exact_rel:.2e}, backward error {backward:.2e}");
     let az = newton_matvec(ode, t, y, &z, gamma, eps);
     let res: Vec<f64> = az.iter().zip(&r).map(|(a, b)| a - b).collect();
-    let n = ode.coords();
     (exact_rel, backward, inf_norm(&res) / inf_norm(&r))
 }
 
