@@ -455,12 +455,8 @@ impl SecondOrderSystem for ReducedSystem {
         dense_mul(&self.b_phi, q, out);
     }
     fn joint_transpose_add(&self, p: &[f64], out: &mut [f64]) {
-        for (row, &pr) in p.iter().enumerate() {
-            if pr != 0.0 {
-                for (c, o) in out.iter_mut().enumerate() {
-                    *o += self.b_phi[(row, c)] * pr;
-                }
-            }
+        for (c, o) in out.iter_mut().enumerate() {
+            *o += dot(col(&self.b_phi, c), p);
         }
     }
     fn newton_factor(&mut self, gamma: f64, kc: &[f64]) -> Result<(), Error> {
@@ -527,13 +523,25 @@ impl SecondOrderSystem for ReducedSystem {
     }
 }
 
-/// `out = A x` for a dense column-major A.
+/// Column `j` of a dense matrix as a slice (faer's `Mat` stores columns contiguously).
+fn col(a: &Mat<f64>, j: usize) -> &[f64] {
+    a.col(j)
+        .try_as_col_major()
+        .expect("columns of an owned Mat are contiguous")
+        .as_slice()
+}
+
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
+/// `out = A x` for a dense matrix, column by column.
 fn dense_mul(a: &Mat<f64>, x: &[f64], out: &mut [f64]) {
     out.fill(0.0);
     for (j, &xj) in x.iter().enumerate().take(a.ncols()) {
         if xj != 0.0 {
-            for (i, o) in out.iter_mut().enumerate() {
-                *o += a[(i, j)] * xj;
+            for (o, &v) in out.iter_mut().zip(col(a, j)) {
+                *o += v * xj;
             }
         }
     }
