@@ -267,3 +267,43 @@ fn tangent_matches_finite_differences() {
         }
     }
 }
+
+/// The stick/slip switch `μ|p_n| − k_t|e|` is positive exactly on sticking closed pairs, and
+/// `evaluate_pairs` agrees with the pair-wise law.
+#[test]
+fn switch_function_and_slice_evaluation_agree_with_the_law() {
+    use jointrom::friction::evaluate_pairs;
+    let law = law();
+    let u = [
+        -1e-5, 1e-8, 2e-8, // stick
+        -1e-5, 3e-6, -1e-6, // slip
+        2e-6, 3e-6, -1e-6, // open
+    ];
+    let s = [0.0, 0.0, 1e-7, 0.0, 1e-7, 0.0];
+    let mut p = [0.0; 9];
+    let mut rate = [0.0; 6];
+    let tot = evaluate_pairs(&law, &u, &s, &mut p, &mut rate);
+    let states = [PairState::Stick, PairState::Slip, PairState::Open];
+    let mut diss = 0.0;
+    for k in 0..3 {
+        let uk = [u[3 * k], u[3 * k + 1], u[3 * k + 2]];
+        let sk = [s[2 * k], s[2 * k + 1]];
+        let r = law.eval(uk, sk);
+        assert_eq!(r.state, states[k]);
+        assert_eq!(&p[3 * k..3 * k + 3], &r.p);
+        assert_eq!(&rate[2 * k..2 * k + 2], &r.s_rate);
+        diss += r.dissipation;
+        let sw = law.switch(uk, sk);
+        match r.state {
+            PairState::Stick => assert!(sw > 0.0),
+            _ => assert!(sw < 0.0),
+        }
+    }
+    assert_eq!(tot.dissipation, diss);
+    assert_eq!((tot.slipping, tot.closed), (1, 2));
+    // Stored energy: penalty plus the capped elastic stick energy.
+    let e = law.stored_energy([u[3], u[4], u[5]], [s[2], s[3]]);
+    let c = law.mu * law.k_n * 1e-5 / law.k_t;
+    let expected = 0.5 * law.k_n * 1e-10 + 0.5 * law.k_t * c * c;
+    assert!((e - expected).abs() <= 1e-14 * expected);
+}
