@@ -23,14 +23,19 @@
 //! where one exists, e.g. from [`cvode_flag_name`]) and the integration time in s — NaN for
 //! calls outside time integration. No C failure panics.
 
+mod callbacks;
 mod context;
+pub mod cvode;
 mod ffi;
+mod owners;
+mod problem_ls;
 mod vector;
 
 use std::ffi::{c_char, CStr};
 use std::fmt::Display;
 
 pub use context::Context;
+pub use cvode::Cvode;
 pub use vector::SerialVector;
 
 use crate::Error;
