@@ -194,10 +194,14 @@ pub(crate) unsafe extern "C" fn roots<P: OdeProblem>(
             } else {
                 std::slice::from_raw_parts_mut(gout, s.nroots)
             };
-            s.problem.roots(t, yv, g)?;
-            check_finite("g", g).map_err(|e| match e {
-                CallbackError::Recoverable(m) | CallbackError::Fatal(m) => CallbackError::Fatal(m),
-            })
+            s.problem
+                .roots(t, yv, g)
+                .and_then(|()| check_finite("g", g))
+                .map_err(|e| match e {
+                    CallbackError::Recoverable(m) | CallbackError::Fatal(m) => {
+                        CallbackError::Fatal(m)
+                    }
+                })
         })
     }
 }
