@@ -4,10 +4,11 @@
 
 use faer::Mat;
 use jointrom::friction::{PairLaw, PairState};
+use jointrom::ode::OdeOptions;
 use jointrom::ode::OdeProblem;
 use jointrom::reduction::ReducedModel;
 use jointrom::system::{FullSystem, ReducedSystem, SecondOrderSystem};
-use jointrom::transient::{MechanicalOde, ProblemOptions};
+use jointrom::transient::{run, MechanicalOde, ProblemOptions, TransientOptions};
 use jointrom::Model;
 
 struct Rng(u64);
@@ -526,5 +527,69 @@ fn identity_reduction_agrees_with_the_full_system() {
         let rel = inf_norm(&diff) / inf_norm(&za);
         println!("Φ = I: Newton solve relative difference {rel:.2e}");
         assert!(rel < 1e-8, "Newton solves differ by {rel:.3e}");
+    }
+}
+
+/// The friction bar ROM (TVD basis, default options) for 0.02 s with Newton and friction: the
+/// run completes and the energy balance `E_kin + E_strain + E_pair + D − W` closes.
+#[test]
+fn friction_bar_rom_runs_and_balances_energy() {
+    let model = Model::from_case_name("friction_bar").unwrap();
+    let basis = jointrom::reduction::build_basis(
+        &model,
+        jointrom::reduction::BasisKind::Tvd,
+        &jointrom::reduction::BasisOptions::default(),
+    )
+    .unwrap();
+    let rom = ReducedModel::new(&model, basis.phi).unwrap();
+    for (atol, tol) in [(1e-6, 1e-3), (1e-8, 2e-5)] {
+        let opts = TransientOptions {
+            ode: OdeOptions {
+                atol,
+                ..OdeOptions::default()
+            },
+            end_time: Some(0.02),
+            ..TransientOptions::default()
+        };
+        let res = run(ReducedSystem::new(&model, &rom).unwrap(), &opts).unwrap();
+        let c = &res.curves;
+        assert_eq!(c.t.len(), 201);
+        assert!((c.t[200] - 0.02).abs() < 1e-15);
+        let w_max = c.external_work.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let balance = c.balance();
+        let worst = balance.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let d_end = c.dissipated[200];
+        println!(
+            "ROM r = {}, atol {atol:e}: {} steps, {} rhs, {} Newton iterations, {} conv. failures, \
+             {} error-test failures, {} setups; wall {:.3} s, cpu {:.2} s; uy(0.02) = {:.6} mm, \
+             ‖f_c‖ = {:.4} N, ‖f_R‖ = {:.4} N, W = {:.6e}, D = {:.6e} N·mm, max |balance| = \
+             {worst:.3e} N·mm ({:.2e} of max W)",
+            rom.dim(),
+            res.stats.steps,
+            res.stats.rhs_evals,
+            res.stats.nonlinear_iterations,
+            res.stats.nonlinear_conv_failures,
+            res.stats.error_test_failures,
+            res.stats.linear_setups,
+            res.wall_s,
+            res.cpu_s,
+            c.master_uy[200],
+            c.contact_force_norm[200],
+            c.friction_force_norm[200],
+            c.external_work[200],
+            d_end,
+            worst / w_max
+        );
+        assert!(
+            worst <= tol * w_max,
+            "energy balance {worst:.3e} > {tol:e} · {w_max:.3e}"
+        );
+        // The structure is pushed down (fy < 0) and friction dissipates.
+        assert!(c.master_uy[200] < -0.5);
+        assert!(d_end > 0.0 && d_end < 0.05 * w_max);
+        assert!(c
+            .dissipated
+            .windows(2)
+            .all(|p| p[1] >= p[0] - 1e-12 * w_max));
     }
 }
