@@ -593,3 +593,52 @@ fn friction_bar_rom_runs_and_balances_energy() {
             .all(|p| p[1] >= p[0] - 1e-12 * w_max));
     }
 }
+
+/// Bad options are errors naming the field, not panics.
+#[test]
+fn bad_transient_options_are_errors() {
+    let model = Model::from_case_name("friction_bar").unwrap();
+    let rom = ReducedModel::new(&model, Mat::identity(model.dofs(), 12)).unwrap();
+    let bad = [
+        (
+            TransientOptions {
+                output_step: 0.0,
+                ..TransientOptions::default()
+            },
+            "output_step",
+        ),
+        (
+            TransientOptions {
+                end_time: Some(f64::NAN),
+                ..TransientOptions::default()
+            },
+            "end_time",
+        ),
+        (
+            TransientOptions {
+                problem: ProblemOptions {
+                    tau: -1.0,
+                    ..ProblemOptions::default()
+                },
+                ..TransientOptions::default()
+            },
+            "tau",
+        ),
+        (
+            TransientOptions {
+                problem: ProblemOptions {
+                    slip_scale: 0.0,
+                    ..ProblemOptions::default()
+                },
+                ..TransientOptions::default()
+            },
+            "slip_scale",
+        ),
+    ];
+    for (opts, field) in bad {
+        let err = run(ReducedSystem::new(&model, &rom).unwrap(), &opts)
+            .err()
+            .unwrap_or_else(|| panic!("{field}: accepted"));
+        assert!(err.to_string().contains(field), "{field}: {err}");
+    }
+}
