@@ -48,6 +48,15 @@ pub trait OdeProblem {
         Ok(())
     }
 
+    /// Per-component scale of the absolute tolerance: the integrator uses
+    /// `atol_i = atol · scale_i` when this fills `scale` (length [`OdeProblem::dim`]) and returns
+    /// `true`; the default returns `false` (one scalar `atol` for every component). Problems
+    /// whose states have different units (displacements, velocities, generalized coordinates)
+    /// use it to state the tolerance in one physical unit.
+    fn atol_scale(&self, _scale: &mut [f64]) -> bool {
+        false
+    }
+
     /// Whether [`OdeProblem::newton_setup`] / [`OdeProblem::newton_solve`] are implemented.
     fn has_newton_solver(&self) -> bool {
         false

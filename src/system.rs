@@ -69,6 +69,14 @@ pub trait SecondOrderSystem {
     fn newton_solve_in_place(&mut self, x: &mut [f64]);
     /// The master node's `[ux, uy, uz (mm), rx, ry, rz (rad)]` at `q`.
     fn master_displacement(&self, q: &[f64]) -> [f64; 6];
+    /// The physical size of a unit of each coordinate: the largest nodal displacement (mm) or
+    /// rotation (rad) it produces. 1 for physical DOF (the default); for a reduced model the
+    /// largest entry of the basis column, so that a tolerance stated in mm applies to the
+    /// physical field whatever the basis normalization (a mass-normalized column of the friction
+    /// bar moves nodes by ~10² mm per unit).
+    fn coordinate_size_into(&self, out: &mut [f64]) {
+        out.iter_mut().for_each(|x| *x = 1.0);
+    }
 }
 
 /// Sparse SPD matrix with a fixed pattern: symbolic Cholesky once, numeric refactorizations and
@@ -337,6 +345,8 @@ pub struct ReducedSystem {
     b_phi: Mat<f64>,
     /// Rows of Φ at the master DOF (6 × r).
     phi_master: Mat<f64>,
+    /// Largest absolute entry of each basis column (mm or rad per unit coordinate).
+    column_size: Vec<f64>,
     load: LoadSpec,
     contact: ContactSpec,
     end_time: f64,
@@ -369,6 +379,17 @@ impl ReducedSystem {
         }
         let master = model.master_dofs();
         let phi_master = Mat::from_fn(6, r, |d, c| rom.phi[(master[d], c)]);
+        let column_size: Vec<f64> = (0..r)
+            .map(|c| rom.phi.col(c).iter().fold(0.0f64, |m, x| m.max(x.abs())))
+            .collect();
+        if let Some(c) = column_size
+            .iter()
+            .position(|s| !(s.is_finite() && *s > 0.0))
+        {
+            return Err(Error::Invalid(format!(
+                "basis column {c} is zero or not finite"
+            )));
+        }
         let mut dev = 0.0f64;
         for i in 0..r {
             for j in 0..r {
@@ -402,6 +423,7 @@ impl ReducedSystem {
             m_llt,
             b_phi: rom.b_phi.clone(),
             phi_master,
+            column_size,
             load: model.case.load,
             contact: model.case.contact,
             end_time: model.case.end_time,
@@ -520,6 +542,9 @@ impl SecondOrderSystem for ReducedSystem {
     }
     fn master_displacement(&self, q: &[f64]) -> [f64; 6] {
         std::array::from_fn(|d| (0..self.r).map(|c| self.phi_master[(d, c)] * q[c]).sum())
+    }
+    fn coordinate_size_into(&self, out: &mut [f64]) {
+        out.copy_from_slice(&self.column_size);
     }
 }
 

@@ -44,11 +44,11 @@ use sundials_sys::{
     CVodeGetNumLinSolvSetups, CVodeGetNumNonlinSolvConvFails, CVodeGetNumNonlinSolvIters,
     CVodeGetNumPrecEvals, CVodeGetNumPrecSolves, CVodeGetNumRhsEvals, CVodeGetNumStabLimOrderReds,
     CVodeGetNumSteps, CVodeGetRootInfo, CVodeInit, CVodeReInit, CVodeRootInit, CVodeSStolerances,
-    CVodeSetEpsLin, CVodeSetErrHandlerFn, CVodeSetInitStep, CVodeSetLinearSolver,
-    CVodeSetMaxNumSteps, CVodeSetMaxOrd, CVodeSetMaxStep, CVodeSetNoInactiveRootWarn,
-    CVodeSetNonlinearSolver, CVodeSetPreconditioner, CVodeSetRootDirection, CVodeSetStabLimDet,
-    CVodeSetStopTime, CVodeSetUserData, SUNDenseMatrix, SUNLinSol_Dense, SUNNonlinSol_FixedPoint,
-    CV_ADAMS, CV_BDF, CV_NORMAL, CV_ROOT_RETURN,
+    CVodeSVtolerances, CVodeSetEpsLin, CVodeSetErrHandlerFn, CVodeSetInitStep,
+    CVodeSetLinearSolver, CVodeSetMaxNumSteps, CVodeSetMaxOrd, CVodeSetMaxStep,
+    CVodeSetNoInactiveRootWarn, CVodeSetNonlinearSolver, CVodeSetPreconditioner,
+    CVodeSetRootDirection, CVodeSetStabLimDet, CVodeSetStopTime, CVodeSetUserData, SUNDenseMatrix,
+    SUNLinSol_Dense, SUNNonlinSol_FixedPoint, CV_ADAMS, CV_BDF, CV_NORMAL, CV_ROOT_RETURN,
 };
 
 use super::callbacks::{self, Failure, Shared};
@@ -205,6 +205,23 @@ impl<P: OdeProblem> Cvode<P> {
             roots_found: 0,
             saved_y: Vec::with_capacity(n),
         };
+        // Per-component absolute tolerances (CVODE copies the vector).
+        let mut scale = vec![0.0; n];
+        let atol_vector = if cvode.shared.get().problem.atol_scale(&mut scale) {
+            if let Some((i, s)) = scale
+                .iter()
+                .enumerate()
+                .find(|(_, s)| !(s.is_finite() && **s > 0.0))
+            {
+                return Err(Error::Invalid(format!(
+                    "the problem's absolute-tolerance scale[{i}] = {s} is not finite and > 0"
+                )));
+            }
+            scale.iter_mut().for_each(|s| *s *= opts.atol);
+            Some(SerialVector::from_slice(&context, &scale)?)
+        } else {
+            None
+        };
         let m = cvode.mem.as_raw();
         let user_data = cvode.shared.as_user_data();
         // SAFETY (all calls below): `m` is live CVODE memory owned by `cvode`; `user_data`
@@ -220,10 +237,16 @@ impl<P: OdeProblem> Cvode<P> {
                 "CVodeInit",
                 CVodeInit(m, Some(callbacks::rhs::<P>), t0, cvode.y.as_raw()),
             )?;
-            cvode.check_cv(
-                "CVodeSStolerances",
-                CVodeSStolerances(m, opts.rtol, opts.atol),
-            )?;
+            match &atol_vector {
+                Some(v) => cvode.check_cv(
+                    "CVodeSVtolerances",
+                    CVodeSVtolerances(m, opts.rtol, v.as_raw()),
+                )?,
+                None => cvode.check_cv(
+                    "CVodeSStolerances",
+                    CVodeSStolerances(m, opts.rtol, opts.atol),
+                )?,
+            }
             // Before the linear solver: CVLS copies user_data as the preconditioner's data.
             cvode.check_cv("CVodeSetUserData", CVodeSetUserData(m, user_data))?;
         }
