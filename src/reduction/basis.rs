@@ -7,7 +7,9 @@ use crate::assembly::SymCsc;
 use crate::error::Error;
 use crate::model::Model;
 
+use super::alldof::alldof_vectors;
 use super::craig_bampton::craig_bampton;
+use super::jim::{jim_vectors, JimSet};
 use super::pod::{pod, DEFAULT_THRESHOLD};
 use super::tvd::{trial_vector_derivatives, TvdOptions};
 
@@ -80,11 +82,59 @@ pub enum BasisKind {
     /// No joint modes: Craig–Bampton with ν + g fixed-interface modes instead (the paper's
     /// comparison, Figure 7).
     Modes,
+    /// Craig–Bampton plus the g lowest Joint Interface Modes (Witteveen & Irschik 2009; the
+    /// paper's Section 5.3 and Figure 19), of the set [`BasisOptions::jim_set`]; see
+    /// [`super::jim`].
+    Jim,
+    /// Craig–Bampton plus the static constraint modes of every joint pair's relative normal DOF
+    /// (all joint DOF kept, the paper's Section 5.1); g is ignored and reported as the number of
+    /// pairs; see [`super::alldof`].
+    AllDof,
+}
+
+impl BasisKind {
+    /// Every kind, in the order of [`BasisKind::NAMES`].
+    pub const ALL: [BasisKind; 5] = [
+        BasisKind::Tvd,
+        BasisKind::TvdPlain,
+        BasisKind::Modes,
+        BasisKind::Jim,
+        BasisKind::AllDof,
+    ];
+
+    /// The accepted names: `tvd`, `tvd-plain`, `modes`, `jim`, `alldof`.
+    pub const NAMES: [&'static str; 5] = ["tvd", "tvd-plain", "modes", "jim", "alldof"];
+
+    /// The kind's name (as accepted by [`BasisKind::from_name`] and the CLI's `--basis`).
+    pub fn name(self) -> &'static str {
+        match self {
+            BasisKind::Tvd => "tvd",
+            BasisKind::TvdPlain => "tvd-plain",
+            BasisKind::Modes => "modes",
+            BasisKind::Jim => "jim",
+            BasisKind::AllDof => "alldof",
+        }
+    }
+
+    /// Parses a name of [`BasisKind::NAMES`] (exact, lower case); anything else is an
+    /// [`Error::Invalid`] listing the accepted names.
+    pub fn from_name(name: &str) -> Result<BasisKind, Error> {
+        BasisKind::ALL
+            .into_iter()
+            .find(|k| k.name() == name)
+            .ok_or_else(|| {
+                Error::Invalid(format!(
+                    "unknown basis `{name}`: expected one of {}",
+                    BasisKind::NAMES.join(", ")
+                ))
+            })
+    }
 }
 
 /// Options of [`build_basis`]. Defaults: `nu = 10` (the paper), `g = None` (chosen by
 /// `threshold`), `threshold =` [`DEFAULT_THRESHOLD`] (0.999), `tvd =` [`TvdOptions::default`]
-/// (tol 1e-6, zero gaps active, no tangential stiffness), `drop_tol =` [`DEFAULT_DROP_TOL`].
+/// (tol 1e-6, zero gaps active, no tangential stiffness), `drop_tol =` [`DEFAULT_DROP_TOL`],
+/// `jim_set =` [`JimSet::Both`]. Construct with `..Default::default()`: fields may be added.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct BasisOptions {
     /// Fixed-interface normal modes ν.
@@ -97,6 +147,8 @@ pub struct BasisOptions {
     pub tvd: TvdOptions,
     /// Relative drop tolerance of the final M-orthonormalization.
     pub drop_tol: f64,
+    /// The joint DOF set of [`BasisKind::Jim`].
+    pub jim_set: JimSet,
 }
 
 impl Default for BasisOptions {
@@ -107,6 +159,7 @@ impl Default for BasisOptions {
             threshold: DEFAULT_THRESHOLD,
             tvd: TvdOptions::default(),
             drop_tol: DEFAULT_DROP_TOL,
+            jim_set: JimSet::Both,
         }
     }
 }
@@ -116,10 +169,12 @@ impl Default for BasisOptions {
 pub struct Basis {
     /// M-orthonormal basis (n × r), `Φᵀ M Φ = I`.
     pub phi: Mat<f64>,
-    /// The POD energy ratio `w[g − 1] = w(g)` of the TVD (the K-weighted one for `Modes`;
-    /// empty for `Modes` with an explicit g, where no TVD are computed).
+    /// The POD energy ratio `w[g − 1] = w(g)` of the TVD (the K-weighted one for `Modes` and
+    /// `Jim`; empty for `Modes` and `Jim` with an explicit g, where no TVD are computed, and for
+    /// `AllDof`; the snapshot POD's for [`super::snapshot_basis`]).
     pub w: Vec<f64>,
-    /// Number of joint modes g used (for `Modes`: extra fixed-interface modes).
+    /// Number of joint modes g used (for `Modes`: extra fixed-interface modes; for `Jim`: Joint
+    /// Interface Modes; for `AllDof`: the number of pairs; for snapshots: POMs).
     pub g: usize,
     /// TVD candidates `2 (v + s)²` and kept nonzero columns.
     pub tvd_total: usize,
@@ -131,10 +186,21 @@ pub struct Basis {
 
 /// Builds `Φ = [Φ_S Φ_V Φ̃_T]` (Algorithm 2) for a model: Craig–Bampton with ν modes, TVD of
 /// all 6 + ν vectors, POD (weighted for `Tvd`, plain for `TvdPlain`), the first g POMs, and
-/// M-orthonormalization. For `Modes` the TVD/POD are still run when `g` is `None`, to choose g
-/// the same way as `Tvd` would, and the basis is Craig–Bampton with ν + g modes.
+/// M-orthonormalization. The competitors replace `Φ̃_T`:
+///
+/// - `Modes`: Craig–Bampton with ν + g fixed-interface modes;
+/// - `Jim`: the g lowest Joint Interface Modes of `opts.jim_set` ([`jim_vectors`]);
+/// - `AllDof`: the constraint modes of all pairs' normal DOF ([`alldof_vectors`]), g = w.
+///
+/// For `Modes` and `Jim` with `g = None` the TVD and their K-weighted POD are still computed, to
+/// choose g exactly as `Tvd` would (the smallest g with `w(g) ≥ opts.threshold`), so the
+/// competitors are compared at the same number of added vectors; `Basis::w` is then that POD's.
 pub fn build_basis(model: &Model, kind: BasisKind, opts: &BasisOptions) -> Result<Basis, Error> {
-    let need_tvd = kind != BasisKind::Modes || opts.g.is_none();
+    let need_tvd = match kind {
+        BasisKind::Tvd | BasisKind::TvdPlain => true,
+        BasisKind::Modes | BasisKind::Jim => opts.g.is_none(),
+        BasisKind::AllDof => false,
+    };
     let cb = craig_bampton(model, opts.nu)?;
     let (w, g, tvd_total, tvd_nonzero, joint_modes) = if need_tvd {
         let tvd = trial_vector_derivatives(model, cb.as_ref(), &opts.tvd)?;
@@ -159,16 +225,32 @@ pub fn build_basis(model: &Model, kind: BasisKind, opts: &BasisOptions) -> Resul
             Mat::zeros(model.dofs(), 0),
         )
     };
-    let (phi, dropped) = match kind {
+    let (phi, dropped, g) = match kind {
         BasisKind::Modes => {
             let cbg = craig_bampton(model, opts.nu + g)?;
-            final_basis(&[cbg.as_ref()], &model.mass, opts.drop_tol)?
+            let (phi, dropped) = final_basis(&[cbg.as_ref()], &model.mass, opts.drop_tol)?;
+            (phi, dropped, g)
         }
-        _ => final_basis(
-            &[cb.as_ref(), joint_modes.as_ref()],
-            &model.mass,
-            opts.drop_tol,
-        )?,
+        BasisKind::Jim => {
+            let jim = jim_vectors(model, g, opts.jim_set)?;
+            let (phi, dropped) =
+                final_basis(&[cb.as_ref(), jim.as_ref()], &model.mass, opts.drop_tol)?;
+            (phi, dropped, g)
+        }
+        BasisKind::AllDof => {
+            let psi = alldof_vectors(model)?;
+            let (phi, dropped) =
+                final_basis(&[cb.as_ref(), psi.as_ref()], &model.mass, opts.drop_tol)?;
+            (phi, dropped, psi.ncols())
+        }
+        BasisKind::Tvd | BasisKind::TvdPlain => {
+            let (phi, dropped) = final_basis(
+                &[cb.as_ref(), joint_modes.as_ref()],
+                &model.mass,
+                opts.drop_tol,
+            )?;
+            (phi, dropped, g)
+        }
     };
     Ok(Basis {
         phi,

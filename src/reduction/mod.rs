@@ -23,20 +23,31 @@
 //!    directions dropped.
 //! 5. [`ReducedModel`]: `K̃`, `M̃`, the reduced joint operator `B Φ` and the reduced load.
 //!
+//! The competitors of the paper's Section 5, behind the same [`build_basis`] ([`BasisKind`]):
+//! modes only (more fixed-interface modes), [`jim`] (Joint Interface Modes, Section 5.3),
+//! [`alldof`] (constraint modes of all joint normal DOF, Section 5.1) and, with its own builder
+//! because it needs full-FE results, [`snapshots`] (POD of transient snapshots, Section 5.2).
+//!
 //! Without `k_t` every TVD lies in `span(K⁻¹ B_nᵀ)`, so the TVD space has at most one dimension
 //! per pair and `w(g) = 1` by g = w (number of pairs).
 //!
 //! Not implemented: the inertia-corrected TVD of eq. (15) for vibration modes (it needs a
 //! factorization of the indefinite `K − Ω_i² M` per mode).
 
+pub mod alldof;
 mod basis;
 mod craig_bampton;
+pub mod jim;
 mod pod;
+pub mod snapshots;
 mod tvd;
 
+pub use alldof::alldof_vectors;
 pub use basis::{build_basis, final_basis, Basis, BasisKind, BasisOptions, DEFAULT_DROP_TOL};
 pub use craig_bampton::craig_bampton;
+pub use jim::{jim_dofs, jim_vectors, joint_interface_modes, JimSet, JointInterfaceModes};
 pub use pod::{pod, Pod, DEFAULT_THRESHOLD, ZERO_EIGENVALUE};
+pub use snapshots::{snapshot_basis, snapshot_pod};
 pub use tvd::{active_pairs, trial_vector_derivatives, Tvd, TvdIndex, TvdOptions};
 
 use faer::Mat;
