@@ -157,7 +157,8 @@ pub(crate) fn interior_size(model: &Model, what: &str) -> Result<usize, Error> {
     Ok(m)
 }
 
-/// Eigenpairs `(λ ascending, φ_i on the interior rows)` of one set, all |J| of them.
+/// Eigenpairs of one set, all |J| of them: `λ` ascending (1/s²) and the coefficients `c_k`
+/// (|J| × |J|) with `φ_k = X_s c_k` M-normalized.
 fn condensed_modes(
     model: &Model,
     x: &Mat<f64>,
@@ -191,30 +192,32 @@ fn condensed_modes(
     let mu = evd.S().column_vector();
     let mut u = evd.U().to_owned();
     solve_upper_triangular_in_place(l.transpose(), u.as_mut(), Par::Seq);
-    // Ascending λ = descending μ.
+    // Ascending λ = descending μ. Only the lowest modes are ever used; μ ≤ 1e-12 μ_max is
+    // numerically an infinite frequency (the pencil (G, F) resolves the largest μ to working
+    // precision, the smallest not at all) and is reported as λ = ∞, an error if requested.
+    let mu_max = if p > 0 { mu[p - 1] } else { 0.0 };
     let mut lambda = Vec::with_capacity(p);
-    let mut phi = Mat::<f64>::zeros(m, p);
+    let mut coef = Mat::<f64>::zeros(p, p);
     for (k, i) in (0..p).rev().enumerate() {
         let mui = mu[i];
-        if !(mui.is_finite() && mui > 0.0) {
-            return Err(Error::LinearAlgebra(format!(
-                "Joint Interface Modes: condensed mass eigenvalue μ = {mui:e} is not positive \
-                 (singular condensed mass)"
-            )));
-        }
-        lambda.push(1.0 / mui);
-        let ui = u.col(i).to_owned() * faer::Scale(1.0 / mui.sqrt());
-        let col = xs * &ui;
-        for r in 0..m {
-            phi[(r, k)] = col[r];
+        if mui.is_finite() && mui > 1e-12 * mu_max {
+            lambda.push(1.0 / mui);
+            let inv = 1.0 / mui.sqrt();
+            for a in 0..p {
+                coef[(a, k)] = u[(a, i)] * inv;
+            }
+        } else {
+            lambda.push(f64::INFINITY);
         }
     }
-    Ok((lambda, phi))
+    Ok((lambda, coef))
 }
 
 /// The `count` lowest Joint Interface Modes of `set` with their eigenvalues (see the module
 /// docs). Errors if `count` exceeds the size of the set (`|J_n|` for `Normal`, `|J_t|` for
-/// `InPlane`, their sum for `Both`), or on a singular joint flexibility or condensed mass.
+/// `InPlane`, their sum for `Both`), on a singular joint flexibility, or if a requested mode's
+/// condensed mass eigenvalue `μ = 1/λ` is below `1e-12 μ_max` (a numerically infinite
+/// frequency: the highest modes of a set are not resolved, nor needed).
 pub fn joint_interface_modes(
     model: &Model,
     count: usize,
@@ -265,30 +268,41 @@ pub fn joint_interface_modes(
             "Joint Interface Modes: static responses are not finite".into(),
         ));
     }
-    let mut parts: Vec<(JimSet, Vec<f64>, Mat<f64>)> = Vec::new();
+    let mut parts: Vec<(JimSet, Vec<f64>, Mat<f64>, usize)> = Vec::new();
     let mut start = 0;
     if use_normal {
-        let (l, p) = condensed_modes(model, &x, 0..normal.len(), &normal)?;
-        parts.push((JimSet::Normal, l, p));
+        let (l, c) = condensed_modes(model, &x, 0..normal.len(), &normal)?;
+        parts.push((JimSet::Normal, l, c, 0));
         start = normal.len();
     }
     if use_in_plane {
-        let (l, p) = condensed_modes(model, &x, start..start + in_plane.len(), &in_plane)?;
-        parts.push((JimSet::InPlane, l, p));
+        let (l, c) = condensed_modes(model, &x, start..start + in_plane.len(), &in_plane)?;
+        parts.push((JimSet::InPlane, l, c, start));
     }
     // Merge by eigenvalue ascending (a single set is already sorted).
     let mut picks: Vec<(f64, usize, usize)> = parts
         .iter()
         .enumerate()
-        .flat_map(|(s, (_, l, _))| l.iter().enumerate().map(move |(k, &v)| (v, s, k)))
+        .flat_map(|(s, (_, l, _, _))| l.iter().enumerate().map(move |(k, &v)| (v, s, k)))
         .collect();
     picks.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
     picks.truncate(count);
+    if let Some(&(_, s, k)) = picks.iter().find(|p| !p.0.is_finite()) {
+        return Err(Error::LinearAlgebra(format!(
+            "Joint Interface Mode {} of the {} set has a numerically infinite frequency \
+             (condensed mass eigenvalue ≤ 1e-12 of the largest): request fewer than {count}",
+            k + 1,
+            parts[s].0.name()
+        )));
+    }
     let mut vectors = Mat::<f64>::zeros(n, count);
     for (c, &(_, s, k)) in picks.iter().enumerate() {
-        let src = &parts[s].2;
+        let (_, _, coef, first) = &parts[s];
+        let p = coef.nrows();
+        let xs = x.as_ref().subcols(*first, p);
+        let phi = xs * coef.col(k);
         for r in 0..m {
-            vectors[(r, c)] = src[(r, k)];
+            vectors[(r, c)] = phi[r];
         }
     }
     Ok(JointInterfaceModes {
