@@ -41,7 +41,8 @@
 //! `F = L Lᵀ`: `C = L⁻¹ G L⁻ᵀ`, `C z = μ z`, `u = L⁻ᵀ z` (faer `self_adjoint_eigen`). The
 //! lowest modes are the largest μ, the best-determined eigenvalues of `C`. With `zᵀz = 1`:
 //! `φᵀ K φ = uᵀ F u = 1` and `φᵀ M φ = uᵀ G u = μ`, so each returned vector is scaled by
-//! `1/√μ` to `φᵀMφ = 1`, `φᵀKφ = λ`. JIM of one set are M- and K-orthogonal to each other (they
+//! `1/√μ` to `φᵀMφ = 1`, `φᵀKφ = λ` (in the code: by the computed `uᵀGu`, with λ the Rayleigh
+//! quotient `uᵀFu / uᵀGu`, which the back substitution leaves more accurate than `1/μ`). JIM of one set are M- and K-orthogonal to each other (they
 //! are eigenvectors of one pencil); the normal and in-plane sets are not mutually orthogonal.
 //!
 //! [`JimSet::Both`] merges the two sets' modes by eigenvalue, ascending.
@@ -181,7 +182,7 @@ fn condensed_modes(
     })?;
     let l = llt.L();
     // C = L⁻¹ G L⁻ᵀ: Y = L⁻¹ G, then C = L⁻¹ Yᵀ.
-    let mut y = g;
+    let mut y = g.clone();
     solve_lower_triangular_in_place(l, y.as_mut(), Par::Seq);
     let mut c = y.transpose().to_owned();
     solve_lower_triangular_in_place(l, c.as_mut(), Par::Seq);
@@ -201,10 +202,22 @@ fn condensed_modes(
     for (k, i) in (0..p).rev().enumerate() {
         let mui = mu[i];
         if mui.is_finite() && mui > 1e-12 * mu_max {
-            lambda.push(1.0 / mui);
-            let inv = 1.0 / mui.sqrt();
+            // Normalize by the computed M-norm uᵀGu and take λ as the Rayleigh quotient
+            // uᵀFu / uᵀGu (both more accurate than μ after the back substitution).
+            let ui = u.col(i);
+            let gu = &g * ui;
+            let fu = &f * ui;
+            let ugu: f64 = (0..p).map(|a| ui[a] * gu[a]).sum();
+            let ufu: f64 = (0..p).map(|a| ui[a] * fu[a]).sum();
+            if !(ugu > 0.0 && ufu > 0.0) {
+                return Err(Error::LinearAlgebra(format!(
+                    "Joint Interface Modes: mode {k} has uᵀGu = {ugu:e}, uᵀFu = {ufu:e}"
+                )));
+            }
+            lambda.push(ufu / ugu);
+            let inv = 1.0 / ugu.sqrt();
             for a in 0..p {
-                coef[(a, k)] = u[(a, i)] * inv;
+                coef[(a, k)] = ui[a] * inv;
             }
         } else {
             lambda.push(f64::INFINITY);
@@ -296,13 +309,30 @@ pub fn joint_interface_modes(
         )));
     }
     let mut vectors = Mat::<f64>::zeros(n, count);
+    let mut mphi = vec![0.0; n];
     for (c, &(_, s, k)) in picks.iter().enumerate() {
         let (_, _, coef, first) = &parts[s];
         let p = coef.nrows();
         let xs = x.as_ref().subcols(*first, p);
         let phi = xs * coef.col(k);
+        let mut full: Vec<f64> = (0..n).map(|r| if r < m { phi[r] } else { 0.0 }).collect();
+        // The columns of X (responses to forces at neighbouring joint DOF) are nearly parallel,
+        // so X c cancels and its M-norm drifts ~1e-10 from uᵀGu: renormalize on the assembled M.
+        model.mass.mul_vec(&full, &mut mphi);
+        let norm = full
+            .iter()
+            .zip(&mphi)
+            .map(|(a, b)| a * b)
+            .sum::<f64>()
+            .sqrt();
+        if !(norm.is_finite() && norm > 0.0) {
+            return Err(Error::LinearAlgebra(format!(
+                "Joint Interface Mode {c} has M-norm {norm:e}"
+            )));
+        }
+        full.iter_mut().for_each(|v| *v /= norm);
         for r in 0..m {
-            vectors[(r, c)] = phi[r];
+            vectors[(r, c)] = full[r];
         }
     }
     Ok(JointInterfaceModes {
