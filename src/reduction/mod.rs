@@ -20,7 +20,8 @@
 //!    approximate the deformation energy of the TVD space) or plain, with the energy ratio
 //!    `w(g)` (eq. 26) to choose the number g of joint modes `Φ̃_T` (eq. 23 scaling).
 //! 4. [`final_basis`]: the parts concatenated and M-orthonormalized (so `M̃ = I`), dependent
-//!    directions dropped.
+//!    directions dropped; [`build_basis`] then rotates Φ to the reduced eigenbasis
+//!    ([`modal_rotation`]: `K̃ = diag(ω²)`, same span) unless `BasisOptions::modal` is false.
 //! 5. [`ReducedModel`]: `K̃`, `M̃`, the reduced joint operator `B Φ` and the reduced load.
 //!
 //! The competitors of the paper's Section 5, behind the same [`build_basis`] ([`BasisKind`]):
@@ -43,7 +44,9 @@ pub mod snapshots;
 mod tvd;
 
 pub use alldof::alldof_vectors;
-pub use basis::{build_basis, final_basis, Basis, BasisKind, BasisOptions, DEFAULT_DROP_TOL};
+pub use basis::{
+    build_basis, final_basis, modal_rotation, Basis, BasisKind, BasisOptions, DEFAULT_DROP_TOL,
+};
 pub use craig_bampton::craig_bampton;
 pub use jim::{jim_dofs, jim_vectors, joint_interface_modes, JimSet, JointInterfaceModes};
 pub use pod::{pod, Pod, DEFAULT_THRESHOLD, ZERO_EIGENVALUE};
@@ -110,7 +113,10 @@ impl ReducedModel {
 /// eigenvalues' accuracy; the compensated product keeps `K̃` the exact projection of the
 /// assembled K to working precision (measured: the alldof basis then reproduces the full contact
 /// statics to ≤ 1e-8, against ≈ 5e-7 with plain products on the multilayer sheet).
-fn compensated_gram(a: &crate::assembly::SymCsc, phi: faer::MatRef<'_, f64>) -> Mat<f64> {
+pub(crate) fn compensated_gram(
+    a: &crate::assembly::SymCsc,
+    phi: faer::MatRef<'_, f64>,
+) -> Mat<f64> {
     let aphi = alldof::sym_mul_compensated(a, phi, 1.0, None);
     let r = phi.ncols();
     let n = phi.nrows();

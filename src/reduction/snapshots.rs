@@ -20,7 +20,7 @@ use crate::assembly::SymCsc;
 use crate::error::Error;
 use crate::model::Model;
 
-use super::basis::{final_basis, Basis, BasisOptions};
+use super::basis::{final_basis, modal_rotation, Basis, BasisOptions};
 use super::craig_bampton::craig_bampton;
 use super::pod::{pod, Pod};
 
@@ -46,7 +46,7 @@ pub fn snapshot_pod(snapshots: MatRef<'_, f64>, weight: Option<&SymCsc>) -> Resu
 
 /// The basis `[Φ_S Φ_V U_g]` of Craig–Bampton (`opts.nu` modes) and the first g snapshot POMs
 /// (`opts.g`, or the smallest g with `w(g) ≥ opts.threshold`), M-orthonormalized with
-/// `opts.drop_tol`. `weight` as in [`snapshot_pod`]. The returned [`Basis::w`] is the snapshot
+/// `opts.drop_tol` (and rotated to the reduced eigenbasis if `opts.modal`). `weight` as in [`snapshot_pod`]. The returned [`Basis::w`] is the snapshot
 /// POD's energy ratio; `tvd_total = tvd_nonzero = 0`. Errors if the snapshots do not have
 /// `model.dofs()` rows.
 pub fn snapshot_basis(
@@ -69,6 +69,11 @@ pub fn snapshot_basis(
         .min(p.lambda.len());
     let cb = craig_bampton(model, opts.nu)?;
     let (phi, dropped) = final_basis(&[cb.as_ref(), p.leading(g)], &model.mass, opts.drop_tol)?;
+    let (phi, eigenvalues) = if opts.modal {
+        modal_rotation(model, phi)?
+    } else {
+        (phi, Vec::new())
+    };
     Ok(Basis {
         phi,
         w: p.w,
@@ -76,5 +81,6 @@ pub fn snapshot_basis(
         tvd_total: 0,
         tvd_nonzero: 0,
         dropped,
+        eigenvalues,
     })
 }
