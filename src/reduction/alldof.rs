@@ -36,8 +36,8 @@ use super::jim::interior_size;
 
 /// The static constraint modes `ψ_k = [K_ii⁻¹ b_{k,i}ᵀ; 0]` of every joint pair's relative
 /// normal DOF (n × w, column k for pair k, mm/N; zero on the master DOF): one sparse Cholesky of
-/// `K_ii`, all pairs at once, refined twice with double-double residuals ([`REFINEMENT_STEPS`]). Craig–Bampton plus these columns span the exact frictionless contact
-/// solution (see the module docs). Entries of `b_k` on master DOF are dropped (the master is
+/// `K_ii`, all pairs at once, refined twice with double-double residuals. Craig–Bampton plus
+/// these columns span the exact frictionless contact solution (see the module docs). Entries of `b_k` on master DOF are dropped (the master is
 /// fixed); a pair acting only on the master gives a zero column.
 pub fn alldof_vectors(model: &Model) -> Result<Mat<f64>, Error> {
     let m = interior_size(model, "all-joint-DOF constraint modes")?;

@@ -41,11 +41,21 @@
 //! `F = L Lᵀ`: `C = L⁻¹ G L⁻ᵀ`, `C z = μ z`, `u = L⁻ᵀ z` (faer `self_adjoint_eigen`). The
 //! lowest modes are the largest μ, the best-determined eigenvalues of `C`. With `zᵀz = 1`:
 //! `φᵀ K φ = uᵀ F u = 1` and `φᵀ M φ = uᵀ G u = μ`, so each returned vector is scaled by
-//! `1/√μ` to `φᵀMφ = 1`, `φᵀKφ = λ` (in the code: by the computed `uᵀGu`, with λ the Rayleigh
-//! quotient `uᵀFu / uᵀGu`, which the back substitution leaves more accurate than `1/μ`). JIM of one set are M- and K-orthogonal to each other (they
-//! are eigenvectors of one pencil); the normal and in-plane sets are not mutually orthogonal.
+//! `1/√μ` to `φᵀMφ = 1`, `φᵀKφ = λ`. In the code λ is the Rayleigh quotient `uᵀFu / uᵀGu`
+//! (more accurate than `1/μ` after the back substitution), and each expanded `φ = X u` is
+//! normalized on the assembled M: the columns of X (responses to forces at neighbouring joint
+//! DOF) are nearly parallel, so `X u` cancels and its M-norm drifts ~1e-10 from `uᵀGu`. JIM of
+//! one set are M- and K-orthogonal to each other (eigenvectors of one pencil); the normal and
+//! in-plane sets are not mutually orthogonal.
+//!
+//! Only the lowest modes are resolved: μ below `1e-12 μ_max` (a numerically infinite frequency;
+//! the friction bar's in-plane set reaches ~1e5 Hz by its 30th mode) is an error if requested.
 //!
 //! [`JimSet::Both`] merges the two sets' modes by eigenvalue, ascending.
+//!
+//! Measured (ν = 10 Craig–Bampton, `tests/competitors.rs`): the friction bar's lowest JIM are
+//! 87 Hz (normal) and 244 Hz (in-plane), the first 30 of `Both` are 25 normal + 5 in-plane; the
+//! multilayer's 186 Hz and 366 Hz, 26 + 4.
 
 use faer::linalg::triangular_solve::{
     solve_lower_triangular_in_place, solve_upper_triangular_in_place,
