@@ -86,10 +86,26 @@ pub struct LineChart {
     pub y_range: Option<(f64, f64)>,
     /// Image size in pixels (SVG user units).
     pub size: (u32, u32),
+    /// Where the legend box goes.
+    pub legend: LegendPosition,
+}
+
+/// Corner of the plot area that holds the legend.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum LegendPosition {
+    /// Upper right (default).
+    #[default]
+    UpperRight,
+    /// Upper left.
+    UpperLeft,
+    /// Lower left.
+    LowerLeft,
+    /// Lower right.
+    LowerRight,
 }
 
 impl LineChart {
-    /// An empty chart, linear axes, 960 × 600.
+    /// An empty chart, linear axes, 960 × 600, legend upper right.
     pub fn new(
         title: impl Into<String>,
         x_label: impl Into<String>,
@@ -105,6 +121,7 @@ impl LineChart {
             references: Vec::new(),
             y_range: None,
             size: (960, 600),
+            legend: LegendPosition::UpperRight,
         }
     }
 
@@ -229,23 +246,29 @@ impl LineChart {
             .map_err(|e| err(&e))?;
         for (k, s) in self.series.iter().enumerate() {
             let color = palette(k);
-            let pts: Vec<(f64, f64)> = s
-                .points
-                .iter()
-                .copied()
-                .filter(|&(x, y)| self.drawable(x, y))
-                .collect();
-            chart
-                .draw_series(LineSeries::new(pts.iter().copied(), color.stroke_width(2)))
-                .map_err(|e| err(&e))?
-                .label(s.label.as_str())
-                .legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2))
-                });
-            if s.markers {
-                chart
-                    .draw_series(pts.iter().map(|&p| Circle::new(p, 3, color.filled())))
+            // Runs of drawable points: a point that cannot be drawn breaks the line.
+            let mut runs: Vec<Vec<(f64, f64)>> = vec![Vec::new()];
+            for &(x, y) in &s.points {
+                if self.drawable(x, y) {
+                    runs.last_mut().expect("runs is never empty").push((x, y));
+                } else if !runs.last().expect("runs is never empty").is_empty() {
+                    runs.push(Vec::new());
+                }
+            }
+            for (i, run) in runs.iter().enumerate() {
+                let drawn = chart
+                    .draw_series(LineSeries::new(run.iter().copied(), color.stroke_width(2)))
                     .map_err(|e| err(&e))?;
+                if i == 0 {
+                    drawn.label(s.label.as_str()).legend(move |(x, y)| {
+                        PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2))
+                    });
+                }
+                if s.markers {
+                    chart
+                        .draw_series(run.iter().map(|&p| Circle::new(p, 3, color.filled())))
+                        .map_err(|e| err(&e))?;
+                }
             }
         }
         for r in &self.references {
@@ -270,7 +293,12 @@ impl LineChart {
                 .label_font((FAMILY, 14))
                 .background_style(WHITE.mix(0.85))
                 .border_style(BLACK)
-                .position(SeriesLabelPosition::UpperRight)
+                .position(match self.legend {
+                    LegendPosition::UpperRight => SeriesLabelPosition::UpperRight,
+                    LegendPosition::UpperLeft => SeriesLabelPosition::UpperLeft,
+                    LegendPosition::LowerLeft => SeriesLabelPosition::LowerLeft,
+                    LegendPosition::LowerRight => SeriesLabelPosition::LowerRight,
+                })
                 .draw()
                 .map_err(|e| err(&e))?;
         }

@@ -708,14 +708,15 @@ pub const ERROR_FLOOR: f64 = 1e-16;
 /// Writes the study's charts into `dir` as SVG and PNG; returns the files written.
 ///
 /// - `fc_error`: relative error of `‖f_c‖` against g, log axis (errors below [`ERROR_FLOOR`]
-///   drawn at the floor), with the 1e-2 and 1e-4 levels as reference lines;
+///   drawn at the floor; failed solves, NaN, leave a gap), with the 1e-2 and 1e-4 levels as
+///   reference lines;
 /// - `fc_norm`: `‖f_c‖` against g with the full-FE value (paper Figs. 7, 15, 19);
 /// - `w`: the POD energy ratios w(g) with the threshold (paper Figs. 8, 16).
 pub fn write_charts(
     study: &Study,
     dir: &std::path::Path,
 ) -> Result<Vec<std::path::PathBuf>, Error> {
-    use crate::chart::{LineChart, Reference, Series};
+    use crate::chart::{LegendPosition, LineChart, Reference, Series};
     let mut files = Vec::new();
     let case = &study.case;
 
@@ -728,12 +729,13 @@ pub fn write_charts(
         "relative error of ‖f_c‖",
     );
     err.y_log = true;
+    err.legend = LegendPosition::LowerLeft;
     for s in &study.series {
         err.series.push(Series::new(
             s.label.clone(),
             s.g.iter()
                 .zip(&s.relative_error)
-                .map(|(&g, &e)| (g as f64, e.max(ERROR_FLOOR)))
+                .map(|(&g, &e)| (g as f64, if e.is_nan() { e } else { e.max(ERROR_FLOOR) }))
                 .collect(),
         ));
     }
@@ -779,6 +781,7 @@ pub fn write_charts(
                 .collect(),
         ));
     }
+    w.legend = LegendPosition::LowerRight;
     w.references.push(Reference {
         label: format!("threshold {}", study.threshold),
         value: study.threshold,
