@@ -63,6 +63,19 @@ pub struct Reference {
     pub label: String,
     /// The y value.
     pub value: f64,
+    /// Line colour (RGB); `None`: black.
+    pub color: Option<[u8; 3]>,
+}
+
+impl Reference {
+    /// A black reference line.
+    pub fn new(label: impl Into<String>, value: f64) -> Reference {
+        Reference {
+            label: label.into(),
+            value,
+            color: None,
+        }
+    }
 }
 
 /// A line chart: title, axes, series and reference lines.
@@ -275,7 +288,8 @@ impl LineChart {
             if !(r.value.is_finite() && (!self.y_log || r.value > 0.0)) {
                 continue;
             }
-            let style = BLACK.stroke_width(1);
+            let [r_, g_, b_] = r.color.unwrap_or([0, 0, 0]);
+            let style = RGBColor(r_, g_, b_).stroke_width(if r.color.is_some() { 2 } else { 1 });
             chart
                 .draw_series(DashedLineSeries::new(
                     [(xmin, r.value), (xmax, r.value)],

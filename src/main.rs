@@ -570,6 +570,12 @@ fn print_study(s: &study::Study) {
             e.name, s.threshold, e.g_threshold, e.tvd_nonzero, e.pod_modes
         );
     }
+    for t in &s.tvd_spans {
+        println!(
+            "  all {} TVD without POD: {} columns ({} dropped), error {:.3e} ({:.2} s)",
+            t.name, t.basis_size, t.dropped, t.relative_error, t.solve_s
+        );
+    }
     println!(
         "study {:.2} s (Craig–Bampton {:.3} s)",
         s.total_s, s.craig_bampton_s

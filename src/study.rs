@@ -47,9 +47,7 @@ use faer::linalg::triangular_solve::{
 use faer::{Mat, MatRef, Par, Side};
 use serde::Serialize;
 
-use crate::contact::{
-    contact_static_full, contact_static_reduced, ActiveStart, ContactOptions, ContactState,
-};
+use crate::contact::{contact_static_full, contact_static_reduced, ContactOptions, ContactState};
 use crate::error::Error;
 use crate::joint::NORMAL;
 use crate::model::Model;
@@ -142,11 +140,10 @@ pub fn reduced_contact_static(
     })
 }
 
-/// [`reduced_contact_static`] from `opts.start`; if that fails (the active-set Newton method
-/// can cycle on a coarse basis, whose contact problem is still convex but poorly resolved),
-/// once more from the opposite start ([`ActiveStart::Open`] ↔ [`ActiveStart::Closed`]).
-/// Returns the solution and the first attempt's error if the restart was needed; the error
-/// names both attempts when both fail.
+/// [`reduced_contact_static`] (the active-set Newton method of [`crate::contact`]) from
+/// `opts.start`; if that fails — it can cycle on a coarse basis, whose contact problem is still
+/// convex but poorly resolved — [`reduced_contact_static_damped`], which converges for any
+/// basis. Returns the solution and the first attempt's error if the fallback was needed.
 pub fn reduced_contact_static_restarting(
     model: &Model,
     rm: &ReducedModel,
@@ -155,22 +152,139 @@ pub fn reduced_contact_static_restarting(
 ) -> Result<(ReducedStatic, Option<Error>), Error> {
     match reduced_contact_static(model, rm, scale, opts) {
         Ok(sol) => Ok((sol, None)),
-        Err(first) => {
-            let other = ContactOptions {
-                start: match opts.start {
-                    ActiveStart::Open => ActiveStart::Closed,
-                    ActiveStart::Closed => ActiveStart::Open,
-                },
-                ..*opts
+        Err(first) => match reduced_contact_static_damped(model, rm, scale, opts) {
+            Ok(sol) => Ok((sol, Some(first))),
+            Err(second) => Err(Error::LinearAlgebra(format!(
+                "reduced contact statics failed: {first}; then, damped: {second}"
+            ))),
+        },
+    }
+}
+
+/// Frictionless contact statics of a reduced model by semismooth Newton with a backtracking
+/// (Armijo) line search on the contact energy
+///
+/// ```text
+/// E(η) = ½ ηᵀ K̃ η − f̃ᵀ η + ½ k_n Σ_i min(b_i η, 0)²     (b_i: row i of B_n Φ)
+/// ```
+///
+/// which is convex and continuously differentiable with `∇E = H_A η − f̃`,
+/// `H_A = K̃ + k_n Σ_{i∈A(η)} b_iᵀ b_i`, `A(η) = {i : b_i η < 0}`. The Newton direction
+/// `d = H_A⁻¹ f̃ − η` is the undamped active-set step of [`crate::contact`]; it is a descent
+/// direction (`∇E·d = −dᵀ H_A d < 0`), and backtracking until
+/// `E(η + t d) ≤ E(η) + 10⁻⁴ t ∇E·d` makes the iteration converge from any start, where the
+/// undamped one can cycle. It stops exactly as the undamped one: when the full step's active set
+/// equals the set it was computed with, the step solves the piecewise linear equilibrium
+/// exactly. Starts from η = 0 (all pairs open); at most `20 · opts.max_iterations` steps.
+pub fn reduced_contact_static_damped(
+    model: &Model,
+    rm: &ReducedModel,
+    scale: f64,
+    opts: &ContactOptions,
+) -> Result<ReducedStatic, Error> {
+    let w = model.joint.pairs();
+    let r = rm.dim();
+    let k_n = model.case.contact.normal_stiffness;
+    let b = Mat::from_fn(w, r, |i, j| rm.b_phi[(3 * i + NORMAL, j)]);
+    let f: Vec<f64> = rm.load.iter().map(|v| v * scale).collect();
+    let gaps_of = |eta: &[f64]| -> Vec<f64> {
+        (0..w)
+            .map(|i| (0..r).map(|j| b[(i, j)] * eta[j]).sum())
+            .collect()
+    };
+    let energy = |eta: &[f64]| -> f64 {
+        let mut e = 0.0;
+        for i in 0..r {
+            let ki: f64 = (0..r).map(|j| rm.k[(i, j)] * eta[j]).sum();
+            e += eta[i] * (0.5 * ki - f[i]);
+        }
+        e + 0.5 * k_n * gaps_of(eta).iter().map(|g| g.min(0.0).powi(2)).sum::<f64>()
+    };
+    let max_steps = 20 * opts.max_iterations.max(1);
+    let mut eta = vec![0.0; r];
+    let mut active_counts = Vec::new();
+    for it in 1..=max_steps {
+        let active: Vec<bool> = gaps_of(&eta).iter().map(|&g| g < 0.0).collect();
+        active_counts.push(active.iter().filter(|&&a| a).count());
+        let mut h = rm.k.to_owned();
+        for i in (0..w).filter(|&i| active[i]) {
+            for c in 0..r {
+                let bc = k_n * b[(i, c)];
+                if bc != 0.0 {
+                    for rr in 0..r {
+                        h[(rr, c)] += b[(i, rr)] * bc;
+                    }
+                }
+            }
+        }
+        let llt = h.llt(Side::Lower).map_err(|e| {
+            Error::LinearAlgebra(format!(
+                "damped reduced contact, step {it}: K̃ + K_c is not positive definite: {e:?}"
+            ))
+        })?;
+        let rhs = Mat::from_fn(r, 1, |i, _| f[i]);
+        let x = faer::linalg::solvers::Solve::solve(&llt, &rhs);
+        let full: Vec<f64> = (0..r).map(|i| x[(i, 0)]).collect();
+        if full.iter().any(|v| !v.is_finite()) {
+            return Err(Error::LinearAlgebra(format!(
+                "damped reduced contact, step {it}: solution is not finite"
+            )));
+        }
+        let gaps = gaps_of(&full);
+        let next: Vec<bool> = gaps.iter().map(|&g| g < 0.0).collect();
+        if next == active {
+            let forces: Vec<f64> = gaps
+                .iter()
+                .zip(&active)
+                .map(|(&g, &a)| if a { k_n * g } else { 0.0 })
+                .collect();
+            let master = model.master_dofs();
+            let master_displacement =
+                master.map(|dof| (0..r).map(|c| rm.phi[(dof, c)] * full[c]).sum::<f64>());
+            let state = ContactState {
+                contact_force_norm: forces.iter().map(|p| p * p).sum::<f64>().sqrt(),
+                pairs_in_contact: active.iter().filter(|&&a| a).count(),
+                gaps,
+                forces,
+                active,
+                iterations: it,
+                active_counts,
             };
-            match reduced_contact_static(model, rm, scale, &other) {
-                Ok(sol) => Ok((sol, Some(first))),
-                Err(second) => Err(Error::LinearAlgebra(format!(
-                    "reduced contact statics failed from both starting sets: {first}; then {second}"
-                ))),
+            return Ok(ReducedStatic {
+                eta: full,
+                master_displacement,
+                state,
+            });
+        }
+        // Armijo backtracking along d = full − η; ∇E·d = −dᵀ H_A d.
+        let d: Vec<f64> = full.iter().zip(&eta).map(|(a, b)| a - b).collect();
+        let mut hd = vec![0.0; r];
+        for c in 0..r {
+            for rr in 0..r {
+                hd[rr] += h[(rr, c)] * d[c];
+            }
+        }
+        let slope = -d.iter().zip(&hd).map(|(a, b)| a * b).sum::<f64>();
+        let e0 = energy(&eta);
+        let mut t = 1.0;
+        loop {
+            let trial: Vec<f64> = eta.iter().zip(&d).map(|(e, dd)| e + t * dd).collect();
+            if energy(&trial) <= e0 + 1e-4 * t * slope {
+                eta = trial;
+                break;
+            }
+            t *= 0.5;
+            if t < 1e-12 {
+                return Err(Error::LinearAlgebra(format!(
+                    "damped reduced contact, step {it}: line search failed (no decrease of the \
+                     contact energy along the Newton direction)"
+                )));
             }
         }
     }
+    Err(Error::LinearAlgebra(format!(
+        "damped reduced contact did not converge in {max_steps} steps"
+    )))
 }
 
 /// What `jointrom static --basis` reports.
@@ -184,7 +298,7 @@ pub struct BasisStatic {
     pub basis_size: usize,
     /// The reduced solution.
     pub solution: ReducedStatic,
-    /// Whether the active-set iteration had to restart from the opposite starting set (see
+    /// Whether the active-set iteration failed and the damped one solved it (see
     /// [`reduced_contact_static_restarting`]).
     pub restarted: bool,
     /// Basis build time (s).
@@ -414,10 +528,10 @@ pub struct ConvergenceSeries {
     pub pairs_in_contact: Vec<usize>,
     /// Where the series gets within 1e-2 and 1e-4.
     pub within: Vec<Within>,
-    /// g where the active-set Newton from the configured start failed (cycled) and the
-    /// restart from the opposite start (all pairs closed / open) succeeded.
+    /// g where the active-set Newton method failed (cycled) and the damped one
+    /// ([`reduced_contact_static_damped`]) solved it.
     pub restarts: Vec<Failure>,
-    /// g where both starts failed: the values are NaN (`null` in JSON) there.
+    /// g where both failed: the values are NaN (`null` in JSON) there.
     pub failures: Vec<Failure>,
     /// Time to prepare the enrichment vectors (TVD + POD, or modes) (s).
     pub prepare_s: f64,
@@ -440,6 +554,51 @@ pub struct EnergyCurve {
     pub tvd_nonzero: usize,
     /// Kept POD modes (eigenvalues above the zero threshold).
     pub pod_modes: usize,
+}
+
+/// The reduced solution on `[Φ_S Φ_V | all nonzero TVD]` (no POD): the limit the POD series
+/// of this TVD variant can reach, up to the POD's zero-eigenvalue cut (`λ ≤ 1e-12 λ_max`) and
+/// the basis drop tolerance.
+#[derive(Clone, Debug, Serialize)]
+pub struct SpanReference {
+    /// TVD variant (`tvd`: k_n only; `tvd-kt`: k_n and k_t).
+    pub name: String,
+    /// Columns kept by the M-orthonormalization.
+    pub basis_size: usize,
+    /// Columns dropped as dependent.
+    pub dropped: usize,
+    /// `‖f_c‖` (N); NaN if the solve failed.
+    pub contact_force_norm: f64,
+    /// Relative error of `‖f_c‖`.
+    pub relative_error: f64,
+    /// Time (s).
+    pub solve_s: f64,
+}
+
+/// See [`SpanReference`].
+fn span_reference(
+    model: &Model,
+    full: &ContactState,
+    cb: MatRef<'_, f64>,
+    tvd: MatRef<'_, f64>,
+    opts: &StudyOptions,
+    name: &str,
+) -> Result<SpanReference, Error> {
+    let t0 = Instant::now();
+    let (phi, dropped) = final_basis(&[cb, tvd], &model.mass, opts.drop_tol)?;
+    let basis_size = phi.ncols();
+    let rm = ReducedModel::new(model, phi)?;
+    let norm = reduced_contact_static_restarting(model, &rm, opts.scale, &opts.contact)
+        .map(|(s, _)| s.state.contact_force_norm)
+        .unwrap_or(f64::NAN);
+    Ok(SpanReference {
+        name: name.into(),
+        basis_size,
+        dropped,
+        contact_force_norm: norm,
+        relative_error: (norm - full.contact_force_norm).abs() / full.contact_force_norm,
+        solve_s: t0.elapsed().as_secs_f64(),
+    })
 }
 
 /// The whole study of one case.
@@ -465,6 +624,8 @@ pub struct Study {
     pub series: Vec<ConvergenceSeries>,
     /// POD energy curves.
     pub energy: Vec<EnergyCurve>,
+    /// The limit of each TVD variant without POD truncation: `[Φ_S Φ_V | all TVD]`.
+    pub tvd_spans: Vec<SpanReference>,
     /// Craig–Bampton time (s).
     pub craig_bampton_s: f64,
     /// Whole study time (s), charts excluded.
@@ -542,6 +703,7 @@ pub fn run_study(model: &Model, opts: &StudyOptions) -> Result<Study, Error> {
     let mut energy = Vec::new();
     // TVD variants: each distinct TvdOptions computed once.
     let mut tvd_cache: Vec<(TvdOptions, crate::reduction::Tvd, f64)> = Vec::new();
+    let mut spans = Vec::new();
     for v in tvd_variants() {
         let t0 = Instant::now();
         let idx = match tvd_cache.iter().position(|(o, _, _)| *o == v.tvd) {
@@ -553,6 +715,16 @@ pub fn run_study(model: &Model, opts: &StudyOptions) -> Result<Study, Error> {
             }
         };
         let (_, tvd, tvd_s) = &tvd_cache[idx];
+        if v.weighted && !spans.iter().any(|x: &SpanReference| x.name == v.name) {
+            spans.push(span_reference(
+                model,
+                &full.state,
+                cb.as_ref(),
+                tvd.vectors.as_ref(),
+                opts,
+                v.name,
+            )?);
+        }
         let weight = v.weighted.then_some(&model.stiffness);
         let p = pod(tvd.vectors.as_ref(), weight)?;
         let prepare_s = tvd_s + t0.elapsed().as_secs_f64();
@@ -603,6 +775,7 @@ pub fn run_study(model: &Model, opts: &StudyOptions) -> Result<Study, Error> {
         full: full_ref,
         series,
         energy,
+        tvd_spans: spans,
         craig_bampton_s,
         total_s: t_all.elapsed().as_secs_f64(),
     })
@@ -740,9 +913,18 @@ pub fn write_charts(
         ));
     }
     for tol in WITHIN_TOLS {
+        err.references
+            .push(Reference::new(format!("{tol:.0e}"), tol));
+    }
+    for (k, t) in study.tvd_spans.iter().enumerate() {
         err.references.push(Reference {
-            label: format!("{tol:.0e}"),
-            value: tol,
+            label: format!("all {} TVD, no POD ({} columns)", t.name, t.basis_size),
+            value: t.relative_error.max(ERROR_FLOOR),
+            color: Some(if k == 0 {
+                [31, 119, 180]
+            } else {
+                [44, 160, 44]
+            }),
         });
     }
     files.extend(err.write(&dir.join("fc_error"))?);
@@ -761,10 +943,10 @@ pub fn write_charts(
                 .collect(),
         ));
     }
-    norm.references.push(Reference {
-        label: format!("full FE, {:.6} N", study.full.contact_force_norm),
-        value: study.full.contact_force_norm,
-    });
+    norm.references.push(Reference::new(
+        format!("full FE, {:.6} N", study.full.contact_force_norm),
+        study.full.contact_force_norm,
+    ));
     files.extend(norm.write(&dir.join("fc_norm"))?);
 
     let mut w = LineChart::new(
@@ -782,10 +964,10 @@ pub fn write_charts(
         ));
     }
     w.legend = LegendPosition::LowerRight;
-    w.references.push(Reference {
-        label: format!("threshold {}", study.threshold),
-        value: study.threshold,
-    });
+    w.references.push(Reference::new(
+        format!("threshold {}", study.threshold),
+        study.threshold,
+    ));
     files.extend(w.write(&dir.join("w"))?);
     Ok(files)
 }

@@ -127,14 +127,16 @@ fn static_basis_json_contract() {
         "--basis",
         "modes",
         "--g",
-        "5",
+        "3",
         "--scale",
         "-1",
         "--json",
     ]);
     assert_eq!(m["basis"], "modes");
-    assert_eq!(m["g"], 5);
-    assert_eq!(m["basis_size"], 21);
+    assert_eq!(m["g"], 3);
+    assert_eq!(m["basis_size"], 19);
+    // Measured: the active-set method cycles here; the damped one solves it.
+    assert_eq!(m["restarted"], true);
     let lf = floats(&full["load"]);
     let lm = floats(&m["load"]);
     assert!(lf.iter().zip(&lm).all(|(a, b)| *b == -*a));
