@@ -38,6 +38,18 @@ pub enum Error {
         flag: String,
         time: f64,
     },
+    /// A problem callback failed during a time integration: it returned an error, panicked, or
+    /// produced a NaN/Inf that persisted through the integrator's retries. `callback` names it
+    /// (`rhs`, `roots`, `newton_setup`, `newton_solve`), `message` is its last message (the
+    /// panic text for a panic), `time` the time it was evaluated at (s), and `flag` what the
+    /// integrator reported (e.g. `CVode returned CV_REPTD_RHSFUNC_ERR at t = 0.01 s`).
+    #[error("ODE callback `{callback}` failed at t = {time} s: {message} ({flag})")]
+    Callback {
+        callback: &'static str,
+        message: String,
+        time: f64,
+        flag: String,
+    },
 }
 
 fn time_suffix(time: f64) -> String {

@@ -16,6 +16,13 @@
 //! `sundials-sys` saw SUNDIALS 6 and `build.rs` saw the very same version (`HEADER_VERSION`);
 //! [`Context::new`] checks the library loaded at run time as well ([`version`]).
 //!
+//! # The integrator
+//! [`Cvode`] drives any [`crate::ode::OdeProblem`] with CVODE (BDF/Adams; functional
+//! iteration, Newton with a dense difference-quotient solver, or Newton with the problem's own
+//! solver through a custom iterative `SUNLinearSolver`); see [`cvode`] for the method, and the
+//! private `callbacks` (trampolines: panics, NaN/Inf) and `problem_ls` (the custom solver and
+//! why it is declared iterative) modules for the FFI contracts.
+//!
 //! # Ownership and errors
 //! Each SUNDIALS object is owned by one Rust value that frees it in `Drop`; objects keep a
 //! handle to their [`Context`], which is freed last. Every C return code is checked, and a
@@ -23,14 +30,19 @@
 //! where one exists, e.g. from [`cvode_flag_name`]) and the integration time in s — NaN for
 //! calls outside time integration. No C failure panics.
 
+mod callbacks;
 mod context;
+pub mod cvode;
 mod ffi;
+mod owners;
+mod problem_ls;
 mod vector;
 
 use std::ffi::{c_char, CStr};
 use std::fmt::Display;
 
 pub use context::Context;
+pub use cvode::Cvode;
 pub use vector::SerialVector;
 
 use crate::Error;
