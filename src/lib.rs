@@ -28,6 +28,7 @@
 
 pub mod assembly;
 pub mod case;
+pub mod chart;
 pub mod contact;
 pub mod element;
 pub mod error;
@@ -39,6 +40,7 @@ pub mod modes;
 pub mod ode;
 pub mod reduction;
 pub mod statics;
+pub mod study;
 #[allow(unsafe_code)]
 pub mod sundials;
 pub mod system;

@@ -7,7 +7,8 @@ use std::time::Instant;
 use clap::{Parser, Subcommand, ValueEnum};
 use serde_json::{json, Value};
 
-use jointrom::{contact, Error, Interface, Model};
+use jointrom::reduction::{BasisKind, BasisOptions};
+use jointrom::{contact, study, Error, Interface, Model};
 
 #[derive(Parser)]
 #[command(
@@ -63,7 +64,62 @@ enum Command {
         /// Factor on the case's load (e.g. -1 reverses it).
         #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
         scale: f64,
+        /// Solve the reduced model on this basis instead of the full FE model: tvd, tvd-plain,
+        /// modes, ... (see `jointrom::study::BASIS_KINDS`).
+        #[arg(long)]
+        basis: Option<String>,
+        /// Enrichment vectors of the basis (joint modes; extra modes for `modes`); default: the
+        /// smallest g with w(g) >= 0.999. Larger than available is an error.
+        #[arg(long)]
+        g: Option<usize>,
+        /// Fixed-interface modes ν of the basis.
+        #[arg(long, default_value_t = 10)]
+        nu: usize,
         /// One JSON document on stdout.
+        #[arg(long)]
+        json: bool,
+    },
+    /// The TVD basis (Algorithm 2): POD energy ratios w(g), chosen g, sizes, build time.
+    Basis {
+        /// Case file path or built-in name.
+        case: String,
+        /// tvd (K-weighted POD) or tvd-plain (plain POD).
+        #[arg(long, default_value = "tvd")]
+        kind: String,
+        /// Number of joint modes; default: the smallest g with w(g) >= --threshold.
+        #[arg(long)]
+        g: Option<usize>,
+        /// Energy threshold for choosing g (eq. 26).
+        #[arg(long, default_value_t = jointrom::reduction::DEFAULT_THRESHOLD)]
+        threshold: f64,
+        /// Fixed-interface modes ν.
+        #[arg(long, default_value_t = 10)]
+        nu: usize,
+        /// One JSON document on stdout.
+        #[arg(long)]
+        json: bool,
+    },
+    /// Static convergence study: ‖f_c‖ of each reduced basis against the number of added
+    /// vectors g, w(g); writes OUT/CASE/study.json and SVG/PNG charts.
+    Study {
+        /// Case file path or built-in name.
+        case: String,
+        /// Output folder.
+        #[arg(long, default_value = "out")]
+        out: PathBuf,
+        /// Largest number of added vectors g.
+        #[arg(long, default_value_t = 60)]
+        max_g: usize,
+        /// Fixed-interface modes ν.
+        #[arg(long, default_value_t = 10)]
+        nu: usize,
+        /// Factor on the case's load.
+        #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
+        scale: f64,
+        /// Skip the charts (JSON only).
+        #[arg(long)]
+        no_charts: bool,
+        /// Print study.json on stdout too.
         #[arg(long)]
         json: bool,
     },
@@ -202,12 +258,28 @@ fn run(command: Command) -> Result<(), Error> {
             case,
             linear,
             scale,
+            basis,
+            g,
+            nu,
             json,
         } => {
             if !scale.is_finite() {
                 return Err(Error::Invalid(format!(
                     "--scale must be finite, got {scale}"
                 )));
+            }
+            if basis.is_none() && g.is_some() {
+                return Err(Error::Invalid("--g needs --basis".into()));
+            }
+            if let Some(name) = basis {
+                if linear {
+                    return Err(Error::Invalid(
+                        "--linear and --basis do not combine: --basis solves the reduced contact statics".into(),
+                    ));
+                }
+                let kind = study::parse_basis(&name)?;
+                let model = Model::from_case_name(&case)?;
+                return reduced_static(&model, kind, g, nu, scale, json);
             }
             let model = Model::from_case_name(&case)?;
             let v = if linear {
@@ -240,6 +312,101 @@ fn run(command: Command) -> Result<(), Error> {
                         model.mesh.pairs.len()
                     );
                 }
+            }
+        }
+        Command::Basis {
+            case,
+            kind,
+            g,
+            threshold,
+            nu,
+            json,
+        } => {
+            let kind = study::parse_basis(&kind)
+                .map_err(|_| Error::Invalid(format!("--kind {kind:?}: valid: tvd, tvd-plain")))?;
+            let model = Model::from_case_name(&case)?;
+            let opts = BasisOptions {
+                nu,
+                g,
+                threshold,
+                ..BasisOptions::default()
+            };
+            let b = study::basis_summary(&model, kind, &opts)?;
+            if json {
+                print_json(&serde_json::to_value(&b).expect("JSON values serialise"));
+            } else {
+                println!(
+                    "{} — {} basis, ν = {}: {} TVD ({} nonzero), g = {} (w = {:.6}, plain w = {:.6}; threshold {}), \
+                     basis {} columns ({} dropped), built in {:.1} ms",
+                    b.case,
+                    b.kind,
+                    b.nu,
+                    b.tvd_count,
+                    b.tvd_nonzero,
+                    b.g_chosen,
+                    b.w.get(b.g_chosen.wrapping_sub(1)).copied().unwrap_or(0.0),
+                    b.w_plain.get(b.g_chosen.wrapping_sub(1)).copied().unwrap_or(0.0),
+                    b.threshold,
+                    b.basis_size,
+                    b.dropped,
+                    b.build_s * 1e3
+                );
+                println!("    g   w(g) K-weighted   w(g) plain");
+                for i in 0..b.w.len().min(60) {
+                    println!("  {:>3}   {:.8}        {:.8}", i + 1, b.w[i], b.w_plain[i]);
+                }
+            }
+        }
+        Command::Study {
+            case,
+            out,
+            max_g,
+            nu,
+            scale,
+            no_charts,
+            json,
+        } => {
+            let model = Model::from_case_name(&case)?;
+            let opts = study::StudyOptions {
+                nu,
+                max_g,
+                scale,
+                ..study::StudyOptions::default()
+            };
+            let s = study::run_study(&model, &opts)?;
+            let dir = out.join(&model.case.name);
+            std::fs::create_dir_all(&dir).map_err(|e| Error::Io {
+                file: dir.clone(),
+                source: e,
+            })?;
+            let t0 = Instant::now();
+            let charts = if no_charts {
+                Vec::new()
+            } else {
+                study::write_charts(&s, &dir)?
+            };
+            let charts_s = t0.elapsed().as_secs_f64();
+            let mut doc = serde_json::to_value(&s).expect("JSON values serialise");
+            doc["command_line"] = json!(std::env::args().collect::<Vec<_>>());
+            doc["charts"] = json!(charts
+                .iter()
+                .filter_map(|p| p.file_name().map(|f| f.to_string_lossy().into_owned()))
+                .collect::<Vec<_>>());
+            doc["charts_s"] = json!(charts_s);
+            let file = dir.join("study.json");
+            std::fs::write(
+                &file,
+                serde_json::to_string_pretty(&doc).expect("JSON values serialise"),
+            )
+            .map_err(|e| Error::Io {
+                file: file.clone(),
+                source: e,
+            })?;
+            if json {
+                print_json(&doc);
+            } else {
+                print_study(&s);
+                println!("charts {:.2} s; written to {}", charts_s, dir.display());
             }
         }
         Command::Run { case, out, json } => {
@@ -304,4 +471,113 @@ fn run(command: Command) -> Result<(), Error> {
         }
     }
     Ok(())
+}
+
+fn reduced_static(
+    model: &Model,
+    kind: BasisKind,
+    g: Option<usize>,
+    nu: usize,
+    scale: f64,
+    json: bool,
+) -> Result<(), Error> {
+    let load = study::scaled_load(model, scale)?;
+    let opts = BasisOptions {
+        nu,
+        g,
+        ..BasisOptions::default()
+    };
+    let r = study::basis_static(model, kind, &opts, scale)?;
+    let st = &r.solution.state;
+    let v = json!({
+        "case": model.case.name,
+        "linear": false,
+        "load": load,
+        "master_displacement": r.solution.master_displacement,
+        "contact_force_norm": st.contact_force_norm,
+        "pairs_in_contact": st.pairs_in_contact,
+        "iterations": st.iterations,
+        "basis": r.basis,
+        "g": r.g,
+        "basis_size": r.basis_size,
+        "restarted": r.restarted,
+        "build_s": r.build_s,
+        "solve_s": r.solve_s,
+    });
+    if json {
+        print_json(&v);
+    } else {
+        println!(
+            "{} — reduced static with contact (frictionless), basis {} (g = {}, {} columns), load × {scale}:",
+            model.case.name, r.basis, r.g, r.basis_size
+        );
+        for (k, name) in ["ux", "uy", "uz", "rx", "ry", "rz"].iter().enumerate() {
+            let unit = if k < 3 { "mm" } else { "rad" };
+            println!(
+                "  {name} = {:>14.6e} {unit}",
+                r.solution.master_displacement[k]
+            );
+        }
+        println!(
+            "  ‖f_c‖ = {:.6} N, {} of {} pairs in contact; basis {:.1} ms, solve {:.1} ms",
+            st.contact_force_norm,
+            st.pairs_in_contact,
+            model.mesh.pairs.len(),
+            r.build_s * 1e3,
+            r.solve_s * 1e3
+        );
+    }
+    Ok(())
+}
+
+fn print_study(s: &study::Study) {
+    println!(
+        "{} — static convergence study: {} DOF, {} pairs, ν = {}, g = 0..={}, load × {}",
+        s.case, s.dofs, s.pairs, s.nu, s.max_g, s.scale
+    );
+    println!(
+        "full FE: ‖f_c‖ = {:.9} N, {} pairs in contact ({:.1} ms)",
+        s.full.contact_force_norm,
+        s.full.pairs_in_contact,
+        s.full.solve_s * 1e3
+    );
+    let show = |o: Option<usize>| o.map_or("—".to_string(), |g| g.to_string());
+    println!(
+        "  {:<10} {:>5} {:>13} {:>13} {:>13} {:>13} {:>9} {:>9}",
+        "basis", "avail", "err(g=0)", "err(g=max)", "1e-2 first/stays", "", "prep s", "sweep s"
+    );
+    for x in &s.series {
+        let last = x.relative_error.last().copied().unwrap_or(f64::NAN);
+        let w2 = &x.within[0];
+        let w4 = &x.within[1];
+        println!(
+            "  {:<10} {:>5} {:>13.3e} {:>13.3e}   1e-2: {:>3}/{:<3}  1e-4: {:>3}/{:<3} {:>9.3} {:>9.3}",
+            x.name,
+            x.available,
+            x.relative_error[0],
+            last,
+            show(w2.first),
+            show(w2.stays),
+            show(w4.first),
+            show(w4.stays),
+            x.prepare_s,
+            x.sweep_s
+        );
+    }
+    for e in &s.energy {
+        println!(
+            "  w(g) {:<10}: g(w >= {}) = {}, {} nonzero TVD, {} POD modes",
+            e.name, s.threshold, e.g_threshold, e.tvd_nonzero, e.pod_modes
+        );
+    }
+    for t in &s.tvd_spans {
+        println!(
+            "  all {} TVD without POD: {} columns ({} dropped), error {:.3e} ({:.2} s)",
+            t.name, t.basis_size, t.dropped, t.relative_error, t.solve_s
+        );
+    }
+    println!(
+        "study {:.2} s (Craig–Bampton {:.3} s)",
+        s.total_s, s.craig_bampton_s
+    );
 }

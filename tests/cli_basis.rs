@@ -1,0 +1,214 @@
+//! CLI contract of `jointrom basis`, `jointrom static --basis` and `jointrom study`: JSON fields,
+//! values checked against the library, errors naming the flag.
+
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+use serde_json::Value;
+
+fn jointrom(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_jointrom"))
+        .args(args)
+        .output()
+        .expect("run jointrom")
+}
+
+fn json_of(args: &[&str]) -> Value {
+    let out = jointrom(args);
+    assert!(
+        out.status.success(),
+        "jointrom {args:?} failed: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).expect("stdout is one JSON document")
+}
+
+fn stderr_of_failure(args: &[&str]) -> String {
+    let out = jointrom(args);
+    assert!(!out.status.success(), "jointrom {args:?} should fail");
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
+fn floats(v: &Value) -> Vec<f64> {
+    v.as_array()
+        .expect("array")
+        .iter()
+        .map(|x| x.as_f64().expect("number"))
+        .collect()
+}
+
+#[test]
+fn basis_json_contract() {
+    let v = json_of(&["basis", "friction_bar", "--json"]);
+    assert_eq!(v["tvd_count"], 512);
+    let nonzero = v["tvd_nonzero"].as_u64().unwrap() as usize;
+    assert!(nonzero > 0 && nonzero <= 512);
+    let threshold = v["threshold"].as_f64().unwrap();
+    assert_eq!(threshold, 0.999);
+    for key in ["w", "w_plain"] {
+        let w = floats(&v[key]);
+        assert_eq!(w.len(), nonzero, "{key}");
+        assert!(w.windows(2).all(|p| p[1] >= p[0]), "{key} decreasing");
+        assert_eq!(*w.last().unwrap(), 1.0, "{key}");
+        assert!(w[0] > 0.0);
+    }
+    // g chosen a priori: the smallest g with w(g) ≥ threshold (K-weighted for --kind tvd).
+    let w = floats(&v["w"]);
+    let g = v["g_chosen"].as_u64().unwrap() as usize;
+    assert!(
+        w[g - 1] >= threshold && (g == 1 || w[g - 2] < threshold),
+        "g = {g}"
+    );
+    let dropped = v["dropped"].as_u64().unwrap() as usize;
+    assert_eq!(v["basis_size"].as_u64().unwrap() as usize, 16 + g - dropped);
+    assert!(v["build_s"].as_f64().unwrap() > 0.0);
+
+    // --kind tvd-plain chooses g from the plain POD; --g overrides.
+    let p = json_of(&["basis", "friction_bar", "--kind", "tvd-plain", "--json"]);
+    let wp = floats(&p["w_plain"]);
+    let gp = p["g_chosen"].as_u64().unwrap() as usize;
+    assert!(wp[gp - 1] >= threshold && (gp == 1 || wp[gp - 2] < threshold));
+    assert_eq!(
+        floats(&p["w"]),
+        w,
+        "the K-weighted curve does not depend on --kind"
+    );
+    let q = json_of(&["basis", "friction_bar", "--g", "5", "--nu", "4", "--json"]);
+    assert_eq!(q["g_chosen"], 5);
+    assert_eq!(q["tvd_count"], 2 * 10 * 10);
+}
+
+#[test]
+fn basis_errors_name_the_flag() {
+    let e = stderr_of_failure(&["basis", "friction_bar", "--kind", "modes"]);
+    assert!(e.contains("--kind"), "{e}");
+    let e = stderr_of_failure(&["basis", "friction_bar", "--threshold", "1.5"]);
+    assert!(e.contains("--threshold"), "{e}");
+    let e = stderr_of_failure(&["basis", "friction_bar", "--g", "400"]);
+    assert!(e.contains("--g 400"), "{e}");
+}
+
+#[test]
+fn static_basis_json_contract() {
+    let full = json_of(&["static", "friction_bar", "--json"]);
+    let red = json_of(&[
+        "static",
+        "friction_bar",
+        "--basis",
+        "tvd",
+        "--g",
+        "20",
+        "--json",
+    ]);
+    // Same fields as the full solution, plus basis, g, basis_size.
+    for key in full.as_object().unwrap().keys() {
+        assert!(red.get(key).is_some(), "missing {key}");
+    }
+    assert_eq!(red["basis"], "tvd");
+    assert_eq!(red["g"], 20);
+    assert_eq!(red["linear"], false);
+    assert_eq!(red["load"], full["load"]);
+    let r = red["basis_size"].as_u64().unwrap();
+    assert!((17..=36).contains(&r), "basis_size {r}");
+    assert_eq!(floats(&red["master_displacement"]).len(), 6);
+    let fr = red["contact_force_norm"].as_f64().unwrap();
+    let ff = full["contact_force_norm"].as_f64().unwrap();
+    // Measured: 0.74 relative at g = 20 (study: the TVD series is not monotone).
+    assert!(
+        fr > 0.0 && (fr - ff).abs() < 2.0 * ff,
+        "reduced {fr}, full {ff}"
+    );
+    assert!(red["pairs_in_contact"].as_u64().unwrap() > 0);
+
+    // modes: g extra modes; --scale reverses the load.
+    let m = json_of(&[
+        "static",
+        "friction_bar",
+        "--basis",
+        "modes",
+        "--g",
+        "3",
+        "--scale",
+        "-1",
+        "--json",
+    ]);
+    assert_eq!(m["basis"], "modes");
+    assert_eq!(m["g"], 3);
+    assert_eq!(m["basis_size"], 19);
+    // Measured: the active-set method cycles here; the damped one solves it.
+    assert_eq!(m["restarted"], true);
+    let lf = floats(&full["load"]);
+    let lm = floats(&m["load"]);
+    assert!(lf.iter().zip(&lm).all(|(a, b)| *b == -*a));
+}
+
+#[test]
+fn static_basis_errors_name_the_flag() {
+    let e = stderr_of_failure(&["static", "friction_bar", "--basis", "nope"]);
+    assert!(
+        e.contains("--basis")
+            && e.contains("tvd")
+            && e.contains("tvd-plain")
+            && e.contains("modes"),
+        "{e}"
+    );
+    let e = stderr_of_failure(&["static", "friction_bar", "--basis", "tvd", "--g", "500"]);
+    assert!(e.contains("--g 500"), "{e}");
+    let e = stderr_of_failure(&["static", "friction_bar", "--g", "5"]);
+    assert!(e.contains("--g") && e.contains("--basis"), "{e}");
+    let e = stderr_of_failure(&["static", "friction_bar", "--basis", "tvd", "--linear"]);
+    assert!(e.contains("--linear"), "{e}");
+}
+
+#[test]
+fn study_writes_json_and_charts() {
+    let out = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("cli_study");
+    let _ = std::fs::remove_dir_all(&out);
+    let o = out.to_str().unwrap();
+    let v = json_of(&[
+        "study",
+        "multilayer_sheet",
+        "--out",
+        o,
+        "--max-g",
+        "4",
+        "--json",
+    ]);
+    let dir = out.join("multilayer_sheet");
+    let file: Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("study.json")).unwrap()).unwrap();
+    assert_eq!(file, v);
+    assert_eq!(v["max_g"], 4);
+    let args: Vec<&str> = v["command_line"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|a| a.as_str().unwrap())
+        .collect();
+    assert_eq!(
+        &args[1..],
+        [
+            "study",
+            "multilayer_sheet",
+            "--out",
+            o,
+            "--max-g",
+            "4",
+            "--json"
+        ]
+    );
+    let full = json_of(&["static", "multilayer_sheet", "--json"]);
+    assert_eq!(v["full"]["contact_force_norm"], full["contact_force_norm"]);
+    for s in v["series"].as_array().unwrap() {
+        assert_eq!(s["g"].as_array().unwrap().len(), 5, "{}", s["name"]);
+        assert_eq!(floats(&s["relative_error"]).len(), 5);
+    }
+    let charts = v["charts"].as_array().unwrap();
+    assert_eq!(charts.len(), 6);
+    for c in charts {
+        let len = std::fs::metadata(dir.join(c.as_str().unwrap()))
+            .unwrap()
+            .len();
+        assert!(len > 1000, "{c}: {len} bytes");
+    }
+}
