@@ -88,21 +88,48 @@ fn row_space(y: MatRef<'_, f64>) -> Result<(Mat<f64>, usize), Error> {
     let norms: Vec<f64> = (0..p)
         .map(|c| y.col(c).iter().map(|v| v * v).sum::<f64>().sqrt())
         .collect();
-    let mut ell = FIRST_SKETCH;
-    while ell < p {
-        let g = sketch(n, ell, ell as u64);
-        let z = y.transpose() * &g;
-        let q_t = z.qr().compute_thin_Q();
-        let w = y * &q_t;
-        let r = y - &w * q_t.transpose();
+    let mut q_t = Mat::<f64>::zeros(p, 0);
+    let mut w = Mat::<f64>::zeros(n, 0);
+    let mut r = y.to_owned();
+    let mut block = FIRST_SKETCH;
+    let mut seed = 0u64;
+    while q_t.ncols() + block < p {
+        // Sample what Y still has outside range(Q_T): Rᵀ G, made orthogonal to Q_T (twice).
+        let mut z = r.transpose() * &sketch(n, block, seed);
+        seed += 1;
+        for _ in 0..2 {
+            if q_t.ncols() > 0 {
+                let c = q_t.transpose() * &z;
+                z -= &q_t * &c;
+            }
+            z = z.qr().compute_thin_Q();
+        }
+        let wn = y * &z;
+        r -= &wn * z.transpose();
+        let old = q_t.ncols();
+        q_t = Mat::from_fn(p, old + block, |i, j| {
+            if j < old {
+                q_t[(i, j)]
+            } else {
+                z[(i, j - old)]
+            }
+        });
+        w = Mat::from_fn(n, old + block, |i, j| {
+            if j < old {
+                w[(i, j)]
+            } else {
+                wn[(i, j - old)]
+            }
+        });
         let ok = (0..p).all(|c| {
             let rn = r.col(c).iter().map(|v| v * v).sum::<f64>().sqrt();
             rn <= RANGE_TOL * norms[c]
         });
         if ok {
+            let ell = w.ncols();
             return Ok((w, ell));
         }
-        ell *= 2;
+        block = q_t.ncols();
     }
     Ok((y.to_owned(), p))
 }
@@ -167,8 +194,8 @@ fn pod_dense_lambda_poms(
 ///    `range Q_T ⊇ range Yᵀ` numerically: `Q_T = qr(Yᵀ G)`, G a fixed pseudo-random n × ℓ
 ///    matrix, accepted when every column satisfies `‖y_j − W Q_Tᵀ e_j‖₂ ≤ RANGE_TOL ‖y_j‖₂`
 ///    with `W = Y Q_T` (1e-10; the round-off floor on the built-in cases is ≤ 5e-12 and a
-///    missed direction leaves ≥ 1e-6); otherwise ℓ doubles from 64, up to ℓ = p where `Q_T = I` is the
-///    dense route. The check is a-posteriori, so the result does not depend on luck, only the
+///    missed direction leaves ≥ 1e-6); otherwise a new block, sampled from the residual and orthogonalized against Q_T,
+///    doubles ℓ (64, 128, …); when ℓ would reach p, `Q_T = I` (the dense route). The check is a-posteriori, so the result does not depend on luck, only the
 ///    cost does.
 /// 2. `T = Q_Tᵀ C Q_T = Wᵀ A W = X Θ Xᵀ` (ℓ × ℓ). The Ritz pairs are `λ_i = θ_i`,
 ///    `û_i = Q_T x_i`, and the POMs (eq. 23) `u_i = Y û_i / sqrt(λ_i) = W x_i / sqrt(λ_i)`, exactly
