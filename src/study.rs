@@ -700,6 +700,15 @@ fn tvd_variants() -> Vec<TvdVariant> {
             weighted: false,
         },
         TvdVariant {
+            name: "tvd-inertia",
+            label: "TVD with inertia (eq. 15), K-weighted POD",
+            tvd: TvdOptions {
+                inertia: true,
+                ..kn
+            },
+            weighted: true,
+        },
+        TvdVariant {
             name: "tvd-kt",
             label: "TVD with k_n + k_t, K-weighted POD",
             tvd: knkt,
