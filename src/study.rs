@@ -989,15 +989,25 @@ pub fn write_charts(
         err.references
             .push(Reference::new(format!("{tol:.0e}"), tol));
     }
-    for (k, t) in study.tvd_spans.iter().enumerate() {
+    for t in &study.tvd_spans {
+        // In the colour of the series it limits (alldof: the next free colour).
+        let k = study
+            .series
+            .iter()
+            .position(|s| s.name == t.name)
+            .unwrap_or(study.series.len());
+        let label = if t.name == "alldof" {
+            format!(
+                "alldof: CB + all pair constraint modes ({} columns)",
+                t.basis_size
+            )
+        } else {
+            format!("all {} TVD, no POD ({} columns)", t.name, t.basis_size)
+        };
         err.references.push(Reference {
-            label: format!("all {} TVD, no POD ({} columns)", t.name, t.basis_size),
+            label,
             value: t.relative_error.max(ERROR_FLOOR),
-            color: Some(if k == 0 {
-                [31, 119, 180]
-            } else {
-                [44, 160, 44]
-            }),
+            color: Some(crate::chart::series_color(k)),
         });
     }
     files.extend(err.write(&dir.join("fc_error"))?);
