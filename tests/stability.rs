@@ -83,3 +83,29 @@ fn tiny_sweep_reports_failures_as_cells() {
     assert!(md.contains("CV_TOO_MUCH_WORK"));
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// The whole map of the issue (minutes): `STABILITY_OUT=dir cargo test --release --test stability
+/// -- --ignored full_map` (until `jointrom stability` is wired into the CLI). Optional
+/// `STABILITY_BUDGET` (s per cell) and `STABILITY_FULL_END` (s).
+#[test]
+#[ignore]
+fn full_map() {
+    let env = |k: &str, d: f64| {
+        std::env::var(k)
+            .ok()
+            .and_then(|v| v.parse().ok())
+            .unwrap_or(d)
+    };
+    let opts = SweepOptions {
+        budget_s: env("STABILITY_BUDGET", 20.0),
+        full_end_time: env("STABILITY_FULL_END", 2e-4),
+        progress: true,
+        ..SweepOptions::default()
+    };
+    let case = Case::load("friction_bar").unwrap();
+    let sweep = run_sweep(&case, &opts).unwrap();
+    let out = std::env::var("STABILITY_OUT").unwrap_or_else(|_| "out".into());
+    let dir = std::path::Path::new(&out).join(&sweep.case);
+    write_outputs(&sweep, &dir, true).unwrap();
+    assert_eq!(sweep.cells.len(), 144);
+}
