@@ -36,30 +36,69 @@
 //! right-hand side (a wrapper problem returns a fatal callback error once the budget is spent, so
 //! CVODE stops at once; the cell is reported as `budget` with the time reached).
 //!
-//! ## Failure kinds (measured on the friction bar; see [`crate::stability`]'s table in the
-//! issue report)
+//! ## Measured (friction bar, 2 shared cores, budget 8 s per cell, ROM window 0.01 s, full 1e-3 s)
 //!
-//! - **Functional iteration** converges only while `γ‖J‖ < 1` (γ = h β₀): the step is bounded by
-//!   the stiffest retained mode — the shells' membrane modes in the full model, the closed
-//!   pairs' penalty frequency `√(k_n/m)` in a ROM, and, with friction, the slip relaxation
-//!   `1/τ` (τ = 1e-6 s) of every sliding pair — so at k_n = 1e6 or with friction it needs
-//!   ~1e-7 s steps, runs into `CV_TOO_MUCH_WORK` or the budget, or loses convergence
-//!   (`CV_CONV_FAILURE`) when CVODE tries to grow the step.
-//! - **BDF orders 3–5** are not A-stable: on an undamped structure (eigenvalues ±iω on the
-//!   imaginary axis) a high-order step large enough for the slow response amplifies the fast
-//!   modes, which the error test then rejects again and again; it shows as more error-test
-//!   failures and steps at max order 5 than at 2, not (in these windows) as a hard failure.
-//! - **Events**: the gaps of nearly closed pairs cross zero thousands of times per millisecond
-//!   (penalty oscillation) and every root restarts CVODE at order 1 with a tiny step: the cell
-//!   is many times slower and may exhaust the budget; a switch that keeps firing at the same
-//!   time ends the cell as `chatter`.
+//! Run with `STABILITY_OUT=DIR STABILITY_BUDGET=8 STABILITY_FULL_END=1e-3 cargo test --release
+//! --test stability -- --ignored full_map --nocapture` (≈ 17 min for the 144 cells and 18
+//! references). The ROMs: g = 0 → r = 16, w(g)-chosen g = 12 → r = 28.
 //!
+//! - **ROMs, k_n ≤ 1e4**: every cell ok, functional and Newton alike (0.03–5.6 s); the
+//!   steps are bounded by accuracy, not stability, so functional iteration needs about as many
+//!   steps as Newton (friction on: ~2× more, the slip relaxation 1/τ enters ‖J‖ for sliding
+//!   pairs). Errors against the 100× tighter reference: g = 0 1e-5…8e-5; the w(g) ROM 1e-4…4e-4
+//!   at k_n = 1e2 but **~2 % at k_n = 1e4** in every cell, i.e. the paper's tolerances do not
+//!   resolve ‖f_c‖(t) of the richer basis over the first 0.01 s (the reference needs 2.5× the
+//!   steps).
+//! - **ROMs, k_n = 1e6**: g = 0 still ok (65 000–130 000 steps, errors 1–5 %); the w(g) ROM
+//!   exhausts the budget with Newton and with events (steps ≈ 4e-8 s): the penalty frequency
+//!   `√(k_n/m)` of the lightly loaded pairs sets an *accuracy* limit that Newton cannot lift;
+//!   functional cells that finish are 14–22 % off.
+//! - **Full model, functional iteration**: every cell `budget` (steps ≈ 2e-8 s, 0.1–0.6 ms
+//!   reached): `γ‖J‖ < 1` with the shells' membrane/drilling modes and the weld beams far above
+//!   the contact frequencies.
+//! - **Full model, Newton, events off**: k_n = 1e2 ok in 187 steps (error 1.5e-3 against the
+//!   tight reference); k_n = 1e4 ok at max order 2 (~2 000 steps, 1–2 s) but `budget` at max
+//!   order 5 (10 000 steps for 0.7–0.8 ms): BDF orders 3–5 are not A-stable on the undamped
+//!   high-frequency modes, so the controller keeps rejecting and shrinking high-order steps;
+//!   k_n = 1e6 `budget` except max order 2 with friction (9 052 steps, 5.4 s).
+//! - **Events on, full model**: every cell `budget` before 1e-5 s: from rest, gaps and
+//!   stick/slip switches of many pairs sit at zero and cross it at every step, and each root
+//!   restarts CVODE at order 1 with a tiny step.
+//! - No cell failed with a CVODE flag with `max_steps` = 20 000 per 1e-4 s output interval:
+//!   the wall budget binds first. With a small cap (tests/stability.rs: 100) functional
+//!   iteration at k_n = 1e6 fails with `CV_TOO_MUCH_WORK`.
+//! - The full-model references (rtol 1e-10, atol 1e-8) finished only for k_n = 1e2, friction
+//!   off (57 000 steps, 36 s); elsewhere they hit their 60 s budget, so full-model cells have
+//!   no error and ROM cells no `error_vs_full` except there: over that first millisecond
+//!   (‖f_c‖ still small) the ROM with g = 0 is off by a factor ~5 (4.77), the w(g) ROM by 24 %,
+//!   whatever the iteration, order or events.
+//!
+//! ## Failure kinds
+//!
+//! - `budget` with **functional iteration** (full model): the fixed point converges only while
+//!   `γ‖J‖ < 1` (γ = h β₀), so the step is bounded by the stiffest retained mode — the shells'
+//!   in-plane and drilling modes in the full model, the closed pairs' penalty frequency
+//!   `√(k_n/m)` in a ROM, and with friction the slip relaxation `1/τ` (τ = 1e-6 s) of sliding
+//!   pairs — whatever the accuracy needs.
+//! - `budget` with **BDF max order 5** where order 2 finishes (full model, k_n = 1e4): orders
+//!   3–5 are not A-stable near the imaginary axis, where an undamped structure's eigenvalues
+//!   ±iω lie; high-order steps over the fast modes fail the error test and the step shrinks.
+//! - `budget` with **events**: gaps of nearly closed pairs and stick/slip switches change sign
+//!   at nearly every step (penalty oscillation), each root restarts the integrator at order 1;
+//!   a switch that fires repeatedly at the same time would end the cell as `chatter`.
+//! - `budget` with **Newton at k_n = 1e6** (w(g) ROM, full model): the contact oscillation at
+//!   `√(k_n/m)` must be resolved to the tolerance, an accuracy limit that a stable implicit
+//!   method does not remove.
+//! - `CV_TOO_MUCH_WORK`: more than `max_steps` steps within one output interval, the same step
+//!   bounds as above met with a small cap.
+
 //! ## Outputs
 //!
 //! [`write_outputs`]: `stability.json` (every cell, the options and the references),
 //! `stability.md` (a markdown table) and three heat maps (SVG + PNG) — rows model × iteration ×
 //! max order, columns k_n × friction × events — coloured by status, by log10 of the wall time and
-//! by log10 of the error, the failure flag written in failed cells.
+//! by log10 of the error, the failure flag (and, on the status map, the time reached, s)
+//! written in failed cells.
 
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -986,7 +1025,7 @@ pub fn heat_map(sweep: &Sweep, kind: MapKind) -> HeatMap {
                                 text: if x.outcome.ok() {
                                     "ok".into()
                                 } else {
-                                    failed_text
+                                    format!("{failed_text} {:.1e}", x.outcome.t_reached)
                                 },
                             },
                             MapKind::Wall => {
