@@ -420,6 +420,12 @@ fn tick(v: f64, log: bool) -> String {
     }
 }
 
+/// The colour of the `k`-th series of a chart (RGB), for references drawn in a series' colour.
+pub fn series_color(k: usize) -> [u8; 3] {
+    let RGBColor(r, g, b) = palette(k);
+    [r, g, b]
+}
+
 /// Distinct line colours (Tableau 10), cycling.
 fn palette(k: usize) -> RGBColor {
     const C: [(u8, u8, u8); 10] = [

@@ -571,9 +571,14 @@ fn print_study(s: &study::Study) {
         );
     }
     for t in &s.tvd_spans {
+        let what = if t.name == "alldof" {
+            "alldof: CB + every pair's normal constraint mode".to_string()
+        } else {
+            format!("all {} TVD without POD", t.name)
+        };
         println!(
-            "  all {} TVD without POD: {} columns ({} dropped), error {:.3e} ({:.2} s)",
-            t.name, t.basis_size, t.dropped, t.relative_error, t.solve_s
+            "  {what}: {} columns ({} dropped), error {:.3e} ({:.2} s)",
+            t.basis_size, t.dropped, t.relative_error, t.solve_s
         );
     }
     println!(

@@ -19,7 +19,7 @@ use faer::{Mat, Par, Side};
 
 use crate::assembly::SymCsc;
 use crate::error::Error;
-use crate::statics::SparseCholesky;
+use crate::statics::{sym_mul_vec_into, SparseCholesky};
 
 /// Eigenmodes, lowest first.
 #[derive(Clone, Debug)]
@@ -86,9 +86,25 @@ pub fn lowest_modes(k: &SymCsc, m: &SymCsc, count: usize) -> Result<Modes, Error
             "eigenproblem: K must be positive definite (is the structure supported?): {e}"
         ))
     })?;
+    lowest_modes_factored(k, m, &chol, count)
+}
+
+/// [`lowest_modes`] with the Cholesky factorization of K given (e.g. shared with the
+/// Craig–Bampton constraint modes); small problems still go to [`dense_modes`].
+pub(crate) fn lowest_modes_factored(
+    k: &SymCsc,
+    m: &SymCsc,
+    chol: &SparseCholesky,
+    count: usize,
+) -> Result<Modes, Error> {
+    let n = k.n;
+    check_count(n, count)?;
+    if n <= 64 || 3 * count > n {
+        return dense_modes(k, m, count);
+    }
     let mut steps = (2 * count + 20).max(40).min(n);
     loop {
-        match lanczos(&chol, m, count, steps)? {
+        match lanczos(chol, m, count, steps)? {
             Some(modes) => {
                 verify(k, m, &modes)?;
                 return Ok(modes);
@@ -121,7 +137,7 @@ fn lanczos(
     let mut restarts = 0u64;
     let mut j = 0;
     // Normalise the start vector in the M-norm.
-    m.mul_vec(&w, &mut mw);
+    sym_mul_vec_into(m, &w, &mut mw);
     let mut norm = dot(&w, &mw).sqrt();
     while j < steps {
         if !(norm.is_finite() && norm > 0.0) {
@@ -152,7 +168,7 @@ fn lanczos(
                 }
             }
         }
-        m.mul_vec(&w, &mut mw);
+        sym_mul_vec_into(m, &w, &mut mw);
         norm = dot(&w, &mw).sqrt();
         if j + 1 < steps {
             beta[j] = norm;
@@ -164,7 +180,7 @@ fn lanczos(
                 let fresh = start_vector(n + restarts as usize);
                 w.copy_from_slice(&fresh[restarts as usize..]);
                 for _ in 0..2 {
-                    m.mul_vec(&w, &mut mw);
+                    sym_mul_vec_into(m, &w, &mut mw);
                     for p in 0..=j {
                         let c = dot(mq.col_as_slice(p), &w);
                         let qp = q.col_as_slice(p);
@@ -173,7 +189,7 @@ fn lanczos(
                         }
                     }
                 }
-                m.mul_vec(&w, &mut mw);
+                sym_mul_vec_into(m, &w, &mut mw);
                 norm = dot(&w, &mw).sqrt();
             }
         } else {
@@ -234,8 +250,8 @@ fn verify(k: &SymCsc, m: &SymCsc, modes: &Modes) -> Result<(), Error> {
     let mut mphi = vec![0.0; n];
     for (c, &lam) in modes.eigenvalues.iter().enumerate() {
         let phi = modes.shapes.col_as_slice(c);
-        k.mul_vec(phi, &mut kphi);
-        m.mul_vec(phi, &mut mphi);
+        sym_mul_vec_into(k, phi, &mut kphi);
+        sym_mul_vec_into(m, phi, &mut mphi);
         let res = kphi
             .iter()
             .zip(&mphi)

@@ -35,7 +35,10 @@
 //! reduced contact solve remain.
 //!
 //! Two references without a g axis are recorded too: `tvd_spans`, the basis with *all* nonzero
-//! TVD of a variant and no POD (the limit of its POD series), and the full-FE value.
+//! TVD of a variant and no POD (the limit of its POD series) plus `alldof` (Craig–Bampton + the
+//! normal constraint mode of every pair, paper Section 5.1: exact by construction), and the
+//! full-FE value. `jim` (paper Section 5.3) is a series: the first g Joint Interface Modes of
+//! the normal and in-plane sets, by frequency.
 //!
 //! ## Reduced contact solves
 //!
@@ -84,8 +87,9 @@ use crate::error::Error;
 use crate::joint::NORMAL;
 use crate::model::Model;
 use crate::reduction::{
-    build_basis, craig_bampton, final_basis, pod, trial_vector_derivatives, BasisKind,
-    BasisOptions, ReducedModel, TvdOptions, DEFAULT_DROP_TOL, DEFAULT_THRESHOLD,
+    alldof_vectors, build_basis, craig_bampton, final_basis, jim_vectors, pod,
+    trial_vector_derivatives, BasisKind, BasisOptions, JimSet, ReducedModel, TvdOptions,
+    DEFAULT_DROP_TOL, DEFAULT_THRESHOLD,
 };
 
 /// The basis kinds of `jointrom static --basis`, by name (the one list; see [`parse_basis`]).
@@ -93,6 +97,8 @@ pub const BASIS_KINDS: &[(&str, BasisKind)] = &[
     ("tvd", BasisKind::Tvd),
     ("tvd-plain", BasisKind::TvdPlain),
     ("modes", BasisKind::Modes),
+    ("jim", BasisKind::Jim),
+    ("alldof", BasisKind::AllDof),
 ];
 
 /// The [`BasisKind`] called `name` (one of [`BASIS_KINDS`]); the error lists the valid names.
@@ -656,7 +662,8 @@ pub struct Study {
     pub series: Vec<ConvergenceSeries>,
     /// POD energy curves.
     pub energy: Vec<EnergyCurve>,
-    /// The limit of each TVD variant without POD truncation: `[Φ_S Φ_V | all TVD]`.
+    /// The limit of each TVD variant without POD truncation, `[Φ_S Φ_V | all TVD]`, and
+    /// `alldof`, `[Φ_S Φ_V | K⁻¹ b_nᵀ of every pair]`.
     pub tvd_spans: Vec<SpanReference>,
     /// Craig–Bampton time (s).
     pub craig_bampton_s: f64,
@@ -691,6 +698,15 @@ fn tvd_variants() -> Vec<TvdVariant> {
             label: "TVD, plain POD",
             tvd: kn,
             weighted: false,
+        },
+        TvdVariant {
+            name: "tvd-inertia",
+            label: "TVD with inertia (eq. 15), K-weighted POD",
+            tvd: TvdOptions {
+                inertia: true,
+                ..kn
+            },
+            weighted: true,
         },
         TvdVariant {
             name: "tvd-kt",
@@ -795,6 +811,31 @@ pub fn run_study(model: &Model, opts: &StudyOptions) -> Result<Study, Error> {
         )?;
         series.push(ConvergenceSeries { prepare_s, ..s });
     }
+
+    // Joint Interface Modes (paper Section 5.3): max_g of them once, g = leading columns.
+    {
+        let t0 = Instant::now();
+        let jim = jim_vectors(model, opts.max_g, JimSet::Both)?;
+        let prepare_s = t0.elapsed().as_secs_f64();
+        let s = sweep(
+            model,
+            &full.state,
+            cb.as_ref(),
+            jim.as_ref(),
+            opts,
+            ("jim", "Craig–Bampton + g Joint Interface Modes"),
+        )?;
+        series.push(ConvergenceSeries { prepare_s, ..s });
+    }
+    // All joint DOF (paper Section 5.1): the exact limit, one column per pair.
+    spans.push(span_reference(
+        model,
+        &full.state,
+        cb.as_ref(),
+        alldof_vectors(model)?.as_ref(),
+        opts,
+        "alldof",
+    )?);
 
     Ok(Study {
         case: model.case.name.clone(),
@@ -948,15 +989,25 @@ pub fn write_charts(
         err.references
             .push(Reference::new(format!("{tol:.0e}"), tol));
     }
-    for (k, t) in study.tvd_spans.iter().enumerate() {
+    for t in &study.tvd_spans {
+        // In the colour of the series it limits (alldof: the next free colour).
+        let k = study
+            .series
+            .iter()
+            .position(|s| s.name == t.name)
+            .unwrap_or(study.series.len());
+        let label = if t.name == "alldof" {
+            format!(
+                "alldof: CB + all pair constraint modes ({} columns)",
+                t.basis_size
+            )
+        } else {
+            format!("all {} TVD, no POD ({} columns)", t.name, t.basis_size)
+        };
         err.references.push(Reference {
-            label: format!("all {} TVD, no POD ({} columns)", t.name, t.basis_size),
+            label,
             value: t.relative_error.max(ERROR_FLOOR),
-            color: Some(if k == 0 {
-                [31, 119, 180]
-            } else {
-                [44, 160, 44]
-            }),
+            color: Some(crate::chart::series_color(k)),
         });
     }
     files.extend(err.write(&dir.join("fc_error"))?);

@@ -3,7 +3,8 @@
 use faer::Mat;
 
 use crate::error::Error;
-use crate::model::{Interface, Model};
+use crate::model::Model;
+use crate::modes::lowest_modes_factored;
 use crate::statics::SparseCholesky;
 
 /// The Craig–Bampton basis `[Φ_S | Φ_V]` (n × (6 + ν)) of a model whose master node's six DOF
@@ -35,7 +36,8 @@ pub fn craig_bampton(model: &Model, nu: usize) -> Result<Mat<f64>, Error> {
         }
     }
     let k = &model.stiffness;
-    let kii = SparseCholesky::new(&k.leading(m))?;
+    let k_ii = k.leading(m);
+    let kii = SparseCholesky::new(&k_ii)?;
     // Right-hand sides −K_ib e_c: column m + c of K restricted to interior rows.
     let mut rhs = Mat::<f64>::zeros(m, 6);
     for c in 0..6 {
@@ -56,7 +58,9 @@ pub fn craig_bampton(model: &Model, nu: usize) -> Result<Mat<f64>, Error> {
         phi[(m + c, c)] = 1.0;
     }
     if nu > 0 {
-        let modes = model.modes(nu, Interface::Fixed)?;
+        // The fixed-interface modes reuse the factorization of K_ii (the same eigenproblem as
+        // `model.modes(nu, Interface::Fixed)`).
+        let modes = lowest_modes_factored(&k_ii, &model.mass.leading(m), &kii, nu)?;
         for c in 0..nu {
             for r in 0..m {
                 phi[(r, 6 + c)] = modes.shapes[(r, c)];

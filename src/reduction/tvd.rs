@@ -1,11 +1,58 @@
-//! Trial vector derivatives for joint contact (Algorithm 2, lines 3–20; eqs. 16, 18, 19, 27–28).
+//! Trial vector derivatives for joint contact (Algorithm 2, lines 3–20; eqs. 12–19, 27–28).
+//!
+//! # The derivatives (paper Section 2.4–2.5)
+//! A trial vector φ_i of the base changes with the state `q` because the joint stiffness does.
+//! Its derivative with respect to the scaling `q_j` of trial vector φ_j is a new trial vector.
+//!
+//! - **Vibration mode** φ_i with `(K − Ω_i² M) φ_i = 0`. Differentiating the eigenproblem
+//!   (eq. 12, M constant) gives eq. (13),
+//!   `(K − Ω_i² M) ∂φ_i/∂q_j + (∂K/∂q_j − ∂Ω_i²/∂q_j M) φ_i = 0`, and premultiplying by φ_iᵀ
+//!   the eigenvalue sensitivity (eq. 14) `∂Ω_i²/∂q_j = φ_iᵀ (∂K/∂q_j) φ_i / φ_iᵀ M φ_i` (the
+//!   paper writes it for M-normalized modes). Substituted back, eq. (15):
+//!   `φ_{i,j} = (K − Ω_i² M)⁻¹ (∂K/∂q_j − ∂Ω_i²/∂q_j M) φ_i`
+//!   (the paper drops the overall sign of eq. 13, immaterial for a trial vector).
+//! - Neglecting inertia (eq. 16), and for **static shapes** such as the constraint modes
+//!   (eqs. 17–18, exactly): `φ_{i,j} = K⁻¹ (∂K/∂q_j) φ_i`, the static response to the
+//!   pseudoforce `f_{i,j} = (∂K/∂q_j) φ_i` (eq. 19).
+//!
+//! Contact makes `∂K/∂q` one-sided, so each φ_j is differentiated for both signs `k = ±1`
+//! (eqs. 27–28): `∂K/∂q_{k,j} = Σ_{z active under k φ_j} k_n b_{n,z}ᵀ b_{n,z}` (optionally
+//! `+ k_t (b_{t1,z}ᵀ b_{t1,z} + b_{t2,z}ᵀ b_{t2,z})`), with b the rows of the joint operator B.
+//! Hence `f_{i,k,j} = Bᵀ p_{i,k,j}`, p the `3w` pair forces `k_n (B φ_i)_r` on the active rows.
+//!
+//! # Which K, M and Ω
+//! K and M are the full model's (master node free, as for eq. 16 in Algorithm 2). A base column
+//! that is exactly zero on the six master DOF is a fixed-interface vibration mode: with
+//! [`TvdOptions::inertia`] its `Ω_i² = φ_iᵀ K φ_i / φ_iᵀ M φ_i` (Rayleigh quotient — exact for
+//! a Craig–Bampton mode, because `(K − Ω_i² M) φ_i` vanishes on the interior rows and φ_i on the
+//! master rows) and eq. (15) is used; every other column (the constraint modes Φ_S) has `Ω = 0`
+//! and eq. (16)/(18). `K − Ω_i² M` is indefinite (Ω_i² lies above the lowest free-interface
+//! eigenvalues) and nonsingular unless Ω_i² is also an eigenvalue of the free-master problem;
+//! it is factored by sparse LU with partial pivoting (faer), one factorization per mode
+//! (symbolic analysis shared), and the solve's backward error is checked (≤ 1e-10).
+//!
+//! # How (one factorization, few right-hand sides)
+//! Every pseudoforce lies in `span(B_uᵀ)`, B_u the m joint rows that receive stiffness (the w
+//! normal rows, or all 3w with `k_t`). So instead of 2(v+s)² = 512 solves, the m "joint
+//! flexibility" columns `Z = K⁻¹ B_uᵀ` are solved once (one sparse Cholesky) and each TVD is
+//! `φ_{i,k,j} = Z p_u` (a dense product, the same vector to round-off). Its strain energy is
+//! `φᵀ K φ = p_uᵀ B_u K⁻¹ B_uᵀ p_u = p_uᵀ G p_u` with the m × m joint flexibility
+//! `G = B_u Z`, so the K-normalization (Algorithm 2, line 20) needs no n-sized product. For
+//! eq. (15) the 2(v+s) right-hand sides `f − ∂Ω_i²/∂q M φ_i` of each mode are solved directly
+//! with its LU factors (combining flexibility columns of the indefinite operator would cancel
+//! catastrophically when Ω_i² lies near a free-interface eigenvalue), and `φᵀ K φ` is formed
+//! with K.
 
+use faer::linalg::solvers::Solve;
+use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
+use faer::sparse::{SparseColMat, SymbolicSparseColMat};
 use faer::{Mat, MatRef};
 
+use crate::assembly::SymCsc;
 use crate::error::Error;
-use crate::joint::{NORMAL, T1, T2};
+use crate::joint::{JointOperator, NORMAL, T1, T2};
 use crate::model::Model;
-use crate::statics::SparseCholesky;
+use crate::statics::{sym_mul_mat, sym_mul_vec_into, SparseCholesky};
 
 /// Options of [`trial_vector_derivatives`]. Defaults: `tol = 1e-6`, `zero_gap_active = true`,
 /// `tangential = false`.
@@ -22,6 +69,10 @@ pub struct TvdOptions {
     /// Add the stick stiffness `k_t` on the two tangential rows of active pairs too (Algorithm 2,
     /// line 10 adds `k_n` and `k_t`). `false`: normal stiffness `k_n` only.
     pub tangential: bool,
+    /// Include the inertia term of eq. (15) for the fixed-interface vibration modes: solve
+    /// `(K − Ω_i² M) φ_{i,k,j} = ∂K/∂q_{k,j} φ_i` with φ_i's own eigenvalue Ω_i² (rad/s)².
+    /// `false` (default): the static eq. (16) for every vector, the paper's Algorithm 2.
+    pub inertia: bool,
 }
 
 impl Default for TvdOptions {
@@ -30,6 +81,7 @@ impl Default for TvdOptions {
             tol: 1e-6,
             zero_gap_active: true,
             tangential: false,
+            inertia: false,
         }
     }
 }
@@ -65,6 +117,10 @@ pub struct Tvd {
     pub negligible_columns: usize,
     /// For each base vector j, the active pairs for `k = −1` and `k = +1`.
     pub active: Vec<[Vec<bool>; 2]>,
+    /// For each base vector i, the `Ω_i²` ((rad/s)²) of the operator `K − Ω_i² M` its
+    /// derivatives were solved with: 0 for the static eq. (16)/(18) (all vectors unless
+    /// [`TvdOptions::inertia`]; constraint modes always).
+    pub omega2: Vec<f64>,
 }
 
 impl Tvd {
@@ -108,10 +164,11 @@ pub fn active_pairs(gaps: &[f64], k: f64, opts: &TvdOptions) -> Vec<bool> {
 /// `∂K/∂q_{k,j} = Σ_active k_n b_nᵀ b_n (+ k_t (b_t1ᵀ b_t1 + b_t2ᵀ b_t2))`, and for every φ_i the
 /// pseudoforce `f_{i,k,j} = ∂K/∂q_{k,j} φ_i` (eq. 19) is formed through the joint operator,
 /// `Bᵀ (D_{k,j} B φ_i)`, never as a dense n × n matrix. One sparse Cholesky of the full `K`
-/// (master free, the paper's K) solves all kept right-hand sides: `K φ_{i,k,j} = f_{i,k,j}`
-/// (eqs. 16/18, inertia terms of eq. 15 neglected). Columns are ordered j, then k = −1, +1, then
-/// i; zero pseudoforces are dropped and counted; each kept column is normalized w.r.t. K
-/// (Algorithm 2, line 20).
+/// (master free, the paper's K) serves all kept right-hand sides: `K φ_{i,k,j} = f_{i,k,j}`
+/// (eqs. 16/18), through the joint flexibility columns `K⁻¹ B_uᵀ` (module docs). With
+/// [`TvdOptions::inertia`] the fixed-interface modes use eq. (15) instead. Columns are ordered
+/// j, then k = −1, +1, then i; zero pseudoforces are dropped and counted; each kept column is
+/// normalized w.r.t. K (Algorithm 2, line 20).
 pub fn trial_vector_derivatives(
     model: &Model,
     base: MatRef<'_, f64>,
@@ -136,28 +193,31 @@ pub fn trial_vector_derivatives(
     let kt = model.case.contact.stick_stiffness;
     let nb = base.ncols();
     let bphi = joint.reduce(base); // 3w × nb
-                                   // Joint scale of each φ_i over the rows that receive stiffness.
-    let rows_used: &[usize] = if opts.tangential {
+                                   // Joint rows that receive stiffness, B_u (m of them), and each one's stiffness.
+    let per_pair: &[usize] = if opts.tangential {
         &[NORMAL, T1, T2]
     } else {
         &[NORMAL]
     };
+    let used: Vec<usize> = (0..w)
+        .flat_map(|z| per_pair.iter().map(move |&r| 3 * z + r))
+        .collect();
+    let m = used.len();
+    let stiff = |r: usize| if r % 3 == NORMAL { kn } else { kt };
+    // Joint scale of each φ_i over the rows that receive stiffness.
     let joint_scale: Vec<f64> = (0..nb)
-        .map(|i| {
-            (0..w)
-                .flat_map(|z| rows_used.iter().map(move |&r| 3 * z + r))
-                .fold(0.0f64, |a, r| a.max(bphi[(r, i)].abs()))
-        })
+        .map(|i| used.iter().fold(0.0f64, |a, &r| a.max(bphi[(r, i)].abs())))
         .collect();
     let max_stiff = if opts.tangential { kn.max(kt) } else { kn };
 
+    // Pseudoforces p_u (m × cols, column-major) of the kept candidates.
     let total = 2 * nb * nb;
-    let mut forces: Vec<Vec<f64>> = Vec::new();
+    let mut coef: Vec<f64> = Vec::new();
     let mut index = Vec::new();
     let mut active_all = Vec::with_capacity(nb);
     let mut zero_columns = 0;
     let mut negligible_columns = 0;
-    let mut p = vec![0.0; 3 * w];
+    let mut p = vec![0.0; m];
     for j in 0..nb {
         let gaps: Vec<f64> = (0..w).map(|z| bphi[(3 * z + NORMAL, j)]).collect();
         let act = [
@@ -166,13 +226,12 @@ pub fn trial_vector_derivatives(
         ];
         for (ki, k) in [-1i8, 1].into_iter().enumerate() {
             for i in 0..nb {
-                p.iter_mut().for_each(|v| *v = 0.0);
-                for z in (0..w).filter(|&z| act[ki][z]) {
-                    p[3 * z + NORMAL] = kn * bphi[(3 * z + NORMAL, i)];
-                    if opts.tangential {
-                        p[3 * z + T1] = kt * bphi[(3 * z + T1, i)];
-                        p[3 * z + T2] = kt * bphi[(3 * z + T2, i)];
-                    }
+                for (pa, &r) in p.iter_mut().zip(&used) {
+                    *pa = if act[ki][r / 3] {
+                        stiff(r) * bphi[(r, i)]
+                    } else {
+                        0.0
+                    };
                 }
                 let pmax = p.iter().fold(0.0f64, |a, v| a.max(v.abs()));
                 if pmax == 0.0 {
@@ -183,38 +242,89 @@ pub fn trial_vector_derivatives(
                     negligible_columns += 1;
                     continue;
                 }
-                let mut f = vec![0.0; n];
-                joint.apply_transpose_add(&p, &mut f);
-                forces.push(f);
+                coef.extend_from_slice(&p);
                 index.push(TvdIndex { i, k, j });
             }
         }
         active_all.push(act);
     }
+    let cols = index.len();
+    let omega2 = if opts.inertia {
+        mode_eigenvalues(model, base)?
+    } else {
+        vec![0.0; nb]
+    };
 
-    let cols = forces.len();
-    let mut x = Mat::from_fn(n, cols, |r, c| forces[c][r]);
-    if cols > 0 {
+    let mut x = Mat::<f64>::zeros(n, cols);
+    let mut k_norms = vec![0.0; cols];
+    let coef_col = |c: usize| &coef[c * m..(c + 1) * m];
+    // Static columns (Ω_i = 0): Z = K⁻¹ B_uᵀ, φᵀKφ = p_uᵀ G p_u with G = B_u Z.
+    let static_cols: Vec<usize> = (0..cols).filter(|&c| omega2[index[c].i] == 0.0).collect();
+    if !static_cols.is_empty() {
         let chol = SparseCholesky::new(&model.stiffness)?;
-        chol.solve_in_place(&mut x);
+        let mut z = joint_rows_transposed(joint, &used, n);
+        chol.solve_in_place(&mut z);
+        let g = symmetric(&rows_times(joint, &used, z.as_ref()));
+        let pc = Mat::from_fn(m, static_cols.len(), |r, c| coef_col(static_cols[c])[r]);
+        let scaled = normalize(&g, pc, &static_cols, &index, &mut k_norms)?;
+        let xs = &z * &scaled;
+        for (a, &c) in static_cols.iter().enumerate() {
+            x.col_mut(c).copy_from(xs.col(a));
+        }
     }
-    let mut k_norms = Vec::with_capacity(cols);
-    let mut kx = vec![0.0; n];
-    for c in 0..cols {
-        let xc: Vec<f64> = x.col(c).iter().copied().collect();
-        model.stiffness.mul_vec(&xc, &mut kx);
-        let e: f64 = xc.iter().zip(&kx).map(|(a, b)| a * b).sum();
-        if !(e.is_finite() && e > 0.0) {
-            return Err(Error::LinearAlgebra(format!(
-                "TVD column {c} ({:?}) has strain energy {e:e}; K is not positive definite",
-                index[c]
-            )));
+    // Eq. (15) per vibration mode: (K − Ω_i² M) φ = f − ∂Ω_i²/∂q M φ_i, sparse LU.
+    let mut lu_symbolic: Option<SymbolicLu<usize>> = None;
+    for i in 0..nb {
+        let om2 = omega2[i];
+        if om2 == 0.0 {
+            continue;
         }
-        let s = e.sqrt();
-        for r in 0..n {
-            x[(r, c)] /= s;
+        let mode_cols: Vec<usize> = (0..cols).filter(|&c| index[c].i == i).collect();
+        if mode_cols.is_empty() {
+            continue;
         }
-        k_norms.push(s);
+        let phi: Vec<f64> = base.col(i).iter().copied().collect();
+        let mut mphi = vec![0.0; n];
+        sym_mul_vec_into(&model.mass, &phi, &mut mphi);
+        let phi_m_phi: f64 = phi.iter().zip(&mphi).map(|(a, b)| a * b).sum();
+        // Right-hand sides f − ∂Ω²/∂q M φ_i, solved directly (Z_i = (K − Ω²M)⁻¹ B_uᵀ would
+        // be dominated by the near-resonant direction and cancel in the combinations).
+        let mut rhs = Mat::<f64>::zeros(n, mode_cols.len());
+        let mut full = vec![0.0; 3 * w];
+        for (a, &c) in mode_cols.iter().enumerate() {
+            let pu = coef_col(c);
+            full.iter_mut().for_each(|v| *v = 0.0);
+            for (&u, v) in used.iter().zip(pu) {
+                full[u] = *v;
+            }
+            let mut f = vec![0.0; n];
+            joint.apply_transpose_add(&full, &mut f);
+            let phi_f: f64 = used.iter().zip(pu).map(|(&u, v)| bphi[(u, i)] * v).sum();
+            let dom2 = phi_f / phi_m_phi;
+            for r in 0..n {
+                rhs[(r, a)] = f[r] - dom2 * mphi[r];
+            }
+        }
+        let mut z = shifted_solve(model, om2, &rhs, &mut lu_symbolic, i)?;
+        let kz = sym_mul_mat(&model.stiffness, z.as_ref());
+        for (a, &c) in mode_cols.iter().enumerate() {
+            let e: f64 = z
+                .col(a)
+                .iter()
+                .zip(kz.col(a).iter())
+                .map(|(x, y)| x * y)
+                .sum();
+            if !(e.is_finite() && e > 0.0) {
+                return Err(Error::LinearAlgebra(format!(
+                    "TVD column {c} ({:?}) has strain energy {e:e}; K is not positive definite",
+                    index[c]
+                )));
+            }
+            let s = e.sqrt();
+            z.col_mut(a).iter_mut().for_each(|v| *v /= s);
+            k_norms[c] = s;
+            x.col_mut(c).copy_from(z.col(a));
+        }
     }
     Ok(Tvd {
         vectors: x,
@@ -224,5 +334,337 @@ pub fn trial_vector_derivatives(
         zero_columns,
         negligible_columns,
         active: active_all,
+        omega2,
     })
+}
+
+/// `Ω_i²` of each base column for eq. (15): the Rayleigh quotient of the columns that vanish
+/// on the master DOF (fixed-interface modes), 0 for the others.
+fn mode_eigenvalues(model: &Model, base: MatRef<'_, f64>) -> Result<Vec<f64>, Error> {
+    let n = model.dofs();
+    let master = model.master_dofs();
+    let mut kv = vec![0.0; n];
+    let mut mv = vec![0.0; n];
+    (0..base.ncols())
+        .map(|i| {
+            if master.iter().any(|&d| base[(d, i)] != 0.0) {
+                return Ok(0.0);
+            }
+            let v: Vec<f64> = base.col(i).iter().copied().collect();
+            sym_mul_vec_into(&model.stiffness, &v, &mut kv);
+            sym_mul_vec_into(&model.mass, &v, &mut mv);
+            let vk: f64 = v.iter().zip(&kv).map(|(a, b)| a * b).sum();
+            let vm: f64 = v.iter().zip(&mv).map(|(a, b)| a * b).sum();
+            let om2 = vk / vm;
+            if !(om2.is_finite() && om2 > 0.0) {
+                return Err(Error::Invalid(format!(
+                    "TVD with inertia: base vector {i} has Rayleigh quotient {om2:e} (zero vector?)"
+                )));
+            }
+            Ok(om2)
+        })
+        .collect()
+}
+
+/// `B_uᵀ`: n × m, column a the joint row `used[a]`.
+fn joint_rows_transposed(joint: &JointOperator, used: &[usize], n: usize) -> Mat<f64> {
+    let mut out = Mat::<f64>::zeros(n, used.len());
+    for (a, &r) in used.iter().enumerate() {
+        for (c, v) in joint.row(r) {
+            out[(c, a)] += v;
+        }
+    }
+    out
+}
+
+/// `B_u Z` (m × Z.ncols()).
+fn rows_times(joint: &JointOperator, used: &[usize], z: MatRef<'_, f64>) -> Mat<f64> {
+    Mat::from_fn(used.len(), z.ncols(), |a, b| {
+        joint.row(used[a]).map(|(c, v)| v * z[(c, b)]).sum()
+    })
+}
+
+fn symmetric(g: &Mat<f64>) -> Mat<f64> {
+    Mat::from_fn(g.nrows(), g.ncols(), |a, b| 0.5 * (g[(a, b)] + g[(b, a)]))
+}
+
+/// Scales each coefficient column q to unit energy `qᵀ G q` (= φᵀKφ of `φ = Z q`), storing
+/// `sqrt(qᵀ G q)` in `k_norms[cols[c]]`.
+fn normalize(
+    g: &Mat<f64>,
+    mut q: Mat<f64>,
+    cols: &[usize],
+    index: &[TvdIndex],
+    k_norms: &mut [f64],
+) -> Result<Mat<f64>, Error> {
+    let gq = g * &q;
+    for (a, &c) in cols.iter().enumerate() {
+        let e: f64 = q
+            .col(a)
+            .iter()
+            .zip(gq.col(a).iter())
+            .map(|(x, y)| x * y)
+            .sum();
+        if !(e.is_finite() && e > 0.0) {
+            return Err(Error::LinearAlgebra(format!(
+                "TVD column {c} ({:?}) has strain energy {e:e}; K is not positive definite",
+                index[c]
+            )));
+        }
+        let s = e.sqrt();
+        q.col_mut(a).iter_mut().for_each(|v| *v /= s);
+        k_norms[c] = s;
+    }
+    Ok(q)
+}
+
+/// Solves `(K − Ω² M) Z = rhs` by sparse LU (symbolic analysis shared through `symbolic`) and
+/// checks the normwise backward error.
+fn shifted_solve(
+    model: &Model,
+    om2: f64,
+    rhs: &Mat<f64>,
+    symbolic: &mut Option<SymbolicLu<usize>>,
+    mode: usize,
+) -> Result<Mat<f64>, Error> {
+    let k = &model.stiffness;
+    let mass = &model.mass;
+    let a = shifted(k, mass, om2);
+    let faer_a = SparseColMat::new(
+        SymbolicSparseColMat::new_checked(a.n, a.n, a.col_ptr.clone(), None, a.row_idx.clone()),
+        a.values.clone(),
+    );
+    let sym = match symbolic {
+        Some(s) => s.clone(),
+        None => {
+            let s = SymbolicLu::try_new(faer_a.symbolic())
+                .map_err(|e| Error::LinearAlgebra(format!("symbolic LU of K − Ω²M: {e:?}")))?;
+            *symbolic = Some(s.clone());
+            s
+        }
+    };
+    let lu = Lu::try_new_with_symbolic(sym, faer_a.as_ref()).map_err(|e| {
+        Error::LinearAlgebra(format!(
+            "LU of K − Ω²M for base vector {mode} (Ω² = {om2:e}): {e:?}"
+        ))
+    })?;
+    let mut z = rhs.clone();
+    lu.solve_in_place(z.as_mut());
+    let az = sym_mul_mat(&a, z.as_ref());
+    let a_norm = a.inf_norm();
+    let mut worst = 0.0f64;
+    for c in 0..z.ncols() {
+        let res = (0..a.n).fold(0.0f64, |m, r| m.max((az[(r, c)] - rhs[(r, c)]).abs()));
+        let zn = z.col(c).iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let bn = rhs.col(c).iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let backward = res / (a_norm * zn + bn).max(f64::MIN_POSITIVE);
+        worst = if backward.is_nan() {
+            f64::INFINITY
+        } else {
+            worst.max(backward)
+        };
+    }
+    if worst > 1e-10 {
+        return Err(Error::LinearAlgebra(format!(
+            "TVD with inertia: (K − Ω²M) solve for base vector {mode} (Ω² = {om2:e}) has backward \
+             error {worst:.2e} > 1e-10 (Ω² is (nearly) a free-interface eigenvalue)"
+        )));
+    }
+    Ok(z)
+}
+
+/// `K − s M` on the union of both patterns (both triangles stored, rows sorted).
+fn shifted(k: &SymCsc, m: &SymCsc, s: f64) -> SymCsc {
+    let n = k.n;
+    let mut col_ptr = Vec::with_capacity(n + 1);
+    col_ptr.push(0);
+    let mut row_idx = Vec::with_capacity(k.row_idx.len());
+    let mut values = Vec::with_capacity(k.values.len());
+    for j in 0..n {
+        let (mut a, ae) = (k.col_ptr[j], k.col_ptr[j + 1]);
+        let (mut b, be) = (m.col_ptr[j], m.col_ptr[j + 1]);
+        while a < ae || b < be {
+            let ra = if a < ae { k.row_idx[a] } else { usize::MAX };
+            let rb = if b < be { m.row_idx[b] } else { usize::MAX };
+            if ra == rb {
+                row_idx.push(ra);
+                values.push(k.values[a] - s * m.values[b]);
+                a += 1;
+                b += 1;
+            } else if ra < rb {
+                row_idx.push(ra);
+                values.push(k.values[a]);
+                a += 1;
+            } else {
+                row_idx.push(rb);
+                values.push(-s * m.values[b]);
+                b += 1;
+            }
+        }
+        col_ptr.push(row_idx.len());
+    }
+    SymCsc {
+        n,
+        col_ptr,
+        row_idx,
+        values,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::reduction::{craig_bampton, pod};
+
+    fn col(m: MatRef<'_, f64>, c: usize) -> Vec<f64> {
+        m.col(c).iter().copied().collect()
+    }
+
+    fn mul(a: &SymCsc, x: &[f64]) -> Vec<f64> {
+        let mut y = vec![0.0; x.len()];
+        a.mul_vec(x, &mut y);
+        y
+    }
+
+    fn inf(x: &[f64]) -> f64 {
+        x.iter().fold(0.0f64, |m, v| m.max(v.abs()))
+    }
+
+    /// The pseudoforce `f_{i,k,j} = Bᵀ D_{k,j} B φ_i` (eq. 19), formed independently.
+    fn pseudoforce(model: &Model, base: MatRef<'_, f64>, tvd: &Tvd, c: usize) -> Vec<f64> {
+        let TvdIndex { i, k, j } = tvd.index[c];
+        let act = &tvd.active[j][if k < 0 { 0 } else { 1 }];
+        let mut b = vec![0.0; model.joint.rows()];
+        model.joint.apply(&col(base, i), &mut b);
+        let kn = model.case.contact.normal_stiffness;
+        let p: Vec<f64> = (0..b.len())
+            .map(|r| {
+                if r % 3 == NORMAL && act[r / 3] {
+                    kn * b[r]
+                } else {
+                    0.0
+                }
+            })
+            .collect();
+        let mut f = vec![0.0; model.dofs()];
+        model.joint.apply_transpose_add(&p, &mut f);
+        f
+    }
+
+    /// `inertia = false` is eq. (16): each column solves `K φ = f` (checked against a direct
+    /// sparse solve of the independently formed pseudoforce) and is K-normalized.
+    #[test]
+    fn static_tvd_solves_eq16() {
+        let model = Model::from_case_name("friction_bar").unwrap();
+        let base = craig_bampton(&model, 10).unwrap();
+        let tvd = trial_vector_derivatives(&model, base.as_ref(), &TvdOptions::default()).unwrap();
+        assert!(tvd.omega2.iter().all(|&o| o == 0.0));
+        let chol = SparseCholesky::new(&model.stiffness).unwrap();
+        for c in [0, 17, 100, 255, 400, tvd.nonzero() - 1] {
+            let f = pseudoforce(&model, base.as_ref(), &tvd, c);
+            let mut x = Mat::from_fn(f.len(), 1, |r, _| f[r]);
+            chol.solve_in_place(&mut x);
+            let x = col(x.as_ref(), 0);
+            let s = tvd.k_norms[c];
+            let v = col(tvd.vectors.as_ref(), c);
+            let dev = x
+                .iter()
+                .zip(&v)
+                .fold(0.0f64, |m, (a, b)| m.max((a - s * b).abs()));
+            assert!(
+                dev <= 1e-8 * inf(&x),
+                "column {c}: {dev:e} vs {:e}",
+                inf(&x)
+            );
+            let e: f64 = v
+                .iter()
+                .zip(mul(&model.stiffness, &v))
+                .map(|(a, b)| a * b)
+                .sum();
+            assert!((e - 1.0).abs() < 1e-8, "column {c}: φᵀKφ = {e}");
+        }
+    }
+
+    /// `inertia = true`: the fixed-interface modes get `Ω² =` their eigenvalue, the constraint
+    /// modes 0; every column satisfies eq. (15),
+    /// `(K − Ω_i² M) φ s = f − (φ_iᵀ f / φ_iᵀ M φ_i) M φ_i`, with `s` its K-norm; constraint-mode
+    /// columns equal the static ones.
+    #[test]
+    fn inertia_tvd_satisfies_eq15() {
+        for name in ["friction_bar", "multilayer_sheet"] {
+            inertia_case(name);
+        }
+    }
+
+    fn inertia_case(name: &str) {
+        let model = Model::from_case_name(name).unwrap();
+        let base = craig_bampton(&model, 10).unwrap();
+        let opts = TvdOptions {
+            inertia: true,
+            ..TvdOptions::default()
+        };
+        let tvd = trial_vector_derivatives(&model, base.as_ref(), &opts).unwrap();
+        let plain =
+            trial_vector_derivatives(&model, base.as_ref(), &TvdOptions::default()).unwrap();
+        assert_eq!(tvd.index, plain.index);
+        let modes = model.modes(10, crate::model::Interface::Fixed).unwrap();
+        for v in 0..10 {
+            let (a, b) = (tvd.omega2[6 + v], modes.eigenvalues[v]);
+            assert!((a - b).abs() < 1e-8 * b, "mode {v}: Ω² {a} vs {b}");
+        }
+        assert!(tvd.omega2[..6].iter().all(|&o| o == 0.0));
+        let (k_norm, m_norm) = (model.stiffness.inf_norm(), model.mass.inf_norm());
+        let mut checked = 0;
+        for c in (0..tvd.nonzero()).step_by(37) {
+            let i = tvd.index[c].i;
+            let om2 = tvd.omega2[i];
+            let phi = col(base.as_ref(), i);
+            let mphi = mul(&model.mass, &phi);
+            let f = pseudoforce(&model, base.as_ref(), &tvd, c);
+            let dom2 = if om2 == 0.0 {
+                0.0
+            } else {
+                phi.iter().zip(&f).map(|(a, b)| a * b).sum::<f64>()
+                    / phi.iter().zip(&mphi).map(|(a, b)| a * b).sum::<f64>()
+            };
+            let rhs: Vec<f64> = f.iter().zip(&mphi).map(|(a, b)| a - dom2 * b).collect();
+            let s = tvd.k_norms[c];
+            let x: Vec<f64> = col(tvd.vectors.as_ref(), c).iter().map(|v| v * s).collect();
+            let kx = mul(&model.stiffness, &x);
+            let mx = mul(&model.mass, &x);
+            let res: Vec<f64> = (0..x.len()).map(|r| kx[r] - om2 * mx[r] - rhs[r]).collect();
+            // Normwise backward error.
+            let scale = (k_norm + om2 * m_norm) * inf(&x) + inf(&rhs);
+            let backward = inf(&res) / scale;
+            assert!(
+                backward <= 1e-12,
+                "column {c} (Ω² {om2}): backward error {backward:e}"
+            );
+            if om2 == 0.0 {
+                let v = col(plain.vectors.as_ref(), c);
+                let u = col(tvd.vectors.as_ref(), c);
+                let dev = u
+                    .iter()
+                    .zip(&v)
+                    .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+                assert!(dev <= 1e-12 * inf(&v), "column {c}: {dev:e}");
+            } else {
+                checked += 1;
+            }
+        }
+        assert!(checked > 5);
+        // Report w(g) of both variants (K-weighted POD) for the record.
+        let wi = pod(tvd.vectors.as_ref(), Some(&model.stiffness)).unwrap();
+        let ws = pod(plain.vectors.as_ref(), Some(&model.stiffness)).unwrap();
+        println!(
+            "{name} w(g), eq. (15): g(0.999) = {}, w[..30] = {:?}",
+            wi.choose_g(0.999),
+            &wi.w[..30]
+        );
+        println!(
+            "{name} w(g), eq. (16): g(0.999) = {}, w[..30] = {:?}",
+            ws.choose_g(0.999),
+            &ws.w[..30]
+        );
+    }
 }
