@@ -33,12 +33,14 @@ pub mod contact;
 pub mod element;
 pub mod error;
 pub mod friction;
+pub mod heatmap;
 pub mod joint;
 pub mod mesh;
 pub mod model;
 pub mod modes;
 pub mod ode;
 pub mod reduction;
+pub mod stability;
 pub mod statics;
 pub mod study;
 #[allow(unsafe_code)]
