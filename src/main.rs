@@ -123,6 +123,10 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// Stability map of the transient methods: model × iteration × k_n × friction × events ×
+    /// max order → status (ok or the CVODE flag and time reached), cost, error; writes
+    /// OUT/CASE/stability.json, stability.md and heat maps (SVG/PNG).
+    Stability(jointrom::stability::StabilityArgs),
     /// The main job on a case (default: the friction bar): model, modes, statics, results.json.
     Run {
         /// Case file path or built-in name.
@@ -356,6 +360,14 @@ fn run(command: Command) -> Result<(), Error> {
                     println!("  {:>3}   {:.8}        {:.8}", i + 1, b.w[i], b.w_plain[i]);
                 }
             }
+        }
+        Command::Stability(args) => {
+            let v = jointrom::stability::stability_command(&args)?;
+            println!(
+                "{}",
+                serde_json::to_string_pretty(&v)
+                    .map_err(|e| Error::Invalid(format!("JSON output: {e}")))?
+            );
         }
         Command::Study {
             case,
