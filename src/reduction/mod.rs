@@ -49,9 +49,9 @@ pub use basis::{
 };
 pub use craig_bampton::craig_bampton;
 pub use jim::{jim_dofs, jim_vectors, joint_interface_modes, JimSet, JointInterfaceModes};
-pub use pod::{pod, Pod, DEFAULT_THRESHOLD, ZERO_EIGENVALUE};
+pub use pod::{pod, pod_tvd, sigma_zero, Pod, DEFAULT_THRESHOLD, ZERO_EIGENVALUE};
 pub use snapshots::{snapshot_basis, snapshot_pod};
-pub use tvd::{active_pairs, trial_vector_derivatives, Tvd, TvdIndex, TvdOptions};
+pub use tvd::{active_pairs, trial_vector_derivatives, Tvd, TvdFactor, TvdIndex, TvdOptions};
 
 use faer::Mat;
 
