@@ -417,7 +417,8 @@ mod tests {
     use crate::reduction::{craig_bampton, trial_vector_derivatives, TvdOptions};
 
     /// The low-rank route agrees with the dense eigensolver of `Yᵀ A Y` on the built-in TVD:
-    /// eigenvalues above 1e-6 λ_max to 1e-6 relative, w(g) to 1e-9, the leading POMs to 1e-6.
+    /// eigenvalues above 1e-6 λ_max to 1e-6 relative, w(g) to 1e-9, the POMs of λ > 1e-4 λ_max to
+    /// 1e-6.
     #[test]
     fn pod_matches_dense_reference() {
         for name in ["friction_bar", "multilayer_sheet"] {
@@ -437,7 +438,11 @@ mod tests {
                 for (i, l) in lambda.iter().enumerate().filter(|(_, l)| **l > 1e-6 * lmax) {
                     let rel = (fast.lambda[i] - l).abs() / l;
                     assert!(rel < 1e-6, "{name}: λ_{i} {} vs {l}", fast.lambda[i]);
-                    // Same POM up to sign.
+                    // Same POM up to sign, where the Gram's round-off (≈ 1e-10 λ_max) over the
+                    // eigenvalue gaps leaves the eigenvectors determined to 1e-6.
+                    if *l <= 1e-4 * lmax {
+                        continue;
+                    }
                     let (u, v) = (fast.poms.col(i), poms.col(i));
                     let s: f64 = u.iter().zip(v.iter()).map(|(a, b)| a * b).sum();
                     let s = s.signum();
