@@ -87,9 +87,8 @@ use crate::error::Error;
 use crate::joint::NORMAL;
 use crate::model::Model;
 use crate::reduction::{
-    alldof_vectors, build_basis, craig_bampton, final_basis, jim_vectors, pod,
-    trial_vector_derivatives, BasisKind, BasisOptions, JimSet, ReducedModel, TvdOptions,
-    DEFAULT_DROP_TOL, DEFAULT_THRESHOLD,
+    alldof_vectors, build_basis, craig_bampton, final_basis, jim_vectors, trial_vector_derivatives,
+    BasisKind, BasisOptions, JimSet, ReducedModel, TvdOptions, DEFAULT_DROP_TOL, DEFAULT_THRESHOLD,
 };
 
 /// The basis kinds of `jointrom static --basis`, by name (the one list; see [`parse_basis`]).
@@ -773,8 +772,7 @@ pub fn run_study(model: &Model, opts: &StudyOptions) -> Result<Study, Error> {
                 v.name,
             )?);
         }
-        let weight = v.weighted.then_some(&model.stiffness);
-        let p = pod(tvd.vectors.as_ref(), weight)?;
+        let p = crate::reduction::pod_tvd(model, tvd, v.weighted)?;
         let prepare_s = tvd_s + t0.elapsed().as_secs_f64();
         energy.push(EnergyCurve {
             name: v.name.into(),

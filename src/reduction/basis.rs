@@ -10,7 +10,7 @@ use crate::model::Model;
 use super::alldof::{alldof_vectors, Dot2};
 use super::craig_bampton::craig_bampton;
 use super::jim::{jim_vectors, JimSet};
-use super::pod::{pod, DEFAULT_THRESHOLD};
+use super::pod::{pod_tvd, DEFAULT_THRESHOLD};
 use super::tvd::{trial_vector_derivatives, TvdOptions};
 
 /// Default relative drop tolerance of [`final_basis`].
@@ -228,12 +228,7 @@ pub fn build_basis(model: &Model, kind: BasisKind, opts: &BasisOptions) -> Resul
     let cb = craig_bampton(model, opts.nu)?;
     let (w, g, tvd_total, tvd_nonzero, joint_modes) = if need_tvd {
         let tvd = trial_vector_derivatives(model, cb.as_ref(), &opts.tvd)?;
-        let weight = if kind == BasisKind::TvdPlain {
-            None
-        } else {
-            Some(&model.stiffness)
-        };
-        let p = pod(tvd.vectors.as_ref(), weight)?;
+        let p = pod_tvd(model, &tvd, kind != BasisKind::TvdPlain)?;
         let g = opts
             .g
             .unwrap_or_else(|| p.choose_g(opts.threshold))

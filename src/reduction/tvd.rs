@@ -42,6 +42,14 @@
 //! with its LU factors (combining flexibility columns of the indefinite operator would cancel
 //! catastrophically when Ω_i² lies near a free-interface eigenvalue), and `φᵀ K φ` is formed
 //! with K.
+//!
+//! # Factor form
+//! The static TVD are kept as `Y = Z C` ([`Tvd::factor`], [`TvdFactor`]): Z refined twice with
+//! double-double residuals (so `B_u Z = Zᵀ K Z` to working precision), `G = B_u Z`, C the
+//! K-normalized coefficients. [`super::pod_tvd`] computes the K-weighted POD as the SVD of
+//! `D^½ Vᵀ C` (`G = V D Vᵀ`) instead of the eigenproblem of `Yᵀ K Y`, which squares the
+//! condition number: on the friction bar the Gram route's round-off is ≈ 1e-10 λ_max, and the
+//! directions carrying the last per cent of the contact force have λ = 1e-12 … 1e-20 λ_max.
 
 use faer::linalg::solvers::Solve;
 use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
@@ -53,6 +61,8 @@ use crate::error::Error;
 use crate::joint::{JointOperator, NORMAL, T1, T2};
 use crate::model::Model;
 use crate::statics::{sym_mul_mat, sym_mul_vec_into, SparseCholesky};
+
+use super::alldof::solve_refined;
 
 /// Options of [`trial_vector_derivatives`]. Defaults: `tol = 1e-6`, `zero_gap_active = true`,
 /// `tangential = false`.
@@ -121,6 +131,25 @@ pub struct Tvd {
     /// derivatives were solved with: 0 for the static eq. (16)/(18) (all vectors unless
     /// [`TvdOptions::inertia`]; constraint modes always).
     pub omega2: Vec<f64>,
+    /// The factor form `vectors = Z C` of the static TVD (module docs, "Factor form"); `None`
+    /// when some column was solved with eq. (15) ([`TvdOptions::inertia`]) or there are no
+    /// columns. [`super::pod_tvd`] uses it for the POD without squaring.
+    pub factor: Option<TvdFactor>,
+}
+
+/// The factor form of static TVD: `vectors = flexibility · coefficients` (to round-off; the
+/// product is how the vectors are formed).
+#[derive(Clone, Debug)]
+pub struct TvdFactor {
+    /// The joint flexibility columns `Z = K⁻¹ B_uᵀ` (n × m, mm/N), m the joint rows that receive
+    /// stiffness (one per pair, or three with [`TvdOptions::tangential`]); solved with two
+    /// double-double residual refinements.
+    pub flexibility: Mat<f64>,
+    /// `G = B_u Z = B_u K⁻¹ B_uᵀ` (m × m, mm/N), symmetrized: `Zᵀ K Z` to the solve's residual.
+    pub joint_flexibility: Mat<f64>,
+    /// The K-normalized pseudoforce coefficients C (m × p, N per unit of the base over the
+    /// column's K-norm): `vectors = Z C`, `cᵀ G c = 1` per column.
+    pub coefficients: Mat<f64>,
 }
 
 impl Tvd {
@@ -257,19 +286,27 @@ pub fn trial_vector_derivatives(
 
     let mut x = Mat::<f64>::zeros(n, cols);
     let mut k_norms = vec![0.0; cols];
+    let mut factor = None;
     let coef_col = |c: usize| &coef[c * m..(c + 1) * m];
     // Static columns (Ω_i = 0): Z = K⁻¹ B_uᵀ, φᵀKφ = p_uᵀ G p_u with G = B_u Z.
     let static_cols: Vec<usize> = (0..cols).filter(|&c| omega2[index[c].i] == 0.0).collect();
     if !static_cols.is_empty() {
         let chol = SparseCholesky::new(&model.stiffness)?;
-        let mut z = joint_rows_transposed(joint, &used, n);
-        chol.solve_in_place(&mut z);
+        let bt = joint_rows_transposed(joint, &used, n);
+        let z = solve_refined(&model.stiffness, &chol, &bt);
         let g = symmetric(&rows_times(joint, &used, z.as_ref()));
         let pc = Mat::from_fn(m, static_cols.len(), |r, c| coef_col(static_cols[c])[r]);
         let scaled = normalize(&g, pc, &static_cols, &index, &mut k_norms)?;
         let xs = &z * &scaled;
         for (a, &c) in static_cols.iter().enumerate() {
             x.col_mut(c).copy_from(xs.col(a));
+        }
+        if static_cols.len() == cols {
+            factor = Some(TvdFactor {
+                flexibility: z,
+                joint_flexibility: g,
+                coefficients: scaled,
+            });
         }
     }
     // Eq. (15) per vibration mode: (K − Ω_i² M) φ = f − ∂Ω_i²/∂q M φ_i, sparse LU.
@@ -335,6 +372,7 @@ pub fn trial_vector_derivatives(
         negligible_columns,
         active: active_all,
         omega2,
+        factor,
     })
 }
 
