@@ -48,23 +48,22 @@
 //! takes over when it fails; every such g is listed in `restarts`, and a g where both fail is
 //! NaN and listed in `failures` (none measured).
 //!
-//! ## Measured (ν = 10, g ≤ 60, load × 1; this crate's meshes)
+//! ## Measured (ν = 10, load × 1; this crate's meshes; `results/study/`)
 //!
-//! | case | full ‖f_c‖ | g = 0 error | tvd (K-weighted) | tvd-plain | tvd-kt | modes |
-//! |---|---|---|---|---|---|---|
-//! | friction_bar (54 pairs) | 2.0630587 N | 33 | 48 POMs, 2.0e-2 at g = 48 | 35, 0.18 | 109, 0.17 at 60 | 3.2e-2 at 60 |
-//! | multilayer_sheet (92 pairs) | 0.04133989 N | 34 | 76 POMs, 1 % from g = 53, 4.3e-3 at 60 | 63, 1 % from 53 | 184, 0.60 at 60 | 0.18 at 60 |
+//! | case | full ‖f_c‖ | g = 0 error | tvd (K-weighted) | tvd-plain | tvd-inertia (eq. 15) | tvd-kt | modes | jim |
+//! |---|---|---|---|---|---|---|---|---|
+//! | friction_bar (54 pairs) | 2.0630588 N | 33 | 1 % from g = 49, 1e-4 from 52, 4.8e-10 at 54 | same g, 4.7e-10 | 2.1e-2 at 60 | 0.17 at 60 | 3.2e-2 at 60 | 3.0e-2 at 60 |
+//! | multilayer_sheet (92 pairs) | 0.04133989 N | 34 | 1 % from 53, 1e-4 from 73, 2.9e-7 at 80 | same g | 2.5e-4 at 80 | 0.36 at 80 | 3.5e-2 at 80 | 0.15 at 80 |
 //!
-//! No series reaches 1e-4 within g ≤ 60, and on the friction bar none reaches 1 %. Yet all TVD
-//! (k_n) without POD reproduce the full value to 4.8e-8 (friction bar, 68 columns) and 1.9e-9
-//! (multilayer, 107 columns): the TVD span holds the solution, but the POMs that carry the last
-//! per cent have POD eigenvalues of 1e-12 … 1e-16 λ_max — below the POD's zero cut (1e-12, so the
-//! series stop at 48 and 76 POMs). With the cut lowered (checked outside the crate) the friction
-//! bar reaches 2.4e-4 at g = 49 and 1e-8 at g = 52; the multilayer 1e-4 at g = 73 and 1e-6 at
-//! g ≈ 78. So the paper's "25 joint modes converge the friction bar (w = 0.9994)" is not
-//! reproduced for the static contact force: w(g) ≥ 0.999 already at g = 12 (friction bar) and 21
-//! (multilayer), far before convergence. k_n + k_t TVD converge more slowly per added vector
-//! than k_n alone (their span is three times larger) and, without POD, stop at 4.7e-4 / 2.9e-3.
+//! The weighted POD of the TVD is computed without forming `YᵀKY` ([`crate::reduction::pod_tvd`]):
+//! the POMs that carry the last per cent of the contact force have POD eigenvalues of
+//! 1e-12 … 1e-16 λ_max, below the round-off floor of the Gram route. The TVD series converge to
+//! the full value, but late: w(g) ≥ 0.999 already at g = 12 (friction bar) and 21 (multilayer),
+//! far before the contact force converges, so the paper's "25 joint modes converge the friction
+//! bar (w = 0.9994)" is not reproduced for the static contact force on this mesh. k_n + k_t TVD
+//! span a three times larger space and converge more slowly per added vector; without POD they
+//! stop at 4.7e-4 / 2.9e-3 (the combined normal-tangential pseudoforces do not contain the pure
+//! normal flexibility directions).
 //!
 //! Timings (2 shared cores, loaded): a whole study ≈ 2.5–6 s per scene (each sweep ≈ 0.3–1.5 s;
 //! the all-TVD references ≈ 0.3–0.6 s each), charts ≈ 0.05 s.
@@ -594,7 +593,7 @@ pub struct EnergyCurve {
 }
 
 /// The reduced solution on `[Φ_S Φ_V | all nonzero TVD]` (no POD): the limit the POD series
-/// of this TVD variant can reach, up to the POD's zero-eigenvalue cut (`λ ≤ 1e-12 λ_max`) and
+/// of this TVD variant can reach, up to the POD's numerical-zero cut and
 /// the basis drop tolerance.
 #[derive(Clone, Debug, Serialize)]
 pub struct SpanReference {
