@@ -7,7 +7,10 @@ use std::time::Instant;
 use clap::{Parser, Subcommand, ValueEnum};
 use serde_json::{json, Value};
 
-use jointrom::reduction::{BasisKind, BasisOptions};
+use jointrom::ode::{Iteration, NewtonLinear};
+use jointrom::reduction::{build_basis, BasisKind, BasisOptions, ReducedModel};
+use jointrom::system::{FullSystem, ReducedSystem};
+use jointrom::transient::{self, TransientOptions};
 use jointrom::{contact, study, Error, Interface, Model};
 
 #[derive(Parser)]
@@ -127,6 +130,59 @@ enum Command {
     /// max order → status (ok or the CVODE flag and time reached), cost, error; writes
     /// OUT/CASE/stability.json, stability.md and heat maps (SVG/PNG).
     Stability(jointrom::stability::StabilityArgs),
+
+    /// Transient run from rest (CVODE): contact force norm, friction force norm and master uy
+    /// over time, solver statistics and wall time.
+    Transient {
+        /// Case file path or built-in name.
+        case: String,
+        /// full (FE model) or a reduced basis: tvd, tvd-plain, modes, jim, alldof (pod: needs
+        /// snapshots, not available here).
+        #[arg(long, default_value = "tvd")]
+        model: String,
+        /// Enrichment vectors of the basis; default: the smallest g with w(g) >= 0.999.
+        #[arg(long)]
+        g: Option<usize>,
+        /// Fixed-interface modes ν of the basis.
+        #[arg(long, default_value_t = 10)]
+        nu: usize,
+        /// Nonlinear iteration: newton (structured solve) or functional (fixed point).
+        #[arg(long, default_value = "newton")]
+        iteration: String,
+        /// Friction on or off.
+        #[arg(long, default_value = "on")]
+        friction: String,
+        /// Event location on gaps and stick/slip switches, on or off.
+        #[arg(long, default_value = "off")]
+        events: String,
+        /// Relative tolerance.
+        #[arg(long)]
+        rtol: Option<f64>,
+        /// Absolute tolerance, mm of the physical displacement field.
+        #[arg(long)]
+        atol: Option<f64>,
+        /// Velocity tolerance per displacement tolerance, 1/s.
+        #[arg(long)]
+        velocity_scale: Option<f64>,
+        /// Maximum BDF order (1–5).
+        #[arg(long)]
+        max_order: Option<usize>,
+        /// BDF stability-limit detection, on or off.
+        #[arg(long)]
+        stab_lim_det: Option<String>,
+        /// End time, s (default: the case's).
+        #[arg(long)]
+        end_time: Option<f64>,
+        /// Output spacing, s.
+        #[arg(long, default_value_t = 1e-4)]
+        output_step: f64,
+        /// One JSON document on stdout (with the curves).
+        #[arg(long)]
+        json: bool,
+        /// Write curves.csv and transient.json into this folder.
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
     /// The main job on a case (default: the friction bar): model, modes, statics, results.json.
     Run {
         /// Case file path or built-in name.
@@ -421,6 +477,41 @@ fn run(command: Command) -> Result<(), Error> {
                 println!("charts {:.2} s; written to {}", charts_s, dir.display());
             }
         }
+        Command::Transient {
+            case,
+            model: model_name,
+            g,
+            nu,
+            iteration,
+            friction,
+            events,
+            rtol,
+            atol,
+            velocity_scale,
+            max_order,
+            stab_lim_det,
+            end_time,
+            output_step,
+            json,
+            out,
+        } => {
+            let args = TransientArgs {
+                model: model_name,
+                g,
+                nu,
+                iteration,
+                friction,
+                events,
+                rtol,
+                atol,
+                velocity_scale,
+                max_order,
+                stab_lim_det,
+                end_time,
+                output_step,
+            };
+            transient_command(&case, &args, json, out)?;
+        }
         Command::Run { case, out, json } => {
             let t0 = Instant::now();
             let model = Model::from_case_name(&case)?;
@@ -538,6 +629,222 @@ fn reduced_static(
             r.build_s * 1e3,
             r.solve_s * 1e3
         );
+    }
+    Ok(())
+}
+
+/// Arguments of `jointrom transient` (besides the case and the output switches).
+struct TransientArgs {
+    model: String,
+    g: Option<usize>,
+    nu: usize,
+    iteration: String,
+    friction: String,
+    events: String,
+    rtol: Option<f64>,
+    atol: Option<f64>,
+    velocity_scale: Option<f64>,
+    max_order: Option<usize>,
+    stab_lim_det: Option<String>,
+    end_time: Option<f64>,
+    output_step: f64,
+}
+
+fn on_off(flag: &str, v: &str) -> Result<bool, Error> {
+    match v {
+        "on" => Ok(true),
+        "off" => Ok(false),
+        _ => Err(Error::Invalid(format!(
+            "--{flag} must be `on` or `off`, got `{v}`"
+        ))),
+    }
+}
+
+fn positive(flag: &str, v: f64) -> Result<f64, Error> {
+    if v.is_finite() && v > 0.0 {
+        Ok(v)
+    } else {
+        Err(Error::Invalid(format!(
+            "--{flag} must be finite and positive, got {v}"
+        )))
+    }
+}
+
+/// The options of a `transient` run from its flags (errors name the flag).
+fn transient_options(a: &TransientArgs) -> Result<TransientOptions, Error> {
+    let mut o = TransientOptions::default();
+    o.ode.iteration = match a.iteration.as_str() {
+        "newton" => Iteration::Newton {
+            linear: NewtonLinear::Problem,
+        },
+        "functional" => Iteration::Functional { anderson: 0 },
+        other => {
+            return Err(Error::Invalid(format!(
+                "--iteration must be `newton` or `functional`, got `{other}`"
+            )))
+        }
+    };
+    o.problem.friction = on_off("friction", &a.friction)?;
+    o.problem.events = on_off("events", &a.events)?;
+    if let Some(r) = a.rtol {
+        o.ode.rtol = positive("rtol", r)?;
+    }
+    if let Some(r) = a.atol {
+        o.ode.atol = positive("atol", r)?;
+    }
+    if let Some(v) = a.velocity_scale {
+        o.problem.velocity_scale = positive("velocity-scale", v)?;
+    }
+    if let Some(k) = a.max_order {
+        if !(1..=5).contains(&k) {
+            return Err(Error::Invalid(format!(
+                "--max-order must be 1..=5 (BDF), got {k}"
+            )));
+        }
+        o.ode.max_order = k;
+    }
+    if let Some(s) = &a.stab_lim_det {
+        o.ode.stab_lim_det = on_off("stab-lim-det", s)?;
+    }
+    if let Some(t) = a.end_time {
+        o.end_time = Some(positive("end-time", t)?);
+    }
+    o.output_step = positive("output-step", a.output_step)?;
+    Ok(o)
+}
+
+fn transient_command(
+    case: &str,
+    a: &TransientArgs,
+    json_out: bool,
+    out: Option<PathBuf>,
+) -> Result<(), Error> {
+    let opts = transient_options(a)?;
+    let model = Model::from_case_name(case)?;
+    let t0 = Instant::now();
+    let (res, basis_size, g_used) = match a.model.as_str() {
+        "full" => {
+            if a.g.is_some() {
+                return Err(Error::Invalid(
+                    "--g applies to reduced models, not --model full".into(),
+                ));
+            }
+            let sys = FullSystem::new(&model)?;
+            (transient::run(sys, &opts)?, model.dofs(), None)
+        }
+        "pod" => {
+            return Err(Error::Invalid(
+                "--model pod needs snapshots of a full run; not available in `transient` yet"
+                    .into(),
+            ))
+        }
+        name => {
+            let kind = BasisKind::from_name(name)
+                .map_err(|e| Error::Invalid(format!("--model: {e} (or full)")))?;
+            let basis = build_basis(
+                &model,
+                kind,
+                &BasisOptions {
+                    g: a.g,
+                    nu: a.nu,
+                    ..Default::default()
+                },
+            )?;
+            let g_used = basis.g;
+            let rom = ReducedModel::new(&model, basis.phi)?;
+            let r = rom.dim();
+            let sys = ReducedSystem::new(&model, &rom)?;
+            (transient::run(sys, &opts)?, r, Some(g_used))
+        }
+    };
+    let total_s = t0.elapsed().as_secs_f64();
+    let c = &res.curves;
+    let doc = json!({
+        "case": model.case.name,
+        "model": a.model,
+        "basis_size": basis_size,
+        "g": g_used,
+        "options": opts,
+        "stats": res.stats,
+        "events": res.events,
+        "wall_s": res.wall_s,
+        "cpu_s": res.cpu_s,
+        "total_s": total_s,
+        "curves": c,
+        "energy_balance": c.balance(),
+    });
+    if let Some(dir) = out {
+        std::fs::create_dir_all(&dir).map_err(|e| Error::Io {
+            file: dir.clone(),
+            source: e,
+        })?;
+        let file = dir.join("transient.json");
+        std::fs::write(
+            &file,
+            serde_json::to_string(&doc).expect("JSON values serialise"),
+        )
+        .map_err(|e| Error::Io {
+            file: file.clone(),
+            source: e,
+        })?;
+        let mut csv = String::from(
+            "t_s,contact_force_norm_N,friction_force_norm_N,master_uy_mm,kinetic_Nmm,strain_Nmm,pair_Nmm,external_work_Nmm,dissipated_Nmm\n",
+        );
+        for i in 0..c.t.len() {
+            csv.push_str(&format!(
+                "{:.8e},{:.10e},{:.10e},{:.10e},{:.10e},{:.10e},{:.10e},{:.10e},{:.10e}\n",
+                c.t[i],
+                c.contact_force_norm[i],
+                c.friction_force_norm[i],
+                c.master_uy[i],
+                c.kinetic[i],
+                c.strain[i],
+                c.pair[i],
+                c.external_work[i],
+                c.dissipated[i]
+            ));
+        }
+        let file = dir.join("curves.csv");
+        std::fs::write(&file, csv).map_err(|e| Error::Io {
+            file: file.clone(),
+            source: e,
+        })?;
+    }
+    if json_out {
+        print_json(&doc);
+    } else {
+        let s = &res.stats;
+        println!(
+            "{} — model {} (n = {}{}), friction {}, events {}",
+            model.case.name,
+            a.model,
+            basis_size,
+            g_used.map(|g| format!(", g = {g}")).unwrap_or_default(),
+            a.friction,
+            a.events
+        );
+        println!(
+            "t_end {:.4e} s: {} steps, {} RHS, {} nonlinear iterations ({} conv. failures), {} error-test failures, {} setups, last order {}, last h {:.2e} s",
+            c.t.last().copied().unwrap_or(0.0),
+            s.steps,
+            s.rhs_evals,
+            s.nonlinear_iterations,
+            s.nonlinear_conv_failures,
+            s.error_test_failures,
+            s.linear_setups,
+            s.last_order,
+            s.last_step
+        );
+        println!(
+            "wall {:.3} s, cpu {:.2} s (total incl. model {:.3} s)",
+            res.wall_s, res.cpu_s, total_s
+        );
+        if let Some(i) = c.t.len().checked_sub(1) {
+            println!(
+                "final: |f_c| {:.6e} N, |f_R| {:.6e} N, master uy {:.6e} mm",
+                c.contact_force_norm[i], c.friction_force_norm[i], c.master_uy[i]
+            );
+        }
     }
     Ok(())
 }

@@ -65,12 +65,75 @@
 //! ~30 000 steps and the energy balance closes to 3e-4 of the external work, at atol 1e-8
 //! ~24 000 steps and 2e-6. With events on, gaps of nearly closed pairs cross zero tens of
 //! thousands of times in 0.02 s and each restart costs a low-order step: ~20× slower.
+//!
+//! ## Step size of the full model: defaults
+//!
+//! The full FE model (friction bar, 906 DOF) took ~1e5 steps of ~1e-8 s per millisecond with
+//! CVODE's defaults. Measured on the first 5 ms (Newton, structured solve, rtol 1e-8, atol 1e-6
+//! mm; `vs` = [`ProblemOptions::velocity_scale`], velocity atol = `vs · atol` mm/s; wall times on
+//! 2 cores loaded by other jobs, so compare steps):
+//!
+//! | friction | max order | vs (1/s) | steps | Newton its | conv. fails | last h (s) | wall (s) |
+//! |---|---|---|---|---|---|---|---|
+//! | off | 5 | 1 | > 300 s, not finished | | | | |
+//! | off | 5 | 1e2 | > 300 s, not finished | | | | |
+//! | off | 5 | 1e3 | 15 081 | 16 682 | 84 | 1.4e-8 | 11.7 |
+//! | off | 5 | 1e4 | 307 986 | 328 455 | 61 | 6.2e-9 | 179 |
+//! | off | 5 + stab. lim. det. | 1e3 | 22 937 | 25 955 | 84 | 6.4e-9 | 16.1 |
+//! | off | 2 | 1 | 25 253 | 26 465 | 16 | 8.4e-8 | 11.7 |
+//! | off | 2 | 1e2 | 1 467 | 1 841 | 59 | 7.4e-7 | 6.2 |
+//! | off | 2 | 1e3 | 1 439 | 1 929 | 87 | 1.4e-5 | 1.0 |
+//! | off | 2 | 1e4 | 1 142 | 1 675 | 114 | 2.6e-6 | 0.9 |
+//! | on | 2 | 1 | 25 072 | 26 295 | 11 | 6.8e-8 | 109 |
+//! | on | 2 | 1e2 | 1 996 | 2 491 | 78 | 6.2e-7 | 8.8 |
+//! | on | 2 (and 5: identical) | 1e3 | 1 193 | 1 802 | 126 | 1.9e-6 | 1.5 |
+//! | on | 2 | 1e4 | 1 361 | 2 263 | 245 | 4.3e-6 | 12.4 |
+//!
+//! Two causes, both legitimately removable:
+//!
+//! 1. **BDF orders 3–5 on an undamped structure.** The FE model has modes up to ~10⁶–10⁷ rad/s
+//!    (shell membrane/drilling, the penalty springs on nodal masses of ~1e-7 t) that the motion
+//!    does not excite. BDF3–5 are not A-stable: their stability regions miss a sector around the
+//!    imaginary axis, and on an undamped mode `hω` must stay small or the mode grows; CVODE's error
+//!    test then keeps `h` near 1e-8 s while the order climbs (15 081 steps, and 307 986 when a
+//!    looser velocity tolerance lets it climb further). Stability-limit detection
+//!    (`CVodeSetStabLimDet`) does not cure it (22 937). BDF2 is A-stable and damps the unresolved
+//!    modes numerically (the ROM has none of them: its highest mode is the truncation's):
+//!    **max order 2** ([`DEFAULT_MAX_ORDER`]), 10× fewer steps. With friction on the order never
+//!    rose above 2 anyway (the −1/τ eigenvalues of open and sliding pairs).
+//! 2. **The velocity tolerance.** With one number for both (vs = 1 1/s, velocity atol 1e-6 mm/s)
+//!    every mode above 0.16 Hz is held to atol/ω in displacement — 1e-12 mm for a 10⁶ rad/s mode
+//!    — and even BDF2 needs 25 000 steps. vs = ω_ref makes the displacement tolerance rule modes
+//!    below ω_ref and the velocity tolerance modes above it (see [`DEFAULT_VELOCITY_SCALE`]):
+//!    **vs = 1e3 1/s** (ω_ref ≈ 160 Hz, between the friction bar's first two fixed-interface
+//!    modes, 87 and 217 Hz); 1e4 saves nothing more (more Newton failures).
+//!
+//! Newton is not the bottleneck: 1.1–1.6 iterations per step, and the convergence failures
+//! (contact pairs opening/closing within a step) cost ~10 % of the steps. With these defaults the
+//! full friction bar runs 0.2 s in 28 000–38 000 steps (~20 s CPU) and the TVD ROM (r = 28) in
+//! 7 000–11 000 steps; the same settings apply to both (tolerances in mm of the physical field,
+//! [`OdeProblem::atol_scale`]). Accuracy: see `cases/reference/SOURCE.md` (default vs 100×
+//! tighter tolerances).
 
 use crate::error::Error;
 use crate::friction::{evaluate_pairs, PairLaw, PairState, DEFAULT_TAU};
 use crate::ode::{CallbackError, OdeOptions, OdeProblem, OdeStats, Stop};
 use crate::sundials::Cvode;
 use crate::system::SecondOrderSystem;
+
+/// Default [`ProblemOptions::velocity_scale`], 1/s: velocities are held to `atol · ω_ref` with
+/// ω_ref = 1e3 rad/s (160 Hz, between the friction bar's 1st and 2nd fixed-interface modes,
+/// 87 and 217 Hz). A mode of circular frequency ω and displacement error ε has a velocity error
+/// ω ε, so modes below ω_ref are controlled by the displacement tolerance (ε ≤ atol) and modes
+/// above by the velocity tolerance (ε ≤ atol · ω_ref/ω, tighter). With ω_ref = 1 rad/s (one
+/// number for both, the paper's Table 1 read literally) every mode above 0.16 Hz — all of them —
+/// is held to atol/ω in displacement, 10⁻¹¹ mm for a 1 MHz shell mode: see the module docs.
+pub const DEFAULT_VELOCITY_SCALE: f64 = 1e3;
+
+/// Default maximum BDF order of [`TransientOptions`]: 2 (see the module docs — BDF orders 3–5
+/// are not A-stable, and the undamped FE model's high-frequency modes on the imaginary axis
+/// then force steps of ~1e-8 s).
+pub const DEFAULT_MAX_ORDER: usize = 2;
 
 /// Options of the mechanical problem.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
@@ -102,7 +165,7 @@ impl Default for ProblemOptions {
             tau: DEFAULT_TAU,
             slip_scale: 1e-3,
             energy_scale: 1e-3,
-            velocity_scale: 1.0,
+            velocity_scale: DEFAULT_VELOCITY_SCALE,
         }
     }
 }
@@ -605,8 +668,9 @@ impl<S: SecondOrderSystem> OdeProblem for MechanicalOde<S> {
 }
 
 /// Options of [`run`]. Defaults: the integrator's defaults ([`OdeOptions::default`]: BDF,
-/// Newton with the structured solve, rtol 1e-8, atol 1e-6 — the paper's Table 1), friction on,
-/// events off, τ = 1e-6 s, outputs every 1e-4 s, the case's end time.
+/// Newton with the structured solve, rtol 1e-8, atol 1e-6 — the paper's Table 1) except the
+/// maximum order [`DEFAULT_MAX_ORDER`] = 2, velocity tolerance [`DEFAULT_VELOCITY_SCALE`] × atol,
+/// friction on, events off, τ = 1e-6 s, outputs every 1e-4 s, the case's end time.
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct TransientOptions {
     /// Integrator options.
@@ -622,7 +686,10 @@ pub struct TransientOptions {
 impl Default for TransientOptions {
     fn default() -> Self {
         TransientOptions {
-            ode: OdeOptions::default(),
+            ode: OdeOptions {
+                max_order: DEFAULT_MAX_ORDER,
+                ..OdeOptions::default()
+            },
             problem: ProblemOptions::default(),
             output_step: 1e-4,
             end_time: None,

@@ -1,0 +1,170 @@
+//! Transient runs against the stored full-FE reference curves of `cases/reference/` (see its
+//! SOURCE.md for the commands, tolerances and the convergence study).
+//!
+//! - A short window of the full model is re-run and compared with the stored curve: it checks
+//!   that the engine still produces the reference (a regression test), at a tolerance above the
+//!   reference's own integration error (the default-vs-100×-tighter difference over that window).
+//! - Reduced models (TVD basis, K-weighted POD) are compared with the stored full-FE curves over
+//!   the whole 0.2 s: g = 0 (Craig–Bampton only) misses the contact force by a factor of ~30, the
+//!   w(g)-chosen g (w ≥ 0.999, g = 12) by ~20 % in ‖f_c‖ (the static study finds the same gap,
+//!   see `jointrom::study`), and the largest POD basis (g = 48) meets the 2 %.
+
+use jointrom::reduction::{build_basis, BasisKind, BasisOptions, ReducedModel};
+use jointrom::system::{FullSystem, ReducedSystem};
+use jointrom::transient::{run, Curves, TransientOptions};
+use jointrom::Model;
+use serde_json::Value;
+
+struct Reference {
+    t: Vec<f64>,
+    contact_force_norm: Vec<f64>,
+    friction_force_norm: Vec<f64>,
+    master_uy: Vec<f64>,
+}
+
+fn reference(name: &str) -> Reference {
+    let path = format!("{}/cases/reference/{name}.json", env!("CARGO_MANIFEST_DIR"));
+    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{path}: {e}"));
+    let v: Value = serde_json::from_str(&text).unwrap();
+    let arr = |k: &str| -> Vec<f64> {
+        v[k].as_array()
+            .unwrap_or_else(|| panic!("{path}: no array {k}"))
+            .iter()
+            .map(|x| x.as_f64().unwrap())
+            .collect()
+    };
+    Reference {
+        t: arr("t"),
+        contact_force_norm: arr("contact_force_norm"),
+        friction_force_norm: arr("friction_force_norm"),
+        master_uy: arr("master_uy"),
+    }
+}
+
+/// Relative L2 difference over the first `n` samples: `‖a − b‖₂ / ‖b‖₂`.
+fn rel_l2(a: &[f64], b: &[f64], n: usize) -> f64 {
+    let num: f64 = (0..n).map(|i| (a[i] - b[i]).powi(2)).sum();
+    let den: f64 = (0..n).map(|i| b[i].powi(2)).sum();
+    (num / den).sqrt()
+}
+
+/// (‖f_c‖, master uy, ‖f_R‖) relative L2 differences of a run against a reference over the
+/// run's outputs (same output times).
+fn errors(c: &Curves, r: &Reference) -> (f64, f64, f64) {
+    let n = c.t.len().min(r.t.len());
+    for i in 0..n {
+        assert!(
+            (c.t[i] - r.t[i]).abs() < 1e-9,
+            "output times differ at {i}: {} vs {}",
+            c.t[i],
+            r.t[i]
+        );
+    }
+    let fr = if r.friction_force_norm[..n].iter().any(|&x| x != 0.0) {
+        rel_l2(&c.friction_force_norm, &r.friction_force_norm, n)
+    } else {
+        0.0
+    };
+    (
+        rel_l2(&c.contact_force_norm, &r.contact_force_norm, n),
+        rel_l2(&c.master_uy, &r.master_uy, n),
+        fr,
+    )
+}
+
+fn options(friction: bool, end: Option<f64>) -> TransientOptions {
+    let mut o = TransientOptions {
+        end_time: end,
+        ..TransientOptions::default()
+    };
+    o.problem.friction = friction;
+    o
+}
+
+fn rom_errors(friction: bool, g: Option<usize>, r: &Reference) -> (usize, f64, f64, f64) {
+    let model = Model::from_case_name("friction_bar").unwrap();
+    let basis = build_basis(
+        &model,
+        BasisKind::Tvd,
+        &BasisOptions {
+            g,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    let g_used = basis.g;
+    let rom = ReducedModel::new(&model, basis.phi).unwrap();
+    let sys = ReducedSystem::new(&model, &rom).unwrap();
+    let res = run(sys, &options(friction, None)).unwrap();
+    assert_eq!(
+        res.curves.t.len(),
+        r.t.len(),
+        "the ROM covers the reference window"
+    );
+    let (fc, uy, fr) = errors(&res.curves, r);
+    eprintln!(
+        "friction {friction}, g = {g_used} (r = {}): ‖f_c‖ {fc:.4}, uy {uy:.2e}, ‖f_R‖ {fr:.4}; {} steps, {:.2} s",
+        rom.dim(),
+        res.stats.steps,
+        res.wall_s
+    );
+    (g_used, fc, uy, fr)
+}
+
+/// The full model over the first 0.01 s reproduces the stored curves (same defaults); the
+/// default-vs-tight difference of the reference over this window bounds the tolerance.
+#[test]
+fn full_model_short_window_reproduces_the_stored_reference() {
+    let model = Model::from_case_name("friction_bar").unwrap();
+    for (friction, name) in [
+        (false, "friction_bar_full_friction_off"),
+        (true, "friction_bar_full_friction_on"),
+    ] {
+        let r = reference(name);
+        let sys = FullSystem::new(&model).unwrap();
+        let res = run(sys, &options(friction, Some(0.01))).unwrap();
+        assert_eq!(res.curves.t.len(), 101);
+        let (fc, uy, fr) = errors(&res.curves, &r);
+        eprintln!(
+            "{name}: ‖f_c‖ {fc:.2e}, uy {uy:.2e}, ‖f_R‖ {fr:.2e}; {} steps, {:.2} s",
+            res.stats.steps, res.wall_s
+        );
+        assert!(
+            fc < 1e-3 && uy < 1e-4 && fr < 1e-3,
+            "{name}: {fc} {uy} {fr}"
+        );
+    }
+}
+
+/// Friction off (the paper's Section 4.1.3 comparison): g = 0 fails, the w(g)-chosen g is ~20 %
+/// off in ‖f_c‖ (the 2 % is not met), g = 48 meets it.
+#[test]
+fn rom_against_full_reference_friction_off() {
+    let r = reference("friction_bar_full_friction_off");
+    let (_, fc0, uy0, _) = rom_errors(false, Some(0), &r);
+    assert!(fc0 > 5.0 && uy0 > 0.2, "g = 0: {fc0} {uy0}");
+    let (g, fc, uy, _) = rom_errors(false, None, &r);
+    assert!(g > 0 && g < 48);
+    // Measured 0.233 / 3.7e-3: the 2 % holds for uy, not for ‖f_c‖.
+    assert!(fc < 0.3 && uy < 0.01, "chosen g = {g}: {fc} {uy}");
+    let (_, fc48, uy48, _) = rom_errors(false, Some(48), &r);
+    // Measured 0.0133 / 1e-5.
+    assert!(fc48 < 0.02 && uy48 < 1e-3, "g = 48: {fc48} {uy48}");
+}
+
+/// Friction on: the same picture for ‖f_c‖, uy and ‖f_R‖.
+#[test]
+fn rom_against_full_reference_friction_on() {
+    let r = reference("friction_bar_full_friction_on");
+    let (_, fc0, uy0, fr0) = rom_errors(true, Some(0), &r);
+    assert!(
+        fc0 > 5.0 && uy0 > 0.2 && fr0 > 5.0,
+        "g = 0: {fc0} {uy0} {fr0}"
+    );
+    let (g, fc, uy, fr) = rom_errors(true, None, &r);
+    // Measured 0.220 / 4.4e-3 / 0.219.
+    assert!(
+        fc < 0.3 && uy < 0.01 && fr < 0.3,
+        "chosen g = {g}: {fc} {uy} {fr}"
+    );
+}
