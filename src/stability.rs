@@ -226,6 +226,9 @@ pub struct SweepOptions {
     pub rtol: f64,
     /// Absolute tolerance (mm of the physical field; see [`crate::transient`]).
     pub atol: f64,
+    /// Velocity tolerance per displacement tolerance, 1/s
+    /// ([`crate::transient::ProblemOptions::velocity_scale`]).
+    pub velocity_scale: f64,
     /// CVODE's maximum steps per output interval.
     pub max_steps: usize,
     /// Wall-clock budget per cell, s.
@@ -258,6 +261,7 @@ impl Default for SweepOptions {
             full_output_step: 1e-5,
             rtol: 1e-8,
             atol: 1e-6,
+            velocity_scale: crate::transient::DEFAULT_VELOCITY_SCALE,
             max_steps: 20_000,
             budget_s: 20.0,
             reference_factor: 100.0,
@@ -729,6 +733,7 @@ pub fn run_sweep(case: &Case, opts: &SweepOptions) -> Result<Sweep, Error> {
                         problem: ProblemOptions {
                             friction,
                             events: false,
+                            velocity_scale: opts.velocity_scale,
                             ..ProblemOptions::default()
                         },
                         ode: OdeOptions {
@@ -787,6 +792,7 @@ pub fn run_sweep(case: &Case, opts: &SweepOptions) -> Result<Sweep, Error> {
                                 problem: ProblemOptions {
                                     friction,
                                     events,
+                                    velocity_scale: opts.velocity_scale,
                                     ..ProblemOptions::default()
                                 },
                                 ode: OdeOptions {
@@ -1221,6 +1227,9 @@ pub struct StabilityArgs {
     /// Absolute tolerance.
     #[arg(long, default_value_t = 1e-6)]
     pub atol: f64,
+    /// Velocity tolerance per displacement tolerance, 1/s (1: the paper's one number).
+    #[arg(long, default_value_t = crate::transient::DEFAULT_VELOCITY_SCALE)]
+    pub velocity_scale: f64,
     /// CVODE maximum steps per output interval.
     #[arg(long, default_value_t = 20_000)]
     pub max_steps: usize,
@@ -1277,6 +1286,7 @@ impl StabilityArgs {
             full_output_step: self.full_output_step,
             rtol: self.rtol,
             atol: self.atol,
+            velocity_scale: self.velocity_scale,
             max_steps: self.max_steps,
             budget_s: self.budget,
             reference_factor: self.reference_factor,

@@ -30,6 +30,10 @@ fn tiny_sweep_reports_failures_as_cells() {
         max_orders: vec![5],
         end_time: 1e-3,
         max_steps: 100,
+        // The paper's single tolerance for displacements and velocities: at k_n = 1e6 N/mm the
+        // default velocity tolerance (1e-3 mm/s) leaves the penalty oscillation of the first
+        // millisecond unresolved (measured: 124 % ‖f_c‖ error against the 100× tighter run).
+        velocity_scale: 1.0,
         budget_s: 10.0,
         reference_budget_s: 10.0,
         ..SweepOptions::default()
