@@ -146,9 +146,19 @@ pub(crate) fn sym_mul_compensated(
 /// Solves `A X = B` for all columns of `b` with the factorization `chol` of `a`, refined
 /// [`REFINEMENT_STEPS`] times with double-double residuals.
 pub(crate) fn solve_refined(a: &SymCsc, chol: &SparseCholesky, b: &Mat<f64>) -> Mat<f64> {
+    solve_refined_steps(a, chol, b, REFINEMENT_STEPS)
+}
+
+/// [`solve_refined`] with `steps` refinement steps.
+pub(crate) fn solve_refined_steps(
+    a: &SymCsc,
+    chol: &SparseCholesky,
+    b: &Mat<f64>,
+    steps: usize,
+) -> Mat<f64> {
     let mut x = b.clone();
     chol.solve_in_place(&mut x);
-    for _ in 0..REFINEMENT_STEPS {
+    for _ in 0..steps {
         let mut r = sym_mul_compensated(a, x.as_ref(), -1.0, Some(b.as_ref()));
         chol.solve_in_place(&mut r);
         x += &r;

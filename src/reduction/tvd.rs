@@ -62,7 +62,7 @@ use crate::joint::{JointOperator, NORMAL, T1, T2};
 use crate::model::Model;
 use crate::statics::{sym_mul_mat, sym_mul_vec_into, SparseCholesky};
 
-use super::alldof::solve_refined;
+use super::alldof::solve_refined_steps;
 
 /// Options of [`trial_vector_derivatives`]. Defaults: `tol = 1e-6`, `zero_gap_active = true`,
 /// `tangential = false`.
@@ -293,7 +293,7 @@ pub fn trial_vector_derivatives(
     if !static_cols.is_empty() {
         let chol = SparseCholesky::new(&model.stiffness)?;
         let bt = joint_rows_transposed(joint, &used, n);
-        let z = solve_refined(&model.stiffness, &chol, &bt);
+        let z = solve_refined_steps(&model.stiffness, &chol, &bt, 1);
         let g = symmetric(&rows_times(joint, &used, z.as_ref()));
         let pc = Mat::from_fn(m, static_cols.len(), |r, c| coef_col(static_cols[c])[r]);
         let scaled = normalize(&g, pc, &static_cols, &index, &mut k_norms)?;
