@@ -344,22 +344,8 @@ pub fn trial_vector_derivatives(
         }
         let mut z = shifted_solve(model, om2, &rhs, &mut lu_symbolic, i)?;
         let kz = sym_mul_mat(&model.stiffness, z.as_ref());
+        scale_to_unit_energy(&mut z, &kz, &mode_cols, &index, &mut k_norms)?;
         for (a, &c) in mode_cols.iter().enumerate() {
-            let e: f64 = z
-                .col(a)
-                .iter()
-                .zip(kz.col(a).iter())
-                .map(|(x, y)| x * y)
-                .sum();
-            if !(e.is_finite() && e > 0.0) {
-                return Err(Error::LinearAlgebra(format!(
-                    "TVD column {c} ({:?}) has strain energy {e:e}; K is not positive definite",
-                    index[c]
-                )));
-            }
-            let s = e.sqrt();
-            z.col_mut(a).iter_mut().for_each(|v| *v /= s);
-            k_norms[c] = s;
             x.col_mut(c).copy_from(z.col(a));
         }
     }
@@ -436,11 +422,24 @@ fn normalize(
     k_norms: &mut [f64],
 ) -> Result<Mat<f64>, Error> {
     let gq = g * &q;
+    scale_to_unit_energy(&mut q, &gq, cols, index, k_norms)?;
+    Ok(q)
+}
+
+/// Scales each column `a` of `q` by `sqrt(q_aᵀ (Aq)_a)` (its energy; `aq = A q`), storing the
+/// factor in `k_norms[cols[a]]`; a non-positive energy means A is not positive definite.
+fn scale_to_unit_energy(
+    q: &mut Mat<f64>,
+    aq: &Mat<f64>,
+    cols: &[usize],
+    index: &[TvdIndex],
+    k_norms: &mut [f64],
+) -> Result<(), Error> {
     for (a, &c) in cols.iter().enumerate() {
         let e: f64 = q
             .col(a)
             .iter()
-            .zip(gq.col(a).iter())
+            .zip(aq.col(a).iter())
             .map(|(x, y)| x * y)
             .sum();
         if !(e.is_finite() && e > 0.0) {
@@ -453,7 +452,7 @@ fn normalize(
         q.col_mut(a).iter_mut().for_each(|v| *v /= s);
         k_norms[c] = s;
     }
-    Ok(q)
+    Ok(())
 }
 
 /// Solves `(K − Ω² M) Z = rhs` by sparse LU (symbolic analysis shared through `symbolic`) and
