@@ -43,6 +43,8 @@ pub struct Series {
     pub points: Vec<(f64, f64)>,
     /// Draw a small circle at every point too.
     pub markers: bool,
+    /// Join the points by a line (`false`: a scatter of markers).
+    pub line: bool,
 }
 
 impl Series {
@@ -52,6 +54,15 @@ impl Series {
             label: label.into(),
             points,
             markers: true,
+            line: true,
+        }
+    }
+
+    /// A scatter: markers only, no connecting line.
+    pub fn scatter(label: impl Into<String>, points: Vec<(f64, f64)>) -> Series {
+        Series {
+            line: false,
+            ..Series::new(label, points)
         }
     }
 }
@@ -95,6 +106,8 @@ pub struct LineChart {
     pub series: Vec<Series>,
     /// Horizontal reference lines.
     pub references: Vec<Reference>,
+    /// Vertical reference lines (`value` is an x value).
+    pub x_references: Vec<Reference>,
     /// Fixed y range `(min, max)`; `None`: from the data (with a margin).
     pub y_range: Option<(f64, f64)>,
     /// Image size in pixels (SVG user units).
@@ -132,6 +145,7 @@ impl LineChart {
             y_log: false,
             series: Vec::new(),
             references: Vec::new(),
+            x_references: Vec::new(),
             y_range: None,
             size: (960, 600),
             legend: LegendPosition::UpperRight,
@@ -193,6 +207,11 @@ impl LineChart {
                 yr = (yr.0.min(r.value), yr.1.max(r.value));
             }
         }
+        for r in &self.x_references {
+            if r.value.is_finite() && (!self.x_log || r.value > 0.0) {
+                xr = (xr.0.min(r.value), xr.1.max(r.value));
+            }
+        }
         if let Some((lo, hi)) = self.y_range {
             if !(lo < hi && lo.is_finite() && hi.is_finite() && (!self.y_log || lo > 0.0)) {
                 return Err(format!(
@@ -214,10 +233,12 @@ impl LineChart {
     {
         let ((x0, x1), (y0, y1)) = self.ranges()?;
         match (self.x_log, self.y_log) {
-            (false, false) => self.draw_in(root, x0..x1, y0..y1),
-            (false, true) => self.draw_in(root, x0..x1, (y0..y1).log_scale()),
-            (true, false) => self.draw_in(root, (x0..x1).log_scale(), y0..y1),
-            (true, true) => self.draw_in(root, (x0..x1).log_scale(), (y0..y1).log_scale()),
+            (false, false) => self.draw_in(root, x0..x1, y0..y1, (y0, y1)),
+            (false, true) => self.draw_in(root, x0..x1, (y0..y1).log_scale(), (y0, y1)),
+            (true, false) => self.draw_in(root, (x0..x1).log_scale(), y0..y1, (y0, y1)),
+            (true, true) => {
+                self.draw_in(root, (x0..x1).log_scale(), (y0..y1).log_scale(), (y0, y1))
+            }
         }
     }
 
@@ -226,6 +247,7 @@ impl LineChart {
         root: DrawingArea<DB, Shift>,
         xs: XS,
         ys: YS,
+        (ylo, yhi): (f64, f64),
     ) -> Result<(), String>
     where
         DB: DrawingBackend,
@@ -269,17 +291,29 @@ impl LineChart {
                 }
             }
             for (i, run) in runs.iter().enumerate() {
+                let width = if s.line { 2 } else { 0 };
                 let drawn = chart
-                    .draw_series(LineSeries::new(run.iter().copied(), color.stroke_width(2)))
+                    .draw_series(LineSeries::new(
+                        run.iter().copied().filter(|_| s.line),
+                        color.stroke_width(width),
+                    ))
                     .map_err(|e| err(&e))?;
-                if i == 0 {
+                if i == 0 && !s.line {
+                    drawn
+                        .label(s.label.as_str())
+                        .legend(move |(x, y)| Circle::new((x + 10, y), 3, color.filled()));
+                } else if i == 0 {
                     drawn.label(s.label.as_str()).legend(move |(x, y)| {
                         PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2))
                     });
                 }
                 if s.markers {
                     chart
-                        .draw_series(run.iter().map(|&p| Circle::new(p, 3, color.filled())))
+                        .draw_series(
+                            run.iter().map(|&p| {
+                                Circle::new(p, if s.line { 3 } else { 5 }, color.filled())
+                            }),
+                        )
                         .map_err(|e| err(&e))?;
                 }
             }
@@ -300,6 +334,25 @@ impl LineChart {
                 .map_err(|e| err(&e))?
                 .label(r.label.as_str())
                 .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
+        }
+        for r in &self.x_references {
+            if !(r.value.is_finite() && (!self.x_log || r.value > 0.0)) {
+                continue;
+            }
+            let [r_, g_, b_] = r.color.unwrap_or([0, 0, 0]);
+            let style = RGBColor(r_, g_, b_).stroke_width(if r.color.is_some() { 2 } else { 1 });
+            chart
+                .draw_series(DashedLineSeries::new(
+                    [(r.value, ylo), (r.value, yhi)],
+                    8,
+                    5,
+                    style,
+                ))
+                .map_err(|e| err(&e))?
+                .label(r.label.as_str())
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x + 10, y - 6), (x + 10, y + 6)], style)
+                });
         }
         if !self.series.is_empty() || !self.references.is_empty() {
             chart

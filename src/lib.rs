@@ -40,6 +40,7 @@ pub mod model;
 pub mod modes;
 pub mod ode;
 pub mod reduction;
+pub mod report;
 pub mod stability;
 pub mod statics;
 pub mod study;

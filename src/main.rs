@@ -11,7 +11,7 @@ use jointrom::ode::{Iteration, NewtonLinear};
 use jointrom::reduction::{build_basis, BasisKind, BasisOptions, ReducedModel};
 use jointrom::system::{FullSystem, ReducedSystem};
 use jointrom::transient::{self, TransientOptions};
-use jointrom::{contact, study, Error, Interface, Model};
+use jointrom::{contact, report, study, Error, Interface, Model};
 
 #[derive(Parser)]
 #[command(
@@ -183,15 +183,22 @@ enum Command {
         #[arg(long)]
         out: Option<PathBuf>,
     },
-    /// The main job on a case (default: the friction bar): model, modes, statics, results.json.
+    /// The main job on a case (default: the friction bar): static study, full FE and reduced
+    /// transients, speed against accuracy → DIR/CASE/report.md, charts, results.json.
     Run {
         /// Case file path or built-in name.
         #[arg(default_value = "friction_bar")]
         case: String,
-        /// Output folder (results.json is written there).
+        /// Output folder (the report is written to DIR/CASE).
         #[arg(long, default_value = "out")]
         out: PathBuf,
-        /// One JSON document on stdout.
+        /// Short variant: 0.02 s window, study g ≤ 20 (well under 20 s).
+        #[arg(long)]
+        quick: bool,
+        /// Folder of stored stability maps copied into the report.
+        #[arg(long, default_value = "results/stability")]
+        stability_dir: PathBuf,
+        /// One JSON document on stdout (results.json).
         #[arg(long)]
         json: bool,
     },
@@ -512,7 +519,13 @@ fn run(command: Command) -> Result<(), Error> {
             };
             transient_command(&case, &args, json, out)?;
         }
-        Command::Run { case, out, json } => {
+        Command::Run {
+            case,
+            out,
+            quick,
+            stability_dir,
+            json,
+        } => {
             let t0 = Instant::now();
             let model = Model::from_case_name(&case)?;
             let t_assembly = t0.elapsed().as_secs_f64();
@@ -521,59 +534,63 @@ fn run(command: Command) -> Result<(), Error> {
             let free = model.modes(10, Interface::Free)?;
             let t_modes = t1.elapsed().as_secs_f64();
             let statics = static_json(&model, 1.0)?;
-            let result = json!({
-                "info": info_json(&model),
-                "fixed_interface_frequencies_hz": fixed.frequencies_hz,
-                "free_interface_frequencies_hz": free.frequencies_hz,
-                "linear_static": statics,
-                "timing_s": {"assembly": t_assembly, "modes": t_modes},
-            });
+            let mut extra = serde_json::Map::new();
+            extra.insert("info".into(), info_json(&model));
+            extra.insert(
+                "fixed_interface_frequencies_hz".into(),
+                json!(fixed.frequencies_hz),
+            );
+            extra.insert(
+                "free_interface_frequencies_hz".into(),
+                json!(free.frequencies_hz),
+            );
+            extra.insert("linear_static".into(), statics);
+            extra.insert(
+                "timing_s".into(),
+                json!({"assembly": t_assembly, "modes": t_modes}),
+            );
             let dir = out.join(&model.case.name);
-            std::fs::create_dir_all(&dir).map_err(|e| Error::Io {
-                file: dir.clone(),
-                source: e,
-            })?;
-            let file = dir.join("results.json");
-            std::fs::write(
-                &file,
-                serde_json::to_string_pretty(&result).expect("JSON values serialise"),
-            )
-            .map_err(|e| Error::Io {
-                file: file.clone(),
-                source: e,
-            })?;
+            let opts = report::ReportOptions {
+                quick,
+                stability_dir,
+                ..Default::default()
+            };
+            let rep = report::run_report(&model, &dir, &opts, extra)?;
             if json {
-                print_json(&result);
+                print_json(&serde_json::to_value(&rep).expect("the report serialises"));
             } else {
-                println!(
-                    "{}: {} DOF, {} joint pairs ({} joint DOF); assembly {:.1} ms, 20 modes {:.1} ms",
-                    model.case.name,
-                    model.dofs(),
-                    model.mesh.pairs.len(),
-                    model.joint_dofs(),
-                    t_assembly * 1e3,
-                    t_modes * 1e3
-                );
-                println!("fixed-interface modes (Hz):");
-                for (i, f) in fixed.frequencies_hz.iter().enumerate() {
-                    println!(
-                        "  {:>3}  {:>10.2}   free: {:>10.2}",
-                        i + 1,
-                        f,
-                        free.frequencies_hz[i]
-                    );
-                }
-                let u = &statics["master_displacement"];
-                println!(
-                    "linear static master displacement: uy = {:.5e} mm, rx = {:.5e} rad",
-                    u[1].as_f64().unwrap_or(f64::NAN),
-                    u[3].as_f64().unwrap_or(f64::NAN)
-                );
-                println!("results written to {}", file.display());
+                print_report(&rep, &dir);
             }
         }
     }
     Ok(())
+}
+
+fn print_report(rep: &report::Report, dir: &std::path::Path) {
+    println!(
+        "{} — {} DOF, {} joint pairs; a-priori g = {} (w ≥ {}); window {} s; job {:.1} s",
+        rep.case, rep.dofs, rep.pairs, rep.g_chosen, rep.threshold, rep.end_time, rep.total_s
+    );
+    println!(
+        "  {:<10} {:>4} {:>5} {:<10} {:<10} {:>10} {:>10} {:>9} {:>9}",
+        "model", "g", "size", "iteration", "status", "err |f_c|", "err uy", "CPU s", "speed-up"
+    );
+    for r in &rep.runs {
+        let e = |v: Option<f64>| v.map_or("-".to_string(), |x| format!("{x:.2e}"));
+        println!(
+            "  {:<10} {:>4} {:>5} {:<10} {:<10} {:>10} {:>10} {:>9.3} {:>9}",
+            r.model,
+            r.g.map_or("-".to_string(), |g| g.to_string()),
+            r.size,
+            r.iteration,
+            r.status,
+            e(r.error_fc),
+            e(r.error_uy),
+            r.cpu_s,
+            r.speedup.map_or("-".to_string(), |x| format!("{x:.0}x"))
+        );
+    }
+    println!("report: {}", dir.join("report.md").display());
 }
 
 fn reduced_static(

@@ -114,7 +114,7 @@ use crate::ode::{CallbackError, Iteration, NewtonLinear, OdeOptions, OdeProblem,
 use crate::reduction::{build_basis, BasisKind, BasisOptions, ReducedModel};
 use crate::sundials::Cvode;
 use crate::system::{FullSystem, ReducedSystem, SecondOrderSystem};
-use crate::transient::{MechanicalOde, ProblemOptions};
+use crate::transient::{EnergySample, MechanicalOde, ProblemOptions};
 
 /// The model of a cell.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
@@ -318,12 +318,20 @@ pub struct Outcome {
     pub events_found: u64,
     /// Wall time of the integration (excluding building the system), s.
     pub wall_s: f64,
+    /// Process CPU time of the integration, s (10 ms resolution; NaN where unavailable).
+    pub cpu_s: f64,
     /// Output times, s.
     #[serde(skip)]
     pub t: Vec<f64>,
     /// ‖f_c‖ at the output times, N.
     #[serde(skip)]
     pub fc: Vec<f64>,
+    /// ‖f_R‖ at the output times, N.
+    #[serde(skip)]
+    pub fr: Vec<f64>,
+    /// Master u_y at the output times, mm.
+    #[serde(skip)]
+    pub uy: Vec<f64>,
 }
 
 impl Outcome {
@@ -331,6 +339,37 @@ impl Outcome {
     pub fn ok(&self) -> bool {
         self.status == "ok"
     }
+
+    fn push(&mut self, s: EnergySample) {
+        self.t.push(s.t);
+        self.fc.push(s.contact_force_norm);
+        self.fr.push(s.friction_force_norm);
+        self.uy.push(s.master[1]);
+    }
+}
+
+/// Integrates `sys` from rest over `[0, end]` with outputs every `output_step` under a
+/// wall-clock budget (checked in every right-hand side). Never fails as a whole: a setup or
+/// integration failure, or the budget running out (`budget`), becomes the outcome's status, with
+/// the curves up to the time reached.
+pub fn integrate_budgeted<S: SecondOrderSystem>(
+    sys: Result<S, Error>,
+    problem: &ProblemOptions,
+    ode: &OdeOptions,
+    end: f64,
+    output_step: f64,
+    budget_s: f64,
+) -> Outcome {
+    integrate(
+        sys,
+        &RunSpec {
+            problem: *problem,
+            ode: ode.clone(),
+            end,
+            output_step,
+            budget_s,
+        },
+    )
 }
 
 /// A reference run.
@@ -478,8 +517,11 @@ fn integrate<S: SecondOrderSystem>(sys: Result<S, Error>, spec: &RunSpec) -> Out
         stats: OdeStats::default(),
         events_found: 0,
         wall_s: 0.0,
+        cpu_s: 0.0,
         t: Vec::new(),
         fc: Vec::new(),
+        fr: Vec::new(),
+        uy: Vec::new(),
     };
     let fail = |mut out: Outcome, e: Error| {
         out.status = classify(&e);
@@ -492,9 +534,9 @@ fn integrate<S: SecondOrderSystem>(sys: Result<S, Error>, spec: &RunSpec) -> Out
     };
     let mut ode = ode;
     let y0 = ode.initial_state();
-    out.t.push(0.0);
-    out.fc.push(ode.sample(0.0, &y0).contact_force_norm);
+    out.push(ode.sample(0.0, &y0));
     let wall = Instant::now();
+    let cpu = crate::transient::cpu_time();
     let problem = Budgeted {
         inner: ode,
         deadline: wall + std::time::Duration::from_secs_f64(spec.budget_s),
@@ -542,11 +584,10 @@ fn integrate<S: SecondOrderSystem>(sys: Result<S, Error>, spec: &RunSpec) -> Out
         }
         let t = cv.t();
         let y = cv.y().to_vec();
-        out.t.push(t);
-        out.fc
-            .push(cv.problem_mut().inner.sample(t, &y).contact_force_norm);
+        out.push(cv.problem_mut().inner.sample(t, &y));
     }
     out.wall_s = wall.elapsed().as_secs_f64();
+    out.cpu_s = crate::transient::cpu_time() - cpu;
     out.stats = cv.stats();
     out.t_reached = cv.t();
     if let Err(e) = result {

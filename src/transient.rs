@@ -765,8 +765,9 @@ pub struct TransientResult {
 /// Roots in a row at the same time after which [`run`] gives up.
 const MAX_STALLED_ROOTS: usize = 1000;
 
-/// Process CPU time (user + system), s, from `/proc/self/stat` (clock ticks of 1/100 s).
-fn cpu_time() -> f64 {
+/// Process CPU time (user + system), s, from `/proc/self/stat` (clock ticks of 1/100 s); NaN
+/// where unavailable.
+pub fn cpu_time() -> f64 {
     std::fs::read_to_string("/proc/self/stat")
         .ok()
         .and_then(|s| {

@@ -1,0 +1,120 @@
+//! The main job's report (`jointrom run --quick`): every chart and table is written, the numbers
+//! are consistent with each other and with the paper's qualitative claims on this window.
+
+use std::path::PathBuf;
+
+use jointrom::report::{run_report, ReportOptions};
+use jointrom::Model;
+
+fn tmp_dir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("jointrom-report-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    d
+}
+
+#[test]
+fn quick_report_on_the_friction_bar() {
+    let model = Model::from_case_name("friction_bar").unwrap();
+    let dir = tmp_dir("quick");
+    let opts = ReportOptions {
+        quick: true,
+        progress: false,
+        stability_dir: PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("results/stability"),
+        ..ReportOptions::default()
+    };
+    let mut extra = serde_json::Map::new();
+    extra.insert("marker".into(), serde_json::json!(42));
+    let rep = run_report(&model, &dir, &opts, extra).unwrap();
+
+    // Files: every chart as PNG and SVG, the study charts, the stored stability map, the texts.
+    for f in [
+        "report.md",
+        "results.json",
+        "fc_t.png",
+        "fc_t.svg",
+        "fr_t.png",
+        "uy_t.png",
+        "speed_accuracy.png",
+        "speed_accuracy.svg",
+        "study/fc_error.png",
+        "study/w.png",
+        "stability_status.png",
+    ] {
+        let p = dir.join(f);
+        let len = std::fs::metadata(&p)
+            .unwrap_or_else(|e| panic!("{} missing: {e}", p.display()))
+            .len();
+        assert!(
+            len > 1000,
+            "{} is suspiciously small ({len} bytes)",
+            p.display()
+        );
+    }
+    let md = std::fs::read_to_string(dir.join("report.md")).unwrap();
+    for needle in [
+        "speed_accuracy.png",
+        "fc_t.png",
+        "study/w.png",
+        "stability_status.png",
+    ] {
+        assert!(md.contains(needle), "report.md does not show {needle}");
+    }
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("results.json")).unwrap()).unwrap();
+    assert_eq!(json["marker"], 42, "extra fields reach results.json");
+    assert_eq!(json["g_chosen"].as_u64(), Some(rep.g_chosen as u64));
+
+    // The a-priori g is the smallest with w(g) ≥ threshold.
+    let g = rep.g_chosen;
+    assert!(g >= 1 && rep.w[g - 1] >= rep.threshold);
+    assert!(g == 1 || rep.w[g - 2] < rep.threshold);
+
+    // The full run is the reference and finished; the full run with functional iteration is
+    // recorded whatever its fate.
+    let full = &rep.runs[0];
+    assert_eq!((full.model.as_str(), full.status.as_str()), ("full", "ok"));
+    assert_eq!(full.size, model.dofs());
+    assert!(rep
+        .runs
+        .iter()
+        .any(|r| r.model == "full" && r.iteration == "functional"));
+    let run = |m: &str, g: usize, it: &str| {
+        rep.runs
+            .iter()
+            .find(|r| r.model == m && r.g == Some(g) && r.iteration == it)
+            .unwrap_or_else(|| panic!("no {m} g = {g} {it} run"))
+    };
+    // g = 0 misses the joint (the paper's point), all joint DOF reproduce it (within the
+    // integration tolerance), and the TVD ROMs sit in between.
+    let g0 = run("tvd", 0, "newton");
+    let all = run("alldof", model.joint.pairs(), "newton");
+    let chosen = run("tvd", g, "newton");
+    let e0 = g0.error_fc.unwrap();
+    let eall = all.error_fc.unwrap();
+    let ech = chosen.error_fc.unwrap();
+    assert!(e0 > 1.0, "g = 0 error {e0}");
+    assert!(eall < 1e-2, "all joint DOF error {eall}");
+    assert!(ech < e0 && ech > eall, "chosen g error {ech}");
+    assert!(all.error_uy.unwrap() < 1e-4);
+    // Functional and Newton iteration solve the same ROM: same curves within the tolerances.
+    let fun = run("tvd", g, "functional");
+    if fun.status == "ok" {
+        let d = jointrom::stability::relative_l2(&fun.t, &fun.fc, &chosen.t, &chosen.fc).unwrap();
+        assert!(d < 1e-2, "functional vs Newton ‖f_c‖ differ by {d}");
+    }
+    // Speed-ups are CPU ratios; the Pareto front is non-empty and not dominated.
+    for r in rep.runs.iter().filter(|r| r.speedup.is_some()) {
+        let s = r.speedup.unwrap();
+        assert!((s * r.cpu_s - full.cpu_s).abs() <= 1e-9 * full.cpu_s.max(1.0));
+    }
+    let front: Vec<_> = rep.runs.iter().filter(|r| r.pareto).collect();
+    assert!(!front.is_empty());
+    for p in &front {
+        let (c, e) = (p.cpu_s, p.error_fc.unwrap());
+        assert!(!rep
+            .runs
+            .iter()
+            .any(|r| r.status == "ok" && r.error_fc.is_some_and(|er| r.cpu_s < c && er < e)));
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
