@@ -115,6 +115,12 @@ impl Dot2 {
 
 /// `out[:, c] = start[:, c] + s · A x[:, c]` for every column, each entry accumulated in
 /// double-double and rounded once (A symmetric sparse, both triangles stored).
+///
+/// Row-oriented: column i of the symmetric A is its row i, so `out[i, :]` is one pass over
+/// column i with all right-hand sides at once. `s·x` is stored row-major and pre-split
+/// (Veltkamp), the accumulators are kept as separate `hi`/`lo` arrays over the columns, so the
+/// inner loop is the same straight-line TwoProduct + TwoSum on contiguous data for every column
+/// (vectorizable). The summation order per entry is the column order of A, as in [`Dot2`].
 pub(crate) fn sym_mul_compensated(
     a: &SymCsc,
     x: MatRef<'_, f64>,
@@ -122,25 +128,74 @@ pub(crate) fn sym_mul_compensated(
     start: Option<MatRef<'_, f64>>,
 ) -> Mat<f64> {
     let n = a.n;
-    let mut out = Mat::<f64>::zeros(n, x.ncols());
-    let mut acc = vec![Dot2::default(); n];
-    for c in 0..x.ncols() {
-        for (i, ai) in acc.iter_mut().enumerate() {
-            *ai = Dot2::new(start.map_or(0.0, |b| b[(i, c)]));
-        }
+    let w = x.ncols();
+    let mut out = Mat::<f64>::zeros(n, w);
+    if w == 0 {
+        return out;
+    }
+    // Row-major s·x, split into halves.
+    let mut xh = vec![0.0; n * w];
+    let mut xl = vec![0.0; n * w];
+    for c in 0..w {
         for j in 0..n {
-            let xj = s * x[(j, c)];
-            if xj != 0.0 {
-                for p in a.col_ptr[j]..a.col_ptr[j + 1] {
-                    acc[a.row_idx[p]].add_product(a.values[p], xj);
-                }
-            }
+            let (h, l) = split(s * x[(j, c)]);
+            xh[j * w + c] = h;
+            xl[j * w + c] = l;
         }
-        for i in 0..n {
-            out[(i, c)] = acc[i].value();
+    }
+    let mut hi = vec![0.0; w];
+    let mut lo = vec![0.0; w];
+    for i in 0..n {
+        for c in 0..w {
+            hi[c] = start.map_or(0.0, |b| b[(i, c)]);
+            lo[c] = 0.0;
+        }
+        for p in a.col_ptr[i]..a.col_ptr[i + 1] {
+            let av = a.values[p];
+            let (ah, al) = split(av);
+            let j = a.row_idx[p];
+            two_product_sums(
+                &mut hi,
+                &mut lo,
+                av,
+                ah,
+                al,
+                &xh[j * w..(j + 1) * w],
+                &xl[j * w..(j + 1) * w],
+            );
+        }
+        for c in 0..w {
+            out[(i, c)] = hi[c] + lo[c];
         }
     }
     out
+}
+
+/// `hi[c] + lo[c] += a · (bh[c] + bl[c])` for every c: Dekker's TwoProduct (`a = ah + al` and
+/// `b = bh + bl` are Veltkamp splits) and Knuth's TwoSum, the error terms summed into `lo` — the
+/// inner loop of [`sym_mul_compensated`]. Compiled for AVX-512 / AVX2 as well as the baseline
+/// and dispatched at run time (`multiversion`); the same IEEE operations on every path (no FMA
+/// contraction in Rust), so the result does not depend on the CPU.
+#[multiversion::multiversion(targets("x86_64+avx512f+avx512vl", "x86_64+avx2"))]
+fn two_product_sums(
+    hi: &mut [f64],
+    lo: &mut [f64],
+    a: f64,
+    ah: f64,
+    al: f64,
+    bh: &[f64],
+    bl: &[f64],
+) {
+    for ((h, l), (&bh, &bl)) in hi.iter_mut().zip(lo.iter_mut()).zip(bh.iter().zip(bl)) {
+        let b = bh + bl;
+        let prod = a * b;
+        let p_err = ((ah * bh - prod) + ah * bl + al * bh) + al * bl;
+        let sum = *h + prod;
+        let z = sum - *h;
+        let s_err = (*h - (sum - z)) + (prod - z);
+        *h = sum;
+        *l += s_err + p_err;
+    }
 }
 
 /// Solves `A X = B` for all columns of `b` with the factorization `chol` of `a`, refined

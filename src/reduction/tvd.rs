@@ -284,7 +284,11 @@ pub fn trial_vector_derivatives(
         vec![0.0; nb]
     };
 
-    let mut x = Mat::<f64>::zeros(n, cols);
+    let mut x = if cols > 0 && omega2.iter().all(|&o| o == 0.0) {
+        Mat::<f64>::zeros(0, 0) // replaced by the static product below
+    } else {
+        Mat::<f64>::zeros(n, cols)
+    };
     let mut k_norms = vec![0.0; cols];
     let mut factor = None;
     let coef_col = |c: usize| &coef[c * m..(c + 1) * m];
@@ -298,8 +302,13 @@ pub fn trial_vector_derivatives(
         let pc = Mat::from_fn(m, static_cols.len(), |r, c| coef_col(static_cols[c])[r]);
         let scaled = normalize(&g, pc, &static_cols, &index, &mut k_norms)?;
         let xs = &z * &scaled;
-        for (a, &c) in static_cols.iter().enumerate() {
-            x.col_mut(c).copy_from(xs.col(a));
+        if static_cols.len() == cols {
+            // All columns static (the default): the product is the whole TVD matrix.
+            x = xs;
+        } else {
+            for (a, &c) in static_cols.iter().enumerate() {
+                x.col_mut(c).copy_from(xs.col(a));
+            }
         }
         if static_cols.len() == cols {
             factor = Some(TvdFactor {
