@@ -8,7 +8,7 @@ use clap::{Parser, Subcommand, ValueEnum};
 use serde_json::{json, Value};
 
 use jointrom::ode::{Iteration, NewtonLinear};
-use jointrom::reduction::{build_basis, BasisKind, BasisOptions, ReducedModel};
+use jointrom::reduction::{build_basis, snapshot_basis, BasisKind, BasisOptions, ReducedModel};
 use jointrom::system::{FullSystem, ReducedSystem};
 use jointrom::transient::{self, TransientOptions};
 use jointrom::{contact, report, study, Error, Interface, Model};
@@ -136,13 +136,20 @@ enum Command {
     Transient {
         /// Case file path or built-in name.
         case: String,
-        /// full (FE model) or a reduced basis: tvd, tvd-plain, modes, jim, alldof (pod: needs
-        /// snapshots, not available here).
+        /// full (FE model) or a reduced basis: tvd, tvd-plain, modes, jim, alldof, pod (POD of
+        /// the displacement snapshots of a full-FE training run, paper Section 5.2).
         #[arg(long, default_value = "tvd")]
         model: String,
         /// Enrichment vectors of the basis; default: the smallest g with w(g) >= 0.999.
         #[arg(long)]
         g: Option<usize>,
+        /// `--model pod`: end of the full-FE training run, s (default: the run's end time).
+        #[arg(long)]
+        train_end: Option<f64>,
+        /// `--model pod`: about this many snapshots kept from the training run (every k-th output,
+        /// k = outputs / N).
+        #[arg(long, default_value_t = 200)]
+        snapshots: usize,
         /// Fixed-interface modes ν of the basis.
         #[arg(long, default_value_t = 10)]
         nu: usize,
@@ -488,6 +495,8 @@ fn run(command: Command) -> Result<(), Error> {
             case,
             model: model_name,
             g,
+            train_end,
+            snapshots,
             nu,
             iteration,
             friction,
@@ -505,6 +514,8 @@ fn run(command: Command) -> Result<(), Error> {
             let args = TransientArgs {
                 model: model_name,
                 g,
+                train_end,
+                snapshots,
                 nu,
                 iteration,
                 friction,
@@ -654,6 +665,8 @@ fn reduced_static(
 struct TransientArgs {
     model: String,
     g: Option<usize>,
+    train_end: Option<f64>,
+    snapshots: usize,
     nu: usize,
     iteration: String,
     friction: String,
@@ -739,25 +752,82 @@ fn transient_command(
     let opts = transient_options(a)?;
     let model = Model::from_case_name(case)?;
     let t0 = Instant::now();
-    let (res, basis_size, g_used) = match a.model.as_str() {
+    let (res, basis_size, g_used, training) = match a.model.as_str() {
         "full" => {
             if a.g.is_some() {
                 return Err(Error::Invalid(
                     "--g applies to reduced models, not --model full".into(),
                 ));
             }
+            if a.train_end.is_some() {
+                return Err(Error::Invalid(
+                    "--train-end applies to --model pod only".into(),
+                ));
+            }
             let sys = FullSystem::new(&model)?;
-            (transient::run(sys, &opts)?, model.dofs(), None)
+            (transient::run(sys, &opts)?, model.dofs(), None, None)
         }
         "pod" => {
-            return Err(Error::Invalid(
-                "--model pod needs snapshots of a full run; not available in `transient` yet"
-                    .into(),
-            ))
+            // Paper Section 5.2: the POD of displacement snapshots of a full-FE run (here over
+            // [0, train_end] with the same options), Euclidean, added to Craig–Bampton.
+            let train_end = match a.train_end {
+                Some(t) => positive("train-end", t)?,
+                None => opts.end_time.unwrap_or(model.case.end_time),
+            };
+            if a.snapshots < 2 {
+                return Err(Error::Invalid(format!(
+                    "--snapshots must be at least 2, got {}",
+                    a.snapshots
+                )));
+            }
+            let train_opts = TransientOptions {
+                end_time: Some(train_end),
+                ..opts.clone()
+            };
+            let outputs = (train_end / opts.output_step).ceil().max(1.0) as usize + 1;
+            let every = (outputs / a.snapshots).max(1);
+            let mut states: Vec<Vec<f64>> = Vec::new();
+            let mut k = 0usize;
+            let train = transient::run_observed(FullSystem::new(&model)?, &train_opts, |_, q| {
+                if k % every == 0 {
+                    states.push(q.to_vec());
+                }
+                k += 1;
+            })?;
+            let n = model.dofs();
+            let y = faer::Mat::from_fn(n, states.len(), |r, c| states[c][r]);
+            let basis = snapshot_basis(
+                &model,
+                y.as_ref(),
+                None,
+                &BasisOptions {
+                    g: a.g,
+                    nu: a.nu,
+                    ..Default::default()
+                },
+            )?;
+            let g_used = basis.g;
+            let training = json!({
+                "end_time": train_end,
+                "snapshots": states.len(),
+                "wall_s": train.wall_s,
+                "cpu_s": train.cpu_s,
+                "steps": train.stats.steps,
+                "w": basis.w,
+            });
+            let rom = ReducedModel::new(&model, basis.phi)?;
+            let r = rom.dim();
+            let sys = ReducedSystem::new(&model, &rom)?;
+            (transient::run(sys, &opts)?, r, Some(g_used), Some(training))
         }
         name => {
+            if a.train_end.is_some() {
+                return Err(Error::Invalid(
+                    "--train-end applies to --model pod only".into(),
+                ));
+            }
             let kind = BasisKind::from_name(name)
-                .map_err(|e| Error::Invalid(format!("--model: {e} (or full)")))?;
+                .map_err(|e| Error::Invalid(format!("--model: {e} (or full, pod)")))?;
             let basis = build_basis(
                 &model,
                 kind,
@@ -771,7 +841,7 @@ fn transient_command(
             let rom = ReducedModel::new(&model, basis.phi)?;
             let r = rom.dim();
             let sys = ReducedSystem::new(&model, &rom)?;
-            (transient::run(sys, &opts)?, r, Some(g_used))
+            (transient::run(sys, &opts)?, r, Some(g_used), None)
         }
     };
     let total_s = t0.elapsed().as_secs_f64();
@@ -789,6 +859,7 @@ fn transient_command(
         "total_s": total_s,
         "curves": c,
         "energy_balance": c.balance(),
+        "training": training,
     });
     if let Some(dir) = out {
         std::fs::create_dir_all(&dir).map_err(|e| Error::Io {

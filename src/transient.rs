@@ -793,6 +793,20 @@ pub fn run<S: SecondOrderSystem>(
     system: S,
     opts: &TransientOptions,
 ) -> Result<TransientResult, Error> {
+    run_observed(system, opts, |_, _| {})
+}
+
+/// [`run`], calling `observe(t, q)` with the system's coordinates `q` (the first `dim` entries
+/// of the state) at t = 0 and at every output time — e.g. to keep displacement snapshots of a
+/// full-FE run for a POD basis ([`crate::reduction::snapshot_basis`]).
+///
+/// # Errors
+/// As [`run`].
+pub fn run_observed<S: SecondOrderSystem>(
+    system: S,
+    opts: &TransientOptions,
+    mut observe: impl FnMut(f64, &[f64]),
+) -> Result<TransientResult, Error> {
     let end = opts.end_time.unwrap_or_else(|| system.end_time());
     if !(end.is_finite() && end > 0.0) {
         return Err(Error::Invalid(format!(
@@ -806,9 +820,11 @@ pub fn run<S: SecondOrderSystem>(
         )));
     }
     let mut ode = MechanicalOde::new(system, &opts.problem)?;
+    let dim = ode.coords();
     let y0 = ode.initial_state();
     let mut curves = Curves::default();
     curves.push(&ode.sample(0.0, &y0));
+    observe(0.0, &y0[..dim]);
     let wall = std::time::Instant::now();
     let cpu0 = cpu_time();
     let mut cv = Cvode::new(ode, 0.0, &y0, &opts.ode)?;
@@ -845,6 +861,7 @@ pub fn run<S: SecondOrderSystem>(
         let y = cv.y().to_vec();
         let s = cv.problem_mut().sample(t, &y);
         curves.push(&s);
+        observe(t, &y[..dim]);
     }
     let wall_s = wall.elapsed().as_secs_f64();
     let cpu_s = cpu_time() - cpu0;
