@@ -32,6 +32,7 @@ pub mod chart;
 pub mod contact;
 pub mod element;
 pub mod error;
+pub mod export;
 pub mod friction;
 pub mod heatmap;
 pub mod joint;

@@ -11,7 +11,7 @@ use jointrom::ode::{Iteration, NewtonLinear};
 use jointrom::reduction::{build_basis, snapshot_basis, BasisKind, BasisOptions, ReducedModel};
 use jointrom::system::{FullSystem, ReducedSystem};
 use jointrom::transient::{self, TransientOptions};
-use jointrom::{contact, report, study, Error, Interface, Model};
+use jointrom::{contact, export, report, study, Error, Interface, Model};
 
 #[derive(Parser)]
 #[command(
@@ -137,7 +137,8 @@ enum Command {
         /// Case file path or built-in name.
         case: String,
         /// full (FE model) or a reduced basis: tvd, tvd-plain, modes, jim, alldof, pod (POD of
-        /// the displacement snapshots of a full-FE training run, paper Section 5.2).
+        /// the displacement snapshots of a full-FE training run, paper Section 5.2), or
+        /// file:PATH (a reduced model written by `jointrom export`; CASE is still loaded).
         #[arg(long, default_value = "tvd")]
         model: String,
         /// Enrichment vectors of the basis; default: the smallest g with w(g) >= 0.999.
@@ -189,6 +190,24 @@ enum Command {
         /// Write curves.csv and transient.json into this folder.
         #[arg(long)]
         out: Option<PathBuf>,
+    },
+    /// Writes a reduced model as a versioned JSON file (schema `jointrom-rom` v1: M̃, K̃, BΦ,
+    /// master rows, reduced loads, contact law, load ramp; see `jointrom::export`).
+    Export {
+        /// Case file path or built-in name.
+        case: String,
+        /// Basis kind: tvd, tvd-plain, modes, jim, alldof.
+        #[arg(long, default_value = "tvd")]
+        basis: String,
+        /// Enrichment vectors g; default: the smallest g with w(g) >= 0.999.
+        #[arg(long)]
+        g: Option<usize>,
+        /// Fixed-interface modes ν.
+        #[arg(long, default_value_t = 10)]
+        nu: usize,
+        /// Output file.
+        #[arg(long)]
+        out: PathBuf,
     },
     /// The main job on a case (default: the friction bar): static study, full FE and reduced
     /// transients, speed against accuracy → DIR/CASE/report.md, charts, results.json.
@@ -530,6 +549,41 @@ fn run(command: Command) -> Result<(), Error> {
             };
             transient_command(&case, &args, json, out)?;
         }
+        Command::Export {
+            case,
+            basis,
+            g,
+            nu,
+            out,
+        } => {
+            let model = Model::from_case_name(&case)?;
+            let kind = BasisKind::from_name(&basis)
+                .map_err(|e| Error::Invalid(format!("--basis: {e}")))?;
+            let opts = BasisOptions {
+                g,
+                nu,
+                ..BasisOptions::default()
+            };
+            let b = build_basis(&model, kind, &opts)?;
+            let info = export::BasisInfo {
+                kind: kind.name().into(),
+                g: b.g,
+                nu,
+                threshold: opts.threshold,
+                w: b.w.clone(),
+            };
+            let rom = ReducedModel::new(&model, b.phi)?;
+            let file = export::RomFile::new(&model, &rom, info)?;
+            file.write(&out)?;
+            println!(
+                "{}: {} basis, g = {}, r = {} → {}",
+                model.case.name,
+                kind.name(),
+                file.basis.g,
+                file.dimension,
+                out.display()
+            );
+        }
         Command::Run {
             case,
             out,
@@ -819,6 +873,18 @@ fn transient_command(
             let r = rom.dim();
             let sys = ReducedSystem::new(&model, &rom)?;
             (transient::run(sys, &opts)?, r, Some(g_used), Some(training))
+        }
+        name if name.starts_with("file:") => {
+            // A reduced model exported by `jointrom export` (schema jointrom-rom v1).
+            if a.g.is_some() || a.train_end.is_some() {
+                return Err(Error::Invalid(
+                    "--g and --train-end do not apply to --model file:PATH".into(),
+                ));
+            }
+            let f = export::RomFile::read(std::path::Path::new(&name["file:".len()..]))?;
+            let r = f.dimension;
+            let g = f.basis.g;
+            (transient::run(f.system()?, &opts)?, r, Some(g), None)
         }
         name => {
             if a.train_end.is_some() {

@@ -357,19 +357,34 @@ pub struct ReducedSystem {
     mem: MemBuffer,
 }
 
+/// Everything a [`ReducedSystem`] is made of, independent of the full model (e.g. read back from
+/// an exported reduced model, [`crate::export`]).
+#[derive(Clone, Debug)]
+pub struct ReducedParts {
+    /// `K̃ = ΦᵀKΦ` (r × r), N/mm per unit coordinate².
+    pub k: Mat<f64>,
+    /// `M̃ = ΦᵀMΦ` (r × r), t per unit coordinate².
+    pub m: Mat<f64>,
+    /// `BΦ` (3w × r), rows normal, t1, t2 per pair, mm per unit coordinate.
+    pub b_phi: Mat<f64>,
+    /// Rows of Φ at the six master DOF (6 × r: ux, uy, uz (mm), rx, ry, rz (rad) per unit).
+    pub phi_master: Mat<f64>,
+    /// Largest absolute entry of each basis column (mm or rad per unit coordinate): the
+    /// coordinate scale of the absolute tolerance.
+    pub column_size: Vec<f64>,
+    /// Master load and its ramp.
+    pub load: LoadSpec,
+    /// Contact and friction law.
+    pub contact: ContactSpec,
+    /// End of the simulated span, s.
+    pub end_time: f64,
+}
+
 impl ReducedSystem {
     /// Builds the system from a model and its reduction (the load direction is the case's
     /// master load; `rom.load` is not used because the master rows of Φ carry it for any t).
     pub fn new(model: &Model, rom: &ReducedModel) -> Result<ReducedSystem, Error> {
         let r = rom.dim();
-        if rom.k.nrows() != r || rom.m.nrows() != r || rom.b_phi.ncols() != r {
-            return Err(Error::Invalid(format!(
-                "reduced model of dimension {r} has inconsistent K̃ ({}), M̃ ({}) or BΦ ({} columns)",
-                rom.k.nrows(),
-                rom.m.nrows(),
-                rom.b_phi.ncols()
-            )));
-        }
         if rom.phi.nrows() != model.dofs() {
             return Err(Error::Invalid(format!(
                 "basis has {} rows, the model {} DOF",
@@ -382,6 +397,67 @@ impl ReducedSystem {
         let column_size: Vec<f64> = (0..r)
             .map(|c| rom.phi.col(c).iter().fold(0.0f64, |m, x| m.max(x.abs())))
             .collect();
+        ReducedSystem::from_parts(ReducedParts {
+            k: rom.k.clone(),
+            m: rom.m.clone(),
+            b_phi: rom.b_phi.clone(),
+            phi_master,
+            column_size,
+            load: model.case.load,
+            contact: model.case.contact,
+            end_time: model.case.end_time,
+        })
+    }
+
+    /// Builds the system from its parts; checks the dimensions, finiteness and the coordinate
+    /// sizes, factors M̃ unless it is the identity.
+    pub fn from_parts(p: ReducedParts) -> Result<ReducedSystem, Error> {
+        let r = p.k.nrows();
+        if p.k.ncols() != r
+            || p.m.nrows() != r
+            || p.m.ncols() != r
+            || p.b_phi.ncols() != r
+            || p.b_phi.nrows() % 3 != 0
+            || p.phi_master.nrows() != 6
+            || p.phi_master.ncols() != r
+            || p.column_size.len() != r
+        {
+            return Err(Error::Invalid(format!(
+                "reduced model of dimension {r} has inconsistent K̃ ({}×{}), M̃ ({}×{}), BΦ ({}×{}, \
+                 3 rows per pair), master rows ({}×{}) or coordinate sizes ({})",
+                p.k.nrows(),
+                p.k.ncols(),
+                p.m.nrows(),
+                p.m.ncols(),
+                p.b_phi.nrows(),
+                p.b_phi.ncols(),
+                p.phi_master.nrows(),
+                p.phi_master.ncols(),
+                p.column_size.len()
+            )));
+        }
+        for (name, a) in [
+            ("K̃", &p.k),
+            ("M̃", &p.m),
+            ("BΦ", &p.b_phi),
+            ("master rows", &p.phi_master),
+        ] {
+            if a.col_iter().any(|c| c.iter().any(|v| !v.is_finite())) {
+                return Err(Error::Invalid(format!(
+                    "reduced model: {name} has a non-finite entry"
+                )));
+            }
+        }
+        let ReducedParts {
+            k,
+            m,
+            b_phi,
+            phi_master,
+            column_size,
+            load,
+            contact,
+            end_time,
+        } = p;
         if let Some(c) = column_size
             .iter()
             .position(|s| !(s.is_finite() && *s > 0.0))
@@ -394,13 +470,13 @@ impl ReducedSystem {
         for i in 0..r {
             for j in 0..r {
                 let id = if i == j { 1.0 } else { 0.0 };
-                dev = dev.max((rom.m[(i, j)] - id).abs());
+                dev = dev.max((m[(i, j)] - id).abs());
             }
         }
         let m_identity = dev <= 1e-12;
         let req = cholesky_in_place_scratch::<f64>(r, Par::Seq, Default::default());
         let mut mem = MemBuffer::new(req);
-        let mut m_llt = rom.m.clone();
+        let mut m_llt = m.clone();
         if !m_identity {
             cholesky_in_place(
                 m_llt.as_mut(),
@@ -417,16 +493,16 @@ impl ReducedSystem {
         }
         Ok(ReducedSystem {
             r,
-            k: rom.k.clone(),
-            m: rom.m.clone(),
+            k,
+            m,
             m_identity,
             m_llt,
-            b_phi: rom.b_phi.clone(),
+            b_phi,
             phi_master,
             column_size,
-            load: model.case.load,
-            contact: model.case.contact,
-            end_time: model.case.end_time,
+            load,
+            contact,
+            end_time,
             newton: Mat::zeros(r, r),
             newton_ok: false,
             kcb: Mat::zeros(3, r),
