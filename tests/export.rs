@@ -61,6 +61,9 @@ fn exported_rom_reintegrates_to_identical_curves() {
     let _ = std::fs::remove_file(&path);
 }
 
+/// Spoils one field of a good file.
+type Damage = dyn Fn(&mut serde_json::Value);
+
 #[test]
 fn damaged_files_are_rejected_naming_the_field() {
     let model = Model::from_case_name("friction_bar").unwrap();
@@ -83,7 +86,7 @@ fn damaged_files_are_rejected_naming_the_field() {
     let rom = ReducedModel::new(&model, b.phi).unwrap();
     let good: serde_json::Value =
         serde_json::to_value(RomFile::new(&model, &rom, info).unwrap()).unwrap();
-    let cases: Vec<(&str, Box<dyn Fn(&mut serde_json::Value)>, &str)> = vec![
+    let cases: Vec<(&str, Box<Damage>, &str)> = vec![
         (
             "unknown",
             Box::new(|v| v["colour"] = "red".into()),
