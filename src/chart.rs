@@ -32,7 +32,7 @@ pub const FONT_CANDIDATES: &[&str] = &[
 type Range = (f64, f64);
 
 /// The font family name the charts use (registered by [`ensure_font`]).
-const FAMILY: &str = "sans-serif";
+pub(crate) const FAMILY: &str = "sans-serif";
 
 /// One line of a chart.
 #[derive(Clone, Debug, PartialEq)]
@@ -411,7 +411,7 @@ fn load_font() -> Result<(), String> {
     })
 }
 
-fn chart_error(path: &Path, reason: String) -> Error {
+pub(crate) fn chart_error(path: &Path, reason: String) -> Error {
     Error::Io {
         file: path.to_path_buf(),
         source: std::io::Error::other(format!("cannot draw chart: {reason}")),

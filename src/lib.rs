@@ -42,6 +42,7 @@ pub mod modes;
 pub mod ode;
 pub mod reduction;
 pub mod report;
+pub mod shapes;
 pub mod stability;
 pub mod statics;
 pub mod study;
@@ -49,6 +50,7 @@ pub mod study;
 pub mod sundials;
 pub mod system;
 pub mod transient;
+pub mod vtu;
 
 pub use error::Error;
 pub use model::{Interface, Model};

@@ -191,6 +191,21 @@ enum Command {
         #[arg(long)]
         out: Option<PathBuf>,
     },
+    /// Writes the Craig–Bampton vectors, the first TVD and joint modes as VTU (ParaView) and a
+    /// picture of the first joint modes (PNG + SVG) → DIR/CASE/.
+    Shapes {
+        /// Case file path or built-in name.
+        case: String,
+        /// Output folder.
+        #[arg(long, default_value = "out")]
+        out: PathBuf,
+        /// TVD and joint modes written.
+        #[arg(long, default_value_t = 12)]
+        count: usize,
+        /// Fixed-interface modes ν.
+        #[arg(long, default_value_t = 10)]
+        nu: usize,
+    },
     /// Writes a reduced model as a versioned JSON file (schema `jointrom-rom` v1: M̃, K̃, BΦ,
     /// master rows, reduced loads, contact law, load ramp; see `jointrom::export`).
     Export {
@@ -548,6 +563,19 @@ fn run(command: Command) -> Result<(), Error> {
                 output_step,
             };
             transient_command(&case, &args, json, out)?;
+        }
+        Command::Shapes {
+            case,
+            out,
+            count,
+            nu,
+        } => {
+            let model = Model::from_case_name(&case)?;
+            let s = jointrom::shapes::shapes(&model, nu, count)?;
+            let dir = out.join(&model.case.name);
+            for f in jointrom::shapes::write_shapes(&model, &s, &dir)? {
+                println!("{}", f.display());
+            }
         }
         Command::Export {
             case,

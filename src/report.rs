@@ -24,7 +24,8 @@
 //!    over the output times t_k — with the full run's CPU time and the paper's CPU ratios (Sections
 //!    4.1.5, 4.2.4) as vertical anchors and the Pareto front (points no other point beats in both
 //!    time and error) drawn through;
-//! 5. the stored stability map of the case (`results/stability/CASE`, made by
+//! 5. the first joint modes as VTU files and a picture (`shapes/`, [`crate::shapes`]);
+//!    the stored stability map of the case (`results/stability/CASE`, made by
 //!    `jointrom stability CASE`; 17 min, too long to repeat here), copied in when present;
 //! 6. `report.md` (the charts as PNG, SVG alongside) and `results.json` with every number.
 //!
@@ -497,6 +498,12 @@ pub fn run_report(
     for f in speed_chart(&report, dir)? {
         report.files.push(relative(dir, &f));
     }
+    // Joint modes: VTU for ParaView and the picture of the first four.
+    let shape_dir = dir.join("shapes");
+    let sh = crate::shapes::shapes(model, BasisOptions::default().nu, 12)?;
+    for f in crate::shapes::write_shapes(model, &sh, &shape_dir)? {
+        report.files.push(relative(dir, &f));
+    }
     // 5. The stored stability map.
     let stab = opts.stability_dir.join(&case);
     let mut stability_files = Vec::new();
@@ -786,6 +793,14 @@ fn markdown(rep: &Report, stab: &Path, stability: bool) -> String {
         s,
         "One point per (basis, size, iteration); the line joins the Pareto front; vertical lines: \
          the full run's CPU time and the paper's CPU ratios applied to it.\n\n![speed against accuracy](speed_accuracy.png)\n"
+    );
+    let _ = writeln!(s, "## Joint modes (Figs. 3–6, 14)\n");
+    let _ = writeln!(
+        s,
+        "The first joint modes Φ̃_T (K-weighted POD of the TVD) as the normal gap they give each \
+         joint pair (blue closes, red opens; the sign of a mode is arbitrary). ParaView files of \
+         the Craig–Bampton vectors, the first TVD and joint modes: `shapes/*.vtu`.\n\n\
+         ![joint modes](shapes/joint_modes.png)\n"
     );
     let _ = writeln!(
         s,
