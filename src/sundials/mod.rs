@@ -33,6 +33,7 @@
 mod callbacks;
 mod context;
 pub mod cvode;
+mod fast_ops;
 mod ffi;
 mod owners;
 mod problem_ls;

@@ -39,9 +39,14 @@ impl SerialVector {
             len,
             context: context.clone(),
         };
-        // SAFETY: `raw` is a valid serial vector; N_VNew_Serial leaves its data uninitialised,
-        // N_VConst writes all `len` entries (none if `len` is 0).
-        unsafe { N_VConst(0.0, vector.as_raw()) };
+        // SAFETY: `raw` is a valid serial vector whose ops table N_VNew_Serial allocated for it
+        // alone; the replacements compute what the library's do (see `fast_ops`), and CVODE's
+        // clones copy the table. N_VNew_Serial leaves the data uninitialised, N_VConst writes all
+        // `len` entries (none if `len` is 0).
+        unsafe {
+            super::fast_ops::install(vector.as_raw());
+            N_VConst(0.0, vector.as_raw());
+        }
         Ok(vector)
     }
 
