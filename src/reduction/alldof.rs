@@ -84,7 +84,7 @@ pub(crate) struct Dot2 {
 }
 
 /// Veltkamp's split of `a` into two 26-bit halves.
-fn split(a: f64) -> (f64, f64) {
+pub(crate) fn split(a: f64) -> (f64, f64) {
     let c = 134_217_729.0 * a; // 2^27 + 1
     let hi = c - (c - a);
     (hi, a - hi)
@@ -177,7 +177,7 @@ pub(crate) fn sym_mul_compensated(
 /// and dispatched at run time (`multiversion`); the same IEEE operations on every path (no FMA
 /// contraction in Rust), so the result does not depend on the CPU.
 #[multiversion::multiversion(targets("x86_64+avx512f+avx512vl", "x86_64+avx2"))]
-fn two_product_sums(
+pub(crate) fn two_product_sums(
     hi: &mut [f64],
     lo: &mut [f64],
     a: f64,

@@ -7,11 +7,12 @@ use crate::assembly::SymCsc;
 use crate::error::Error;
 use crate::model::Model;
 
-use super::alldof::{alldof_vectors, Dot2};
+use super::alldof::{alldof_vectors, split, two_product_sums};
 use super::craig_bampton::craig_bampton;
 use super::jim::{jim_vectors, JimSet};
 use super::pod::{pod_tvd, DEFAULT_THRESHOLD};
 use super::tvd::{trial_vector_derivatives, TvdOptions};
+use crate::statics::sym_mul_vec_into;
 
 /// Default relative drop tolerance of [`final_basis`].
 pub const DEFAULT_DROP_TOL: f64 = 1e-8;
@@ -42,13 +43,18 @@ pub fn final_basis(
     }
     let mut q: Vec<Vec<f64>> = Vec::new();
     let mut mq: Vec<Vec<f64>> = Vec::new();
+    // Veltkamp splits of the accepted columns, for the compensated updates.
+    let mut q_hi: Vec<Vec<f64>> = Vec::new();
+    let mut q_lo: Vec<Vec<f64>> = Vec::new();
     let mut dropped = 0;
     let mut mv = vec![0.0; n];
+    let mut hi = vec![0.0; n];
+    let mut lo = vec![0.0; n];
     let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| x * y).sum::<f64>();
     for part in parts {
         for c in 0..part.ncols() {
             let mut v: Vec<f64> = part.col(c).iter().copied().collect();
-            m.mul_vec(&v, &mut mv);
+            sym_mul_vec_into(m, &v, &mut mv);
             let norm0 = dot(&v, &mv).max(0.0).sqrt();
             if !norm0.is_finite() {
                 return Err(Error::Invalid("basis column is not finite".into()));
@@ -58,22 +64,21 @@ pub fn final_basis(
                 continue;
             }
             for _ in 0..2 {
-                // v ← v − Σ_k (q_kᵀ M v) q_k, each entry accumulated in double-double and
-                // rounded once (see the doc comment).
-                let mut acc: Vec<Dot2> = v.iter().map(|&x| Dot2::new(x)).collect();
-                for (qk, mqk) in q.iter().zip(&mq) {
-                    let a = dot(mqk, &v);
+                // v ← v − Σ_k (q_kᵀ M v) q_k, each entry accumulated in double-double (`hi + lo`,
+                // the arithmetic of `Dot2`) and rounded once (see the doc comment).
+                hi.copy_from_slice(&v);
+                lo.fill(0.0);
+                for ((mqk, qh), ql) in mq.iter().zip(&q_hi).zip(&q_lo) {
+                    let a = -dot(mqk, &v);
+                    let (ah, al) = split(a);
+                    two_product_sums(&mut hi, &mut lo, a, ah, al, qh, ql);
                     // Modified Gram–Schmidt: the next coefficient sees this update.
-                    acc.iter_mut()
-                        .zip(qk)
-                        .zip(v.iter_mut())
-                        .for_each(|((s, y), x)| {
-                            s.add_product(-a, *y);
-                            *x = s.value();
-                        });
+                    for ((x, h), l) in v.iter_mut().zip(&hi).zip(&lo) {
+                        *x = h + l;
+                    }
                 }
             }
-            m.mul_vec(&v, &mut mv);
+            sym_mul_vec_into(m, &v, &mut mv);
             let norm = dot(&v, &mv).max(0.0).sqrt();
             if norm <= drop_tol * norm0 {
                 dropped += 1;
@@ -81,6 +86,9 @@ pub fn final_basis(
             }
             v.iter_mut().for_each(|x| *x /= norm);
             mv.iter_mut().for_each(|x| *x /= norm);
+            let (h, l): (Vec<f64>, Vec<f64>) = v.iter().map(|&x| split(x)).unzip();
+            q_hi.push(h);
+            q_lo.push(l);
             q.push(v);
             mq.push(mv.clone());
         }
