@@ -48,6 +48,7 @@ pub mod statics;
 pub mod study;
 #[allow(unsafe_code)]
 pub mod sundials;
+pub mod sweep;
 pub mod system;
 pub mod transient;
 pub mod vtu;

@@ -206,6 +206,31 @@ enum Command {
         #[arg(long, default_value_t = 10)]
         nu: usize,
     },
+    /// Runs a list of variants (load factor, μ, k_n, k_t) of one reduced model in parallel,
+    /// sharing the basis → a table (or JSON with every run's curves).
+    Sweep {
+        /// Case file path or built-in name.
+        case: String,
+        /// The variant file (`{"variants": [{"name", "load_scale", "friction_coefficient",
+        /// "normal_stiffness", "stick_stiffness"}, ...]}`).
+        #[arg(long)]
+        variants: PathBuf,
+        /// Basis kind: tvd, tvd-plain, modes, jim, alldof.
+        #[arg(long, default_value = "tvd")]
+        basis: String,
+        /// Enrichment vectors g; default: the smallest g with w(g) >= 0.999.
+        #[arg(long)]
+        g: Option<usize>,
+        /// End time, s (default: the case's).
+        #[arg(long)]
+        end_time: Option<f64>,
+        /// Run the variants one after the other.
+        #[arg(long)]
+        sequential: bool,
+        /// One JSON document on stdout (with the curves).
+        #[arg(long)]
+        json: bool,
+    },
     /// Writes a reduced model as a versioned JSON file (schema `jointrom-rom` v1: M̃, K̃, BΦ,
     /// master rows, reduced loads, contact law, load ramp; see `jointrom::export`).
     Export {
@@ -575,6 +600,77 @@ fn run(command: Command) -> Result<(), Error> {
             let dir = out.join(&model.case.name);
             for f in jointrom::shapes::write_shapes(&model, &s, &dir)? {
                 println!("{}", f.display());
+            }
+        }
+        Command::Sweep {
+            case,
+            variants,
+            basis,
+            g,
+            end_time,
+            sequential,
+            json,
+        } => {
+            let model = Model::from_case_name(&case)?;
+            let list = jointrom::sweep::read_variants(&variants)?;
+            let kind = BasisKind::from_name(&basis)
+                .map_err(|e| Error::Invalid(format!("--basis: {e}")))?;
+            let t0 = Instant::now();
+            let b = build_basis(
+                &model,
+                kind,
+                &BasisOptions {
+                    g,
+                    ..BasisOptions::default()
+                },
+            )?;
+            let g_used = b.g;
+            let rom = ReducedModel::new(&model, b.phi)?;
+            let build_s = t0.elapsed().as_secs_f64();
+            let mut opts = TransientOptions::default();
+            if let Some(t) = end_time {
+                opts.end_time = Some(positive("end-time", t)?);
+            }
+            let res = jointrom::sweep::run_sweep(&model, &rom, &list, &opts, !sequential)?;
+            if json {
+                print_json(&json!({
+                    "case": model.case.name,
+                    "basis": kind.name(),
+                    "g": g_used,
+                    "basis_size": rom.dim(),
+                    "build_s": build_s,
+                    "sweep": res,
+                }));
+            } else {
+                println!(
+                    "{} — {} basis, g = {g_used}, r = {} (built once, {:.3} s); {} variants on {} threads",
+                    model.case.name,
+                    kind.name(),
+                    rom.dim(),
+                    build_s,
+                    res.runs.len(),
+                    res.threads
+                );
+                for r in &res.runs {
+                    let last = |v: &[f64]| v.last().copied().unwrap_or(f64::NAN);
+                    println!(
+                        "  {:<20} {:<6} {:>8.3} s {:>8} steps  final |f_c| {:.4e} N  |f_R| {:.4e} N  uy {:.4e} mm",
+                        r.variant.name,
+                        if r.status == "ok" { "ok" } else { "failed" },
+                        r.wall_s,
+                        r.stats.steps,
+                        last(&r.curves.contact_force_norm),
+                        last(&r.curves.friction_force_norm),
+                        last(&r.curves.master_uy)
+                    );
+                    if r.status != "ok" {
+                        println!("    {}", r.status);
+                    }
+                }
+                println!(
+                    "sweep wall {:.3} s, sum of runs {:.3} s",
+                    res.wall_s, res.sum_wall_s
+                );
             }
         }
         Command::Export {

@@ -380,10 +380,10 @@ pub struct ReducedParts {
     pub end_time: f64,
 }
 
-impl ReducedSystem {
-    /// Builds the system from a model and its reduction (the load direction is the case's
-    /// master load; `rom.load` is not used because the master rows of Φ carry it for any t).
-    pub fn new(model: &Model, rom: &ReducedModel) -> Result<ReducedSystem, Error> {
+impl ReducedParts {
+    /// The parts of a model's reduction, with the case's load and contact law (change them to
+    /// run variants on one basis, e.g. `jointrom sweep`).
+    pub fn new(model: &Model, rom: &ReducedModel) -> Result<ReducedParts, Error> {
         let r = rom.dim();
         if rom.phi.nrows() != model.dofs() {
             return Err(Error::Invalid(format!(
@@ -397,7 +397,7 @@ impl ReducedSystem {
         let column_size: Vec<f64> = (0..r)
             .map(|c| rom.phi.col(c).iter().fold(0.0f64, |m, x| m.max(x.abs())))
             .collect();
-        ReducedSystem::from_parts(ReducedParts {
+        Ok(ReducedParts {
             k: rom.k.clone(),
             m: rom.m.clone(),
             b_phi: rom.b_phi.clone(),
@@ -407,6 +407,14 @@ impl ReducedSystem {
             contact: model.case.contact,
             end_time: model.case.end_time,
         })
+    }
+}
+
+impl ReducedSystem {
+    /// Builds the system from a model and its reduction (the load direction is the case's
+    /// master load; `rom.load` is not used because the master rows of Φ carry it for any t).
+    pub fn new(model: &Model, rom: &ReducedModel) -> Result<ReducedSystem, Error> {
+        ReducedSystem::from_parts(ReducedParts::new(model, rom)?)
     }
 
     /// Builds the system from its parts; checks the dimensions, finiteness and the coordinate
