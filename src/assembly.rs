@@ -91,17 +91,37 @@ pub struct DofDep {
 }
 
 impl DofDep {
-    const FIXED: DofDep = DofDep {
+    pub(crate) const FIXED: DofDep = DofDep {
         idx: [0; 3],
         coef: [0.0; 3],
         len: 0,
     };
-    fn single(i: usize) -> DofDep {
+    pub(crate) fn single(i: usize) -> DofDep {
         DofDep {
             idx: [i, 0, 0],
             coef: [1.0, 0.0, 0.0],
             len: 1,
         }
+    }
+    /// The 6 DOF of a node tied rigidly (RBE2) to a master node with independent DOF `master`
+    /// `[ux, uy, uz, rx, ry, rz]`, at offset `r = x_s − x_m` (mm): `u_s = u_m + θ_m × r`,
+    /// `θ_s = θ_m`.
+    pub(crate) fn rigid_follower(master: [usize; 6], r: [f64; 3]) -> [DofDep; 6] {
+        let [ux, uy, uz, rx, ry, rz] = master;
+        let mut dep = [DofDep::FIXED; 6];
+        dep[0].push(ux, 1.0);
+        dep[0].push(ry, r[2]);
+        dep[0].push(rz, -r[1]);
+        dep[1].push(uy, 1.0);
+        dep[1].push(rz, r[0]);
+        dep[1].push(rx, -r[2]);
+        dep[2].push(uz, 1.0);
+        dep[2].push(rx, r[1]);
+        dep[2].push(ry, -r[0]);
+        dep[3].push(rx, 1.0);
+        dep[4].push(ry, 1.0);
+        dep[5].push(rz, 1.0);
+        dep
     }
     fn push(&mut self, i: usize, c: f64) {
         if c != 0.0 {
@@ -162,23 +182,8 @@ impl DofMap {
         let xm = mesh.nodes[master_node];
         for &s in &mesh.tie.slaves {
             let xs = mesh.nodes[s];
-            let r = [xs[0] - xm[0], xs[1] - xm[1], xs[2] - xm[2]];
-            let [ux, uy, uz, rx, ry, rz] = master;
-            let mut dep = [DofDep::FIXED; 6];
-            // u_s = u_m + θ × r
-            dep[0].push(ux, 1.0);
-            dep[0].push(ry, r[2]);
-            dep[0].push(rz, -r[1]);
-            dep[1].push(uy, 1.0);
-            dep[1].push(rz, r[0]);
-            dep[1].push(rx, -r[2]);
-            dep[2].push(uz, 1.0);
-            dep[2].push(rx, r[1]);
-            dep[2].push(ry, -r[0]);
-            dep[3].push(rx, 1.0);
-            dep[4].push(ry, 1.0);
-            dep[5].push(rz, 1.0);
-            nodes[s] = dep;
+            nodes[s] =
+                DofDep::rigid_follower(master, [xs[0] - xm[0], xs[1] - xm[1], xs[2] - xm[2]]);
         }
         DofMap {
             nodes,

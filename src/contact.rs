@@ -271,7 +271,7 @@ pub fn contact_static_full(
         &model.stiffness,
         &model.joint,
         &f,
-        model.case.contact.normal_stiffness,
+        model.contact.normal_stiffness,
         opts,
     )?;
     Ok(ContactSolution {

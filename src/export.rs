@@ -128,7 +128,7 @@ impl RomFile {
         Ok(RomFile {
             schema: SCHEMA.into(),
             version: VERSION,
-            case: model.case.name.clone(),
+            case: model.name.clone(),
             basis,
             dimension: r,
             pairs: model.joint.pairs(),
@@ -137,12 +137,12 @@ impl RomFile {
             joint_operator: rows(&rom.b_phi),
             master_rows: rows(&phi_master),
             reduced_loads: rows(&phi_master),
-            master_load: model.case.load.master,
-            load_ramp: model.case.load.ramp,
-            contact: model.case.contact,
+            master_load: model.load.master,
+            load_ramp: model.load.ramp,
+            contact: model.contact,
             friction_relaxation_time: DEFAULT_TAU,
             coordinate_size: column_size,
-            end_time: model.case.end_time,
+            end_time: model.end_time,
         })
     }
 

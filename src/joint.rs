@@ -3,12 +3,15 @@
 //! For `w` joint pairs the sparse operator `B` (3w × n) maps the independent DOF `q` to three
 //! rows per pair, in the order **normal, t1, t2**:
 //!
-//! - normal gap `g = u_y(upper) − u_y(lower)` (mm; zero initial clearance, contact when g < 0),
-//! - tangential slips `s1 = u_x(upper) − u_x(lower)`, `s2 = u_z(upper) − u_z(lower)` (mm).
+//! - normal gap `g = n · (u(upper) − u(lower))` (mm; zero initial clearance, contact when g < 0),
+//! - tangential slips `s1 = t1 · (u(upper) − u(lower))`, `s2 = t2 · (…)` (mm),
+//!
+//! with the pair's orthonormal frame `n, t1, t2` ([`PairFrame`]; for generated sheets `n = +y`,
+//! `t1 = +x`, `t2 = +z`, so the rows are `u_y`, `u_x`, `u_z` differences).
 //!
 //! These are node-to-node quantities at the shell mid-surface nodes, as in the paper's
 //! NASTRAN model (Section 4, "node-to-node contact and friction model"). Pair forces
-//! `p` (N, same row order, positive pulls the upper node in +y/+x/+z) return to the structure as
+//! `p` (N, same row order, positive pulls the upper node along +n/+t1/+t2) return to the structure as
 //! `f = Bᵀ p`. For a reduced model `q = Φ η` the operator [`JointOperator::reduce`] gives the dense
 //! `B Φ` (3w × r) once, so a pseudoforce costs O(w r), never O(n).
 
@@ -16,13 +19,13 @@ use faer::{Mat, MatRef};
 
 use crate::assembly::DofMap;
 use crate::error::Error;
-use crate::mesh::Mesh;
+use crate::model::PairFrame;
 
 /// Row kinds within a pair's three rows.
 pub const NORMAL: usize = 0;
-/// First tangential row (x).
+/// First tangential row (t1; x for generated sheets).
 pub const T1: usize = 1;
-/// Second tangential row (z).
+/// Second tangential row (t2; z for generated sheets).
 pub const T2: usize = 2;
 
 /// Sparse joint operator B in compressed rows.
@@ -38,15 +41,14 @@ pub struct JointOperator {
 }
 
 impl JointOperator {
-    /// Builds B for the mesh's joint pairs. Errors if a pair node is not an independent node
-    /// (clamped or tied pair nodes are rejected by case validation already).
-    pub fn new(mesh: &Mesh, map: &DofMap) -> Result<JointOperator, Error> {
+    /// Builds B for joint pairs with their frames. Errors if a pair node does not exist or has
+    /// a translation that is not an independent DOF (clamped or without a matrix row).
+    pub fn new(pairs: &[PairFrame], map: &DofMap) -> Result<JointOperator, Error> {
         let mut row_ptr = vec![0];
         let mut col_idx = Vec::new();
         let mut values = Vec::new();
-        for (k, pair) in mesh.pairs.iter().enumerate() {
-            for dir in [1usize, 0, 2] {
-                // normal = y (1), t1 = x (0), t2 = z (2)
+        for (k, pair) in pairs.iter().enumerate() {
+            for dir in pair.directions() {
                 let mut entries: Vec<(usize, f64)> = Vec::new();
                 for (node, sign) in [(pair.upper, 1.0), (pair.lower, -1.0)] {
                     let dep = map.nodes.get(node).ok_or_else(|| {
@@ -54,14 +56,21 @@ impl JointOperator {
                             "joint pair {k} names node {node}, which does not exist"
                         ))
                     })?;
-                    let terms: Vec<(usize, f64)> = dep[dir].terms().collect();
-                    if terms.is_empty() {
-                        return Err(Error::Invalid(format!(
-                            "joint pair {k}: node {node} is clamped; a clamped node cannot be in a joint pair"
-                        )));
-                    }
-                    for (i, c) in terms {
-                        entries.push((i, sign * c));
+                    for (axis, &w) in dir.iter().enumerate() {
+                        if w == 0.0 {
+                            continue;
+                        }
+                        let terms: Vec<(usize, f64)> = dep[axis].terms().collect();
+                        if terms.is_empty() {
+                            return Err(Error::Invalid(format!(
+                                "joint pair {k}: node {node} has no independent {} translation \
+                                 (clamped or not in the matrices); a joint node must move",
+                                ["x", "y", "z"][axis]
+                            )));
+                        }
+                        for (i, c) in terms {
+                            entries.push((i, sign * w * c));
+                        }
                     }
                 }
                 entries.sort_by_key(|e| e.0);
@@ -82,7 +91,7 @@ impl JointOperator {
             }
         }
         Ok(JointOperator {
-            pairs: mesh.pairs.len(),
+            pairs: pairs.len(),
             n: map.n,
             row_ptr,
             col_idx,

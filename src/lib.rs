@@ -36,6 +36,7 @@ pub mod export;
 pub mod friction;
 pub mod heatmap;
 pub mod joint;
+pub mod matrices;
 pub mod mesh;
 pub mod model;
 pub mod modes;

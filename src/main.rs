@@ -36,7 +36,7 @@ enum InterfaceArg {
 enum Command {
     /// Model summary: DOF, joint pairs, nodes, elements.
     Info {
-        /// Case file path or built-in name (friction_bar, multilayer_sheet).
+        /// Case file, matrix map (`jointrom-matrices` JSON) or built-in name (friction_bar, multilayer_sheet).
         case: String,
         /// One JSON document on stdout.
         #[arg(long)]
@@ -44,7 +44,7 @@ enum Command {
     },
     /// Lowest eigenfrequencies (joint open, no contact stiffness).
     Modes {
-        /// Case file path or built-in name.
+        /// Case file, matrix map (`jointrom-matrices` JSON) or built-in name.
         case: String,
         /// Number of modes.
         #[arg(long, default_value_t = 10)]
@@ -58,7 +58,7 @@ enum Command {
     },
     /// Static response to the case's master load.
     Static {
-        /// Case file path or built-in name.
+        /// Case file, matrix map (`jointrom-matrices` JSON) or built-in name.
         case: String,
         /// Linear analysis without contact (the joint may interpenetrate); default: full FE
         /// model with frictionless penalty contact in the joint pairs.
@@ -84,7 +84,7 @@ enum Command {
     },
     /// The TVD basis (Algorithm 2): POD energy ratios w(g), chosen g, sizes, build time.
     Basis {
-        /// Case file path or built-in name.
+        /// Case file, matrix map (`jointrom-matrices` JSON) or built-in name.
         case: String,
         /// tvd (K-weighted POD) or tvd-plain (plain POD).
         #[arg(long, default_value = "tvd")]
@@ -105,7 +105,7 @@ enum Command {
     /// Static convergence study: ‖f_c‖ of each reduced basis against the number of added
     /// vectors g, w(g); writes OUT/CASE/study.json and SVG/PNG charts.
     Study {
-        /// Case file path or built-in name.
+        /// Case file, matrix map (`jointrom-matrices` JSON) or built-in name.
         case: String,
         /// Output folder.
         #[arg(long, default_value = "out")]
@@ -134,7 +134,7 @@ enum Command {
     /// Transient run from rest (CVODE): contact force norm, friction force norm and master uy
     /// over time, solver statistics and wall time.
     Transient {
-        /// Case file path or built-in name.
+        /// Case file, matrix map (`jointrom-matrices` JSON) or built-in name.
         case: String,
         /// full (FE model) or a reduced basis: tvd, tvd-plain, modes, jim, alldof, pod (POD of
         /// the displacement snapshots of a full-FE training run, paper Section 5.2), or
@@ -190,11 +190,19 @@ enum Command {
         /// Write curves.csv and transient.json into this folder.
         #[arg(long)]
         out: Option<PathBuf>,
+        /// Write the displacement field over time as VTU files plus a `.pvd` collection
+        /// (ParaView plays it) into this folder: DIR/u_NNNN.vtu, DIR/u.pvd. Reduced runs are
+        /// expanded with their basis, u = Φ q.
+        #[arg(long)]
+        vtu: Option<PathBuf>,
+        /// `--vtu`: about this many frames (every k-th output, k = outputs / N).
+        #[arg(long, default_value_t = 100)]
+        vtu_frames: usize,
     },
     /// Writes the Craig–Bampton vectors, the first TVD and joint modes as VTU (ParaView) and a
     /// picture of the first joint modes (PNG + SVG) → DIR/CASE/.
     Shapes {
-        /// Case file path or built-in name.
+        /// Case file, matrix map (`jointrom-matrices` JSON) or built-in name.
         case: String,
         /// Output folder.
         #[arg(long, default_value = "out")]
@@ -209,7 +217,7 @@ enum Command {
     /// Runs a list of variants (load factor, μ, k_n, k_t) of one reduced model in parallel,
     /// sharing the basis → a table (or JSON with every run's curves).
     Sweep {
-        /// Case file path or built-in name.
+        /// Case file, matrix map (`jointrom-matrices` JSON) or built-in name.
         case: String,
         /// The variant file (`{"variants": [{"name", "load_scale", "friction_coefficient",
         /// "normal_stiffness", "stick_stiffness"}, ...]}`).
@@ -234,7 +242,7 @@ enum Command {
     /// Writes a reduced model as a versioned JSON file (schema `jointrom-rom` v1: M̃, K̃, BΦ,
     /// master rows, reduced loads, contact law, load ramp; see `jointrom::export`).
     Export {
-        /// Case file path or built-in name.
+        /// Case file, matrix map (`jointrom-matrices` JSON) or built-in name.
         case: String,
         /// Basis kind: tvd, tvd-plain, modes, jim, alldof.
         #[arg(long, default_value = "tvd")]
@@ -249,10 +257,23 @@ enum Command {
         #[arg(long)]
         out: PathBuf,
     },
+    /// Writes a model's K and M as MatrixMarket files plus the JSON map (`K.mtx`, `M.mtx`,
+    /// `model.json`; see `jointrom::matrices`): the format a user's own model comes in. Any
+    /// command takes `DIR/model.json` where it takes a case.
+    ExportMatrices {
+        /// Case file, matrix map or built-in name.
+        case: String,
+        /// Output folder.
+        #[arg(long)]
+        out: PathBuf,
+        /// One JSON document on stdout.
+        #[arg(long)]
+        json: bool,
+    },
     /// The main job on a case (default: the friction bar): static study, full FE and reduced
     /// transients, speed against accuracy → DIR/CASE/report.md, charts, results.json.
     Run {
-        /// Case file path or built-in name.
+        /// Case file, matrix map (`jointrom-matrices` JSON) or built-in name.
         #[arg(default_value = "friction_bar")]
         case: String,
         /// Output folder (the report is written to DIR/CASE).
@@ -283,18 +304,38 @@ fn main() -> ExitCode {
 
 fn info_json(model: &Model) -> Value {
     json!({
-        "case": model.case.name,
+        "case": model.name,
         "dofs": model.dofs(),
-        "joint_pairs": model.mesh.pairs.len(),
+        "joint_pairs": model.pair_count(),
         "joint_dofs": model.joint_dofs(),
-        "nodes": model.mesh.nodes.len(),
-        "elements": model.mesh.shells.len() + model.mesh.beams.len(),
-        "shells": model.mesh.shells.len(),
-        "beams": model.mesh.beams.len(),
-        "clamped_nodes": model.mesh.clamped.len(),
-        "tied_nodes": model.mesh.tie.slaves.len(),
+        "origin": match model.origin {
+            jointrom::model::Origin::Case { .. } => "case",
+            jointrom::model::Origin::Matrices { .. } => "matrices",
+        },
+        "nodes": model.geometry.nodes.len(),
+        "elements": model.geometry.cells.len(),
+        "shells": cell_count(model, true),
+        "beams": cell_count(model, false),
+        "clamped_nodes": model
+            .dof_map
+            .nodes
+            .iter()
+            .filter(|d| d.iter().all(|c| c.terms().next().is_none()))
+            .count(),
+        "tied_nodes": model.geometry.followers.len(),
         "stiffness_nonzeros": model.stiffness.values.len(),
     })
+}
+
+/// Number of 4-node (`quads`) or 2-node display cells.
+fn cell_count(model: &Model, quads: bool) -> usize {
+    use jointrom::model::CellNodes;
+    model
+        .geometry
+        .cells
+        .iter()
+        .filter(|c| matches!(c.nodes, CellNodes::Quad4(_)) == quads)
+        .count()
 }
 
 fn print_json(v: &Value) {
@@ -305,10 +346,10 @@ fn print_json(v: &Value) {
 }
 
 fn static_json(model: &Model, scale: f64) -> Result<Value, Error> {
-    let load = model.case.master_load().map(|v| v * scale);
+    let load = model.master_load().map(|v| v * scale);
     let sol = model.static_linear(&[load])?.remove(0);
     Ok(json!({
-        "case": model.case.name,
+        "case": model.name,
         "linear": true,
         "load": load,
         "master_displacement": sol.master_displacement,
@@ -316,10 +357,10 @@ fn static_json(model: &Model, scale: f64) -> Result<Value, Error> {
 }
 
 fn contact_json(model: &Model, scale: f64) -> Result<Value, Error> {
-    let load = model.case.master_load().map(|v| v * scale);
+    let load = model.master_load().map(|v| v * scale);
     let sol = contact::contact_static_full(model, load, &contact::ContactOptions::default())?;
     Ok(json!({
-        "case": model.case.name,
+        "case": model.name,
         "linear": false,
         "load": load,
         "master_displacement": sol.master_displacement,
@@ -337,16 +378,16 @@ fn run(command: Command) -> Result<(), Error> {
             if json {
                 print_json(&v);
             } else {
-                println!("case            {}", model.case.name);
+                println!("case            {}", model.name);
                 println!("DOF             {}", model.dofs());
-                println!("joint pairs     {}", model.mesh.pairs.len());
+                println!("joint pairs     {}", model.pair_count());
                 println!("joint DOF       {}", model.joint_dofs());
-                println!("nodes           {}", model.mesh.nodes.len());
+                println!("nodes           {}", model.geometry.nodes.len());
                 println!(
                     "elements        {} ({} Shell4, {} Beam2)",
-                    model.mesh.shells.len() + model.mesh.beams.len(),
-                    model.mesh.shells.len(),
-                    model.mesh.beams.len()
+                    model.geometry.cells.len(),
+                    cell_count(&model, true),
+                    cell_count(&model, false)
                 );
             }
         }
@@ -366,7 +407,7 @@ fn run(command: Command) -> Result<(), Error> {
             let secs = t0.elapsed().as_secs_f64();
             if json {
                 print_json(&json!({
-                    "case": model.case.name,
+                    "case": model.name,
                     "interface": match iface { Interface::Fixed => "fixed", Interface::Free => "free" },
                     "frequencies_hz": modes.frequencies_hz,
                     "solve_s": secs,
@@ -374,7 +415,7 @@ fn run(command: Command) -> Result<(), Error> {
             } else {
                 println!(
                     "{} — {} lowest modes, master {} ({:.1} ms):",
-                    model.case.name,
+                    model.name,
                     count,
                     match iface {
                         Interface::Fixed => "clamped (fixed interface)",
@@ -429,7 +470,7 @@ fn run(command: Command) -> Result<(), Error> {
                 } else {
                     "with contact (frictionless)"
                 };
-                println!("{} — static {kind}, load × {scale}:", model.case.name);
+                println!("{} — static {kind}, load × {scale}:", model.name);
                 for (k, name) in ["ux", "uy", "uz", "rx", "ry", "rz"].iter().enumerate() {
                     let unit = if k < 3 { "mm" } else { "rad" };
                     println!(
@@ -442,7 +483,7 @@ fn run(command: Command) -> Result<(), Error> {
                         "  ‖f_c‖ = {:.6} N, {} of {} pairs in contact",
                         v["contact_force_norm"].as_f64().unwrap_or(f64::NAN),
                         v["pairs_in_contact"],
-                        model.mesh.pairs.len()
+                        model.pair_count()
                     );
                 }
             }
@@ -515,7 +556,7 @@ fn run(command: Command) -> Result<(), Error> {
                 ..study::StudyOptions::default()
             };
             let s = study::run_study(&model, &opts)?;
-            let dir = out.join(&model.case.name);
+            let dir = out.join(&model.name);
             std::fs::create_dir_all(&dir).map_err(|e| Error::Io {
                 file: dir.clone(),
                 source: e,
@@ -569,6 +610,8 @@ fn run(command: Command) -> Result<(), Error> {
             output_step,
             json,
             out,
+            vtu,
+            vtu_frames,
         } => {
             let args = TransientArgs {
                 model: model_name,
@@ -586,6 +629,8 @@ fn run(command: Command) -> Result<(), Error> {
                 stab_lim_det,
                 end_time,
                 output_step,
+                vtu,
+                vtu_frames,
             };
             transient_command(&case, &args, json, out)?;
         }
@@ -597,7 +642,7 @@ fn run(command: Command) -> Result<(), Error> {
         } => {
             let model = Model::from_case_name(&case)?;
             let s = jointrom::shapes::shapes(&model, nu, count)?;
-            let dir = out.join(&model.case.name);
+            let dir = out.join(&model.name);
             for f in jointrom::shapes::write_shapes(&model, &s, &dir)? {
                 println!("{}", f.display());
             }
@@ -634,7 +679,7 @@ fn run(command: Command) -> Result<(), Error> {
             let res = jointrom::sweep::run_sweep(&model, &rom, &list, &opts, !sequential)?;
             if json {
                 print_json(&json!({
-                    "case": model.case.name,
+                    "case": model.name,
                     "basis": kind.name(),
                     "g": g_used,
                     "basis_size": rom.dim(),
@@ -644,7 +689,7 @@ fn run(command: Command) -> Result<(), Error> {
             } else {
                 println!(
                     "{} — {} basis, g = {g_used}, r = {} (built once, {:.3} s); {} variants on {} threads",
-                    model.case.name,
+                    model.name,
                     kind.name(),
                     rom.dim(),
                     build_s,
@@ -670,6 +715,30 @@ fn run(command: Command) -> Result<(), Error> {
                 println!(
                     "sweep wall {:.3} s, sum of runs {:.3} s",
                     res.wall_s, res.sum_wall_s
+                );
+            }
+        }
+        Command::ExportMatrices { case, out, json } => {
+            let model = Model::from_case_name(&case)?;
+            let files = jointrom::matrices::write(&model, &out)?;
+            if json {
+                print_json(&json!({
+                    "case": model.name,
+                    "dofs": model.dofs(),
+                    "joint_pairs": model.pair_count(),
+                    "files": files,
+                }));
+            } else {
+                println!(
+                    "{}: {} DOF, {} joint pairs → {}",
+                    model.name,
+                    model.dofs(),
+                    model.pair_count(),
+                    files
+                        .iter()
+                        .map(|f| f.display().to_string())
+                        .collect::<Vec<_>>()
+                        .join(", ")
                 );
             }
         }
@@ -701,7 +770,7 @@ fn run(command: Command) -> Result<(), Error> {
             file.write(&out)?;
             println!(
                 "{}: {} basis, g = {}, r = {} → {}",
-                model.case.name,
+                model.name,
                 kind.name(),
                 file.basis.g,
                 file.dimension,
@@ -738,7 +807,7 @@ fn run(command: Command) -> Result<(), Error> {
                 "timing_s".into(),
                 json!({"assembly": t_assembly, "modes": t_modes}),
             );
-            let dir = out.join(&model.case.name);
+            let dir = out.join(&model.name);
             let opts = report::ReportOptions {
                 quick,
                 stability_dir,
@@ -799,7 +868,7 @@ fn reduced_static(
     let r = study::basis_static(model, kind, &opts, scale)?;
     let st = &r.solution.state;
     let v = json!({
-        "case": model.case.name,
+        "case": model.name,
         "linear": false,
         "load": load,
         "master_displacement": r.solution.master_displacement,
@@ -818,7 +887,7 @@ fn reduced_static(
     } else {
         println!(
             "{} — reduced static with contact (frictionless), basis {} (g = {}, {} columns), load × {scale}:",
-            model.case.name, r.basis, r.g, r.basis_size
+            model.name, r.basis, r.g, r.basis_size
         );
         for (k, name) in ["ux", "uy", "uz", "rx", "ry", "rz"].iter().enumerate() {
             let unit = if k < 3 { "mm" } else { "rad" };
@@ -831,7 +900,7 @@ fn reduced_static(
             "  ‖f_c‖ = {:.6} N, {} of {} pairs in contact; basis {:.1} ms, solve {:.1} ms",
             st.contact_force_norm,
             st.pairs_in_contact,
-            model.mesh.pairs.len(),
+            model.pair_count(),
             r.build_s * 1e3,
             r.solve_s * 1e3
         );
@@ -856,6 +925,28 @@ struct TransientArgs {
     stab_lim_det: Option<String>,
     end_time: Option<f64>,
     output_step: f64,
+    vtu: Option<PathBuf>,
+    vtu_frames: usize,
+}
+
+/// A transient run that keeps every `every`-th state (with its time) when `every` is given.
+fn run_keeping<S: jointrom::system::SecondOrderSystem>(
+    sys: S,
+    opts: &TransientOptions,
+    every: Option<usize>,
+) -> Result<(transient::TransientResult, Vec<(f64, Vec<f64>)>), Error> {
+    let Some(every) = every else {
+        return Ok((transient::run(sys, opts)?, Vec::new()));
+    };
+    let mut frames = Vec::new();
+    let mut k = 0usize;
+    let res = transient::run_observed(sys, opts, |t, q| {
+        if k % every == 0 {
+            frames.push((t, q.to_vec()));
+        }
+        k += 1;
+    })?;
+    Ok((res, frames))
 }
 
 fn on_off(flag: &str, v: &str) -> Result<bool, Error> {
@@ -921,6 +1012,18 @@ fn transient_options(a: &TransientArgs) -> Result<TransientOptions, Error> {
     Ok(o)
 }
 
+/// Reduced states `q` (r) to physical DOF `Φ q` (n).
+fn expand_frames(rom: &ReducedModel, kept: Vec<(f64, Vec<f64>)>) -> Vec<(f64, Vec<f64>)> {
+    kept.into_iter()
+        .map(|(t, q)| {
+            let u = (0..rom.phi.nrows())
+                .map(|i| (0..q.len()).map(|c| rom.phi[(i, c)] * q[c]).sum())
+                .collect();
+            (t, u)
+        })
+        .collect()
+}
+
 fn transient_command(
     case: &str,
     a: &TransientArgs,
@@ -929,6 +1032,19 @@ fn transient_command(
 ) -> Result<(), Error> {
     let opts = transient_options(a)?;
     let model = Model::from_case_name(case)?;
+    let vtu_every = match &a.vtu {
+        None => None,
+        Some(_) if a.vtu_frames == 0 => {
+            return Err(Error::Invalid("--vtu-frames must be at least 1".into()))
+        }
+        Some(_) => {
+            let end = opts.end_time.unwrap_or(model.end_time);
+            let outputs = (end / opts.output_step).ceil().max(1.0) as usize + 1;
+            Some((outputs / a.vtu_frames).max(1))
+        }
+    };
+    // Kept states in physical DOF (reduced states are expanded with Φ).
+    let mut frames: Vec<(f64, Vec<f64>)> = Vec::new();
     let t0 = Instant::now();
     let (res, basis_size, g_used, training) = match a.model.as_str() {
         "full" => {
@@ -943,14 +1059,16 @@ fn transient_command(
                 ));
             }
             let sys = FullSystem::new(&model)?;
-            (transient::run(sys, &opts)?, model.dofs(), None, None)
+            let (res, kept) = run_keeping(sys, &opts, vtu_every)?;
+            frames = kept;
+            (res, model.dofs(), None, None)
         }
         "pod" => {
             // Paper Section 5.2: the POD of displacement snapshots of a full-FE run (here over
             // [0, train_end] with the same options), Euclidean, added to Craig–Bampton.
             let train_end = match a.train_end {
                 Some(t) => positive("train-end", t)?,
-                None => opts.end_time.unwrap_or(model.case.end_time),
+                None => opts.end_time.unwrap_or(model.end_time),
             };
             if a.snapshots < 2 {
                 return Err(Error::Invalid(format!(
@@ -996,13 +1114,22 @@ fn transient_command(
             let rom = ReducedModel::new(&model, basis.phi)?;
             let r = rom.dim();
             let sys = ReducedSystem::new(&model, &rom)?;
-            (transient::run(sys, &opts)?, r, Some(g_used), Some(training))
+            let (res, kept) = run_keeping(sys, &opts, vtu_every)?;
+            frames = expand_frames(&rom, kept);
+            (res, r, Some(g_used), Some(training))
         }
         name if name.starts_with("file:") => {
             // A reduced model exported by `jointrom export` (schema jointrom-rom v1).
             if a.g.is_some() || a.train_end.is_some() {
                 return Err(Error::Invalid(
                     "--g and --train-end do not apply to --model file:PATH".into(),
+                ));
+            }
+            if a.vtu.is_some() {
+                return Err(Error::Invalid(
+                    "--vtu needs the basis Φ, which an exported reduced model does not carry; \
+                     run the basis by name instead (e.g. --model tvd)"
+                        .into(),
                 ));
             }
             let f = export::RomFile::read(std::path::Path::new(&name["file:".len()..]))?;
@@ -1031,13 +1158,15 @@ fn transient_command(
             let rom = ReducedModel::new(&model, basis.phi)?;
             let r = rom.dim();
             let sys = ReducedSystem::new(&model, &rom)?;
-            (transient::run(sys, &opts)?, r, Some(g_used), None)
+            let (res, kept) = run_keeping(sys, &opts, vtu_every)?;
+            frames = expand_frames(&rom, kept);
+            (res, r, Some(g_used), None)
         }
     };
     let total_s = t0.elapsed().as_secs_f64();
     let c = &res.curves;
     let doc = json!({
-        "case": model.case.name,
+        "case": model.name,
         "model": a.model,
         "basis_size": basis_size,
         "g": g_used,
@@ -1051,6 +1180,11 @@ fn transient_command(
         "energy_balance": c.balance(),
         "training": training,
     });
+    if let Some(dir) = &a.vtu {
+        let (times, states): (Vec<f64>, Vec<Vec<f64>>) = frames.into_iter().unzip();
+        let pvd = jointrom::vtu::write_series(&model, "u", &times, &states, dir)?;
+        eprintln!("{} frames → {}", times.len(), pvd.display());
+    }
     if let Some(dir) = out {
         std::fs::create_dir_all(&dir).map_err(|e| Error::Io {
             file: dir.clone(),
@@ -1094,7 +1228,7 @@ fn transient_command(
         let s = &res.stats;
         println!(
             "{} — model {} (n = {}{}), friction {}, events {}",
-            model.case.name,
+            model.name,
             a.model,
             basis_size,
             g_used.map(|g| format!(", g = {g}")).unwrap_or_default(),

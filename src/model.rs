@@ -1,7 +1,22 @@
-//! The full finite-element model of a case: mesh, DOF map, assembled K and M, joint pairs.
+//! The full finite-element model: K and M on the independent DOF, the joint operator B, the
+//! master node, the load and the contact law — from a case (mesh generated and assembled here)
+//! or from a user's own matrices ([`crate::matrices`]: MatrixMarket K, M plus a JSON map).
+//!
+//! Everything downstream (bases, statics, transient runs, reports) sees only this type, so one
+//! pipeline serves both origins. Conventions every model satisfies (checked where it is built):
+//!
+//! - the master (Craig–Bampton boundary) DOF are the **last six** independent DOF, in the order
+//!   `[ux, uy, uz, rx, ry, rz]` of one master node, which carries the load (eq. 1's `f(t)`);
+//! - each joint pair has three rows in B (eq. 2): `n · (u_upper − u_lower)` (normal gap, contact
+//!   when negative, zero initial clearance), `t1 · (…)` and `t2 · (…)` (slips), with `n, t1, t2`
+//!   orthonormal;
+//! - K is symmetric positive definite (the structure is supported), M symmetric positive
+//!   definite, both stored on one sparsity pattern.
+
+use std::path::PathBuf;
 
 use crate::assembly::{assemble_structure, DofMap, Structure, SymCsc};
-use crate::case::Case;
+use crate::case::{Case, ContactSpec, LoadSpec};
 use crate::error::Error;
 use crate::joint::JointOperator;
 use crate::mesh::Mesh;
@@ -17,26 +32,134 @@ pub enum Interface {
     Fixed,
 }
 
-/// The assembled full FE model of a case.
+/// A node-to-node joint pair with its local frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PairFrame {
+    /// Node on the lower surface (index into [`Geometry::nodes`]).
+    pub lower: usize,
+    /// Node on the upper surface, coincident with `lower` (zero initial clearance).
+    pub upper: usize,
+    /// Unit normal, pointing from the lower to the upper surface.
+    pub normal: [f64; 3],
+    /// First unit tangent (⊥ normal).
+    pub t1: [f64; 3],
+    /// Second unit tangent (⊥ normal, ⊥ t1).
+    pub t2: [f64; 3],
+}
+
+impl PairFrame {
+    /// The frame of the generated sheets: normal +y, t1 = +x, t2 = +z.
+    pub const SHEET_AXES: ([f64; 3], [f64; 3], [f64; 3]) =
+        ([0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]);
+
+    /// The three directions in row order (normal, t1, t2).
+    pub fn directions(&self) -> [[f64; 3]; 3] {
+        [self.normal, self.t1, self.t2]
+    }
+
+    /// The global axis (0 = x, 1 = y, 2 = z) closest to the normal.
+    pub fn normal_axis(&self) -> usize {
+        let a = self.normal.map(f64::abs);
+        if a[1] >= a[0] && a[1] >= a[2] {
+            1
+        } else if a[0] >= a[2] {
+            0
+        } else {
+            2
+        }
+    }
+}
+
+/// What a cell of the display geometry is.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum CellNodes {
+    /// A 4-node shell (VTK quad).
+    Quad4([usize; 4]),
+    /// A 2-node beam (VTK line).
+    Line2([usize; 2]),
+}
+
+/// A cell of the display geometry (VTU output, pictures; not used by the mechanics).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Cell {
+    /// Node indices into [`Geometry::nodes`].
+    pub nodes: CellNodes,
+    /// Group (sheet index of a generated case; the map's `group`; −1 for none).
+    pub group: i32,
+    /// Shell thickness or beam diameter, mm (0 where unknown).
+    pub size: f64,
+}
+
+/// Node positions, node ids and cells: what output needs to show a displacement field.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Geometry {
+    /// Node coordinates (x, y, z), mm.
+    pub nodes: Vec<[f64; 3]>,
+    /// The user's node ids (1-based node numbers for a generated case).
+    pub node_ids: Vec<u64>,
+    /// Cells for display.
+    pub cells: Vec<Cell>,
+    /// Nodes tied rigidly to the master node (RBE2): no DOF of their own.
+    pub followers: Vec<usize>,
+}
+
+/// Where a model came from.
+#[derive(Clone, Debug)]
+pub enum Origin {
+    /// Generated and assembled from a case.
+    Case {
+        /// The validated case.
+        case: Box<Case>,
+        /// Its discretisation.
+        mesh: Box<Mesh>,
+    },
+    /// Read from a user's MatrixMarket K and M plus a JSON map ([`crate::matrices`]).
+    Matrices {
+        /// The map file.
+        map: PathBuf,
+        /// The stiffness file.
+        stiffness: PathBuf,
+        /// The mass file.
+        mass: PathBuf,
+    },
+}
+
+/// The full FE model (see the module docs for its conventions).
 #[derive(Clone, Debug)]
 pub struct Model {
-    /// The validated case.
-    pub case: Case,
-    /// The discretisation.
-    pub mesh: Mesh,
+    /// Name (used in reports and output folders).
+    pub name: String,
+    /// Where it came from, for errors: a file path or `builtin:<name>`.
+    pub source: String,
+    /// Case and mesh, or the matrix files.
+    pub origin: Origin,
+    /// Nodes and cells for output.
+    pub geometry: Geometry,
+    /// The joint pairs with their frames, in the row order of [`Model::joint`].
+    pub pairs: Vec<PairFrame>,
     /// Node DOF → independent DOF.
     pub dof_map: DofMap,
     /// Stiffness on the independent DOF, N/mm (N, N·mm/rad for rotations).
     pub stiffness: SymCsc,
     /// Mass on the independent DOF, t (t·mm² for rotations).
     pub mass: SymCsc,
-    /// The joint operator B (3 rows per pair: normal gap, slip x, slip z).
+    /// The joint operator B (3 rows per pair: normal, t1, t2).
     pub joint: JointOperator,
+    /// The master-node load and its ramp.
+    pub load: LoadSpec,
+    /// Contact and friction law of all pairs.
+    pub contact: ContactSpec,
+    /// End of the simulated time span, s.
+    pub end_time: f64,
 }
 
 impl Model {
-    /// Loads a case (path or built-in name) and assembles it.
+    /// Loads a model: a user's matrix map (a JSON file with `"schema": "jointrom-matrices"`,
+    /// see [`crate::matrices`]), a case file or a built-in case name.
     pub fn from_case_name(arg: &str) -> Result<Model, Error> {
+        if let Some(map) = crate::matrices::map_file(arg)? {
+            return crate::matrices::load(&map);
+        }
         Model::from_case(Case::load(arg)?)
     }
 
@@ -48,10 +171,51 @@ impl Model {
             stiffness,
             mass,
         } = assemble_structure(&mesh)?;
-        let joint = JointOperator::new(&mesh, &dof_map)?;
+        let (normal, t1, t2) = PairFrame::SHEET_AXES;
+        let pairs: Vec<PairFrame> = mesh
+            .pairs
+            .iter()
+            .map(|p| PairFrame {
+                lower: p.lower,
+                upper: p.upper,
+                normal,
+                t1,
+                t2,
+            })
+            .collect();
+        let joint = JointOperator::new(&pairs, &dof_map)?;
+        let mut cells: Vec<Cell> = mesh
+            .shells
+            .iter()
+            .map(|e| Cell {
+                nodes: CellNodes::Quad4(e.nodes),
+                group: e.sheet as i32,
+                size: e.thickness,
+            })
+            .collect();
+        cells.extend(mesh.beams.iter().map(|b| Cell {
+            nodes: CellNodes::Line2(b.nodes),
+            group: -1,
+            size: b.diameter,
+        }));
+        let geometry = Geometry {
+            nodes: mesh.nodes.clone(),
+            node_ids: (1..=mesh.nodes.len() as u64).collect(),
+            cells,
+            followers: mesh.tie.slaves.clone(),
+        };
         Ok(Model {
-            case,
-            mesh,
+            name: case.name.clone(),
+            source: case.source.clone(),
+            load: case.load,
+            contact: case.contact,
+            end_time: case.end_time,
+            origin: Origin::Case {
+                case: Box::new(case),
+                mesh: Box::new(mesh),
+            },
+            geometry,
+            pairs,
             dof_map,
             stiffness,
             mass,
@@ -59,19 +223,40 @@ impl Model {
         })
     }
 
+    /// The case, for a model generated from one.
+    pub fn case(&self) -> Option<&Case> {
+        match &self.origin {
+            Origin::Case { case, .. } => Some(case),
+            Origin::Matrices { .. } => None,
+        }
+    }
+
+    /// The mesh, for a model generated from a case.
+    pub fn mesh(&self) -> Option<&Mesh> {
+        match &self.origin {
+            Origin::Case { mesh, .. } => Some(mesh),
+            Origin::Matrices { .. } => None,
+        }
+    }
+
+    /// The final master load `[Fx, Fy, Fz (N), Mx, My, Mz (N·mm)]`, before the ramp.
+    pub fn master_load(&self) -> [f64; 6] {
+        self.load.master.to_array()
+    }
+
     /// Number of independent DOF (after eliminating clamp and rigid tie).
     pub fn dofs(&self) -> usize {
         self.dof_map.n
     }
 
+    /// Number of joint pairs.
+    pub fn pair_count(&self) -> usize {
+        self.pairs.len()
+    }
+
     /// Number of distinct independent DOF on nodes of joint pairs.
     pub fn joint_dofs(&self) -> usize {
-        let mut nodes: Vec<usize> = self
-            .mesh
-            .pairs
-            .iter()
-            .flat_map(|p| [p.lower, p.upper])
-            .collect();
+        let mut nodes: Vec<usize> = self.pairs.iter().flat_map(|p| [p.lower, p.upper]).collect();
         nodes.sort_unstable();
         nodes.dedup();
         nodes

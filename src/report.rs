@@ -309,11 +309,11 @@ pub fn run_report(
         file: dir.to_path_buf(),
         source: e,
     })?;
-    let case = model.case.name.clone();
+    let case = model.name.clone();
     let end_time = if opts.quick {
-        model.case.end_time.min(0.02)
+        model.end_time.min(0.02)
     } else {
-        model.case.end_time
+        model.end_time
     };
     let output_step = 1e-4;
     let problem = ProblemOptions::default();

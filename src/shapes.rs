@@ -114,12 +114,13 @@ pub fn render_joint_modes(
     ensure_font()?;
     let w = model.joint.pairs();
     let pos: Vec<(f64, f64)> = model
-        .mesh
         .pairs
         .iter()
         .map(|p| {
-            let x = model.mesh.nodes[p.lower];
-            (x[0], x[2])
+            // In the joint plane: (t1 · x, t2 · x); (x, z) for generated sheets.
+            let x = model.geometry.nodes[p.lower];
+            let dot = |t: [f64; 3]| t[0] * x[0] + t[1] * x[1] + t[2] * x[2];
+            (dot(p.t1), dot(p.t2))
         })
         .collect();
     let mut gaps = vec![vec![0.0; w]; modes.ncols()];
@@ -137,14 +138,14 @@ pub fn render_joint_modes(
     let size = (1000, 700);
     draw_panels(
         BitMapBackend::new(&png, size).into_drawing_area(),
-        &model.case.name,
+        &model.name,
         &pos,
         &gaps,
     )
     .map_err(|e| chart_error(&png, e))?;
     draw_panels(
         SVGBackend::new(&svg, size).into_drawing_area(),
-        &model.case.name,
+        &model.name,
         &pos,
         &gaps,
     )
@@ -200,8 +201,8 @@ where
             .map_err(|e| err(&e))?;
         chart
             .configure_mesh()
-            .x_desc("x (mm)")
-            .y_desc("z (mm)")
+            .x_desc("along t1 (x for sheets), mm")
+            .y_desc("along t2 (z), mm")
             .label_style((FAMILY, 12))
             .axis_desc_style((FAMILY, 13))
             .draw()

@@ -697,6 +697,17 @@ fn check_options(o: &SweepOptions) -> Result<(), Error> {
 /// model or basis are errors; every integration failure is a cell's status.
 pub fn run_sweep(case: &Case, opts: &SweepOptions) -> Result<Sweep, Error> {
     check_options(opts)?;
+    let t0 = Instant::now();
+    let model = Model::from_case(case.clone())?;
+    let model_s = t0.elapsed().as_secs_f64();
+    run_sweep_model(&model, model_s, opts)
+}
+
+/// [`run_sweep`] on a built model (a case's or a user's matrices, [`crate::matrices`]);
+/// `model_s` is the time it took to build, reported with the full model's cells. Each k_n
+/// value only changes the contact law: K, M and B are shared.
+pub fn run_sweep_model(base: &Model, model_s: f64, opts: &SweepOptions) -> Result<Sweep, Error> {
+    check_options(opts)?;
     let t_all = Instant::now();
     let progress = |s: &str| {
         if opts.progress {
@@ -707,11 +718,8 @@ pub fn run_sweep(case: &Case, opts: &SweepOptions) -> Result<Sweep, Error> {
     let mut references = Vec::new();
     let mut cells = Vec::new();
     for &kn in &opts.normal_stiffness {
-        let mut case = case.clone();
-        case.contact.normal_stiffness = kn;
-        let t0 = Instant::now();
-        let model = Model::from_case(case)?;
-        let model_s = t0.elapsed().as_secs_f64();
+        let mut model = base.clone();
+        model.contact.normal_stiffness = kn;
         // Prepared models, full first so that its reference is there for the ROMs.
         let mut order = opts.models.clone();
         order.sort_by_key(|m| ModelKind::ALL.iter().position(|k| k == m));
@@ -900,7 +908,7 @@ pub fn run_sweep(case: &Case, opts: &SweepOptions) -> Result<Sweep, Error> {
         }
     }
     Ok(Sweep {
-        case: case.name.clone(),
+        case: base.name.clone(),
         options: opts.clone(),
         models: built,
         references,
@@ -1227,7 +1235,7 @@ pub fn sweep_json(sweep: &Sweep) -> serde_json::Value {
 /// `jointrom stability CASE`: the stability map (see the module docs).
 #[derive(clap::Args, Debug, Clone)]
 pub struct StabilityArgs {
-    /// Case file path or built-in name.
+    /// Case file, matrix map (`jointrom-matrices` JSON) or built-in name.
     pub case: String,
     /// Output folder (OUT/CASE/stability.json, .md and heat maps).
     #[arg(long, default_value = "out")]
@@ -1344,8 +1352,9 @@ impl StabilityArgs {
 /// total wall time.
 pub fn stability_command(args: &StabilityArgs) -> Result<serde_json::Value, Error> {
     let opts = args.options()?;
-    let case = Case::load(&args.case)?;
-    let sweep = run_sweep(&case, &opts)?;
+    let t0 = Instant::now();
+    let model = Model::from_case_name(&args.case)?;
+    let sweep = run_sweep_model(&model, t0.elapsed().as_secs_f64(), &opts)?;
     let dir = args.out.join(&sweep.case);
     let files = write_outputs(&sweep, &dir, !args.no_charts)?;
     let mut by_status = std::collections::BTreeMap::<String, usize>::new();

@@ -134,7 +134,7 @@ pub fn scaled_load(model: &Model, scale: f64) -> Result<[f64; 6], Error> {
             "--scale must be finite, got {scale}"
         )));
     }
-    Ok(model.case.master_load().map(|v| v * scale))
+    Ok(model.master_load().map(|v| v * scale))
 }
 
 /// A reduced contact static solution.
@@ -164,7 +164,7 @@ pub fn reduced_contact_static(
         rm.k.as_ref(),
         b_n.as_ref(),
         &f,
-        model.case.contact.normal_stiffness,
+        model.contact.normal_stiffness,
         opts,
     )?;
     let master = model.master_dofs();
@@ -220,7 +220,7 @@ pub fn reduced_contact_static_damped(
 ) -> Result<ReducedStatic, Error> {
     let w = model.joint.pairs();
     let r = rm.dim();
-    let k_n = model.case.contact.normal_stiffness;
+    let k_n = model.contact.normal_stiffness;
     let b = Mat::from_fn(w, r, |i, j| rm.b_phi[(3 * i + NORMAL, j)]);
     let f: Vec<f64> = rm.load.iter().map(|v| v * scale).collect();
     let gaps_of = |eta: &[f64]| -> Vec<f64> {
@@ -362,7 +362,7 @@ pub fn basis_static(
                 "--g {g}: basis `{}` has only {} enrichment vectors on {}",
                 basis_name(kind),
                 basis.g,
-                model.case.name
+                model.name
             )));
         }
     }
@@ -436,7 +436,7 @@ pub fn basis_summary(
         if basis.g < g {
             return Err(Error::Invalid(format!(
                 "--g {g}: the POD of the TVD has only {} modes on {}",
-                basis.g, model.case.name
+                basis.g, model.name
             )));
         }
     }
@@ -461,7 +461,7 @@ pub fn basis_summary(
         (w_other, basis.w)
     };
     Ok(BasisSummary {
-        case: model.case.name.clone(),
+        case: model.name.clone(),
         kind: basis_name(kind),
         nu: opts.nu,
         w,
@@ -737,7 +737,7 @@ pub fn run_study(model: &Model, opts: &StudyOptions) -> Result<Study, Error> {
         return Err(Error::Invalid(format!(
             "{}: the full model has no pair in contact under this load (‖f_c‖ = 0), so there is \
              no contact force to converge to; try --scale -1",
-            model.case.name
+            model.name
         )));
     }
 
@@ -835,7 +835,7 @@ pub fn run_study(model: &Model, opts: &StudyOptions) -> Result<Study, Error> {
     )?);
 
     Ok(Study {
-        case: model.case.name.clone(),
+        case: model.name.clone(),
         dofs: model.dofs(),
         pairs: model.joint.pairs(),
         nu: opts.nu,

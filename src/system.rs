@@ -251,9 +251,9 @@ impl FullSystem {
             mass: m.clone(),
             joint: joint.clone(),
             master: model.master_dofs(),
-            load: model.case.load,
-            contact: model.case.contact,
-            end_time: model.case.end_time,
+            load: model.load,
+            contact: model.contact,
+            end_time: model.end_time,
             mass_llt,
             newton,
             newton_values: vec![0.0; nnz],
@@ -403,9 +403,9 @@ impl ReducedParts {
             b_phi: rom.b_phi.clone(),
             phi_master,
             column_size,
-            load: model.case.load,
-            contact: model.case.contact,
-            end_time: model.case.end_time,
+            load: model.load,
+            contact: model.contact,
+            end_time: model.end_time,
         })
     }
 }

@@ -5,8 +5,10 @@
 //! ([`crate::assembly::DofMap::expand`]: clamped DOF are zero, RBE2 slaves follow their master
 //! rigidly, `u_s = u_m + θ_m × (x_s − x_m)`), and written per node as two point arrays,
 //! `<name>_u` (u_x, u_y, u_z in mm) and `<name>_rot` (θ_x, θ_y, θ_z in rad). Cells: `Shell4` as
-//! `VTK_QUAD` (9), `Beam2` as `VTK_LINE` (3), with the cell data `sheet` (−1 for beams) and
-//! `thickness` (mm; the beam diameter for beams). In ParaView, "Warp By Vector" on `<name>_u`
+//! `VTK_QUAD` (9), `Beam2` as `VTK_LINE` (3), with the cell data `sheet` (−1 for beams; the map's
+//! `group` for a user's model) and `thickness` (mm; the beam diameter for beams). A user's model
+//! ([`crate::matrices`]) shows the cells its map lists; a node component without a matrix row is
+//! drawn as zero. In ParaView, "Warp By Vector" on `<name>_u`
 //! shows the deformed shape.
 //!
 //! [`write_shapes`] puts several shapes in one file (one array pair each); [`write_series`]
@@ -18,7 +20,7 @@ use std::path::{Path, PathBuf};
 use faer::MatRef;
 
 use crate::error::Error;
-use crate::model::Model;
+use crate::model::{CellNodes, Model};
 
 /// VTK cell type of a 4-node quadrilateral.
 const VTK_QUAD: u8 = 9;
@@ -34,9 +36,9 @@ fn io(path: &Path) -> impl FnOnce(std::io::Error) -> Error + '_ {
 
 /// The XML of one file: the mesh and, per shape, its two point arrays.
 fn document(model: &Model, shapes: &[(String, Vec<f64>)]) -> String {
-    let mesh = &model.mesh;
-    let nodes = mesh.nodes.len();
-    let cells = mesh.shells.len() + mesh.beams.len();
+    let geo = &model.geometry;
+    let nodes = geo.nodes.len();
+    let cells = geo.cells.len();
     let mut s = String::new();
     let _ = writeln!(s, r#"<?xml version="1.0"?>"#);
     let _ = writeln!(
@@ -53,7 +55,7 @@ fn document(model: &Model, shapes: &[(String, Vec<f64>)]) -> String {
         s,
         r#"<DataArray type="Float64" NumberOfComponents="3" format="ascii">"#
     );
-    for p in &mesh.nodes {
+    for p in &geo.nodes {
         let _ = writeln!(s, "{:e} {:e} {:e}", p[0], p[1], p[2]);
     }
     let _ = writeln!(s, "</DataArray>\n</Points>");
@@ -62,12 +64,15 @@ fn document(model: &Model, shapes: &[(String, Vec<f64>)]) -> String {
         s,
         r#"<DataArray type="Int64" Name="connectivity" format="ascii">"#
     );
-    for e in &mesh.shells {
-        let n = e.nodes;
-        let _ = writeln!(s, "{} {} {} {}", n[0], n[1], n[2], n[3]);
-    }
-    for b in &mesh.beams {
-        let _ = writeln!(s, "{} {}", b.nodes[0], b.nodes[1]);
+    for c in &geo.cells {
+        match c.nodes {
+            CellNodes::Quad4(n) => {
+                let _ = writeln!(s, "{} {} {} {}", n[0], n[1], n[2], n[3]);
+            }
+            CellNodes::Line2(n) => {
+                let _ = writeln!(s, "{} {}", n[0], n[1]);
+            }
+        }
     }
     let _ = writeln!(s, "</DataArray>");
     let _ = writeln!(
@@ -75,41 +80,35 @@ fn document(model: &Model, shapes: &[(String, Vec<f64>)]) -> String {
         r#"<DataArray type="Int64" Name="offsets" format="ascii">"#
     );
     let mut off = 0usize;
-    for _ in &mesh.shells {
-        off += 4;
-        let _ = write!(s, "{off} ");
-    }
-    for _ in &mesh.beams {
-        off += 2;
+    for c in &geo.cells {
+        off += match c.nodes {
+            CellNodes::Quad4(_) => 4,
+            CellNodes::Line2(_) => 2,
+        };
         let _ = write!(s, "{off} ");
     }
     let _ = writeln!(s, "\n</DataArray>");
     let _ = writeln!(s, r#"<DataArray type="UInt8" Name="types" format="ascii">"#);
-    for _ in &mesh.shells {
-        let _ = write!(s, "{VTK_QUAD} ");
-    }
-    for _ in &mesh.beams {
-        let _ = write!(s, "{VTK_LINE} ");
+    for c in &geo.cells {
+        let t = match c.nodes {
+            CellNodes::Quad4(_) => VTK_QUAD,
+            CellNodes::Line2(_) => VTK_LINE,
+        };
+        let _ = write!(s, "{t} ");
     }
     let _ = writeln!(s, "\n</DataArray>\n</Cells>");
     let _ = writeln!(s, "<CellData>");
     let _ = writeln!(s, r#"<DataArray type="Int32" Name="sheet" format="ascii">"#);
-    for e in &mesh.shells {
-        let _ = write!(s, "{} ", e.sheet);
-    }
-    for _ in &mesh.beams {
-        let _ = write!(s, "-1 ");
+    for c in &geo.cells {
+        let _ = write!(s, "{} ", c.group);
     }
     let _ = writeln!(s, "\n</DataArray>");
     let _ = writeln!(
         s,
         r#"<DataArray type="Float64" Name="thickness" format="ascii">"#
     );
-    for e in &mesh.shells {
-        let _ = write!(s, "{:e} ", e.thickness);
-    }
-    for b in &mesh.beams {
-        let _ = write!(s, "{:e} ", b.diameter);
+    for c in &geo.cells {
+        let _ = write!(s, "{:e} ", c.size);
     }
     let _ = writeln!(s, "\n</DataArray>\n</CellData>");
     let _ = writeln!(s, "<PointData>");

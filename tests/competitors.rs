@@ -101,7 +101,7 @@ fn try_reduced_contact(
         red.k.as_ref(),
         b_n_phi.as_ref(),
         &f_red,
-        model.case.contact.normal_stiffness,
+        model.contact.normal_stiffness,
         &ContactOptions::default(),
     )?;
     let um = master.map(|d| (0..r).map(|c| red.phi[(d, c)] * eta[c]).sum());
@@ -265,7 +265,7 @@ fn check_condensed_eigenproblem(model: &Model, set: JimSet, count: usize) -> Vec
     );
     eprintln!(
         "{} {set:?}: |J| = {p}, worst eigen residual {worst:.2e}, f_1 = {:.1} Hz, f_{count} = {:.1} Hz",
-        model.case.name,
+        model.name,
         jim.eigenvalues[0].sqrt() / (2.0 * std::f64::consts::PI),
         jim.eigenvalues[count - 1].sqrt() / (2.0 * std::f64::consts::PI)
     );
@@ -358,7 +358,7 @@ fn alldof_reproduces_the_full_contact_statics() {
         };
         let gs = build_basis(&model, BasisKind::AllDof, &gs_opts).unwrap();
         for s in [1.0, -1.0] {
-            let load = scaled(model.case.master_load(), s);
+            let load = scaled(model.master_load(), s);
             let full = contact_static_full(&model, load, &ContactOptions::default()).unwrap();
             let fc = full.state.contact_force_norm;
             for (what, phi, tol_f) in [
@@ -392,7 +392,7 @@ fn alldof_reproduces_the_full_contact_statics() {
 fn tvd_contact_force_converges_as_g_grows() {
     for name in Case::BUILTIN {
         let model = Model::from_case_name(name).unwrap();
-        let load = model.case.master_load();
+        let load = model.master_load();
         let full = contact_static_full(&model, load, &ContactOptions::default()).unwrap();
         let fc = full.state.contact_force_norm;
         let mut errs = Vec::new();

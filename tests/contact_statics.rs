@@ -35,7 +35,7 @@ fn solve_timed(model: &Model, load: [f64; 6], opts: &ContactOptions) -> ContactS
     println!(
         "{}: load {:?}: |f_c| = {:.6e} N, pairs in contact {}/{}, iterations {} (active per solve {:?}), \
          master uy = {:.6e} mm, wall {:.1} ms",
-        model.case.name,
+        model.name,
         load,
         sol.state.contact_force_norm,
         sol.state.pairs_in_contact,
@@ -52,7 +52,7 @@ fn solve_timed(model: &Model, load: [f64; 6], opts: &ContactOptions) -> ContactS
 /// `K q + B_nᵀ p = f` holds to rounding (backward error ≤ n eps; ≤ 1e-8 relative to f).
 fn check_solution(model: &Model, load: [f64; 6], sol: &ContactSolution) {
     let w = model.joint.pairs();
-    let k_n = model.case.contact.normal_stiffness;
+    let k_n = model.contact.normal_stiffness;
     let s = &sol.state;
     assert_eq!(s.gaps.len(), w);
     // Gaps recomputed from the returned displacement.
@@ -103,18 +103,14 @@ fn check_solution(model: &Model, load: [f64; 6], sol: &ContactSolution) {
     let rel = norm(&r) / norm(&f);
     println!(
         "{}: equilibrium residual: relative to |f| {rel:.3e}, backward error {backward:.3e}",
-        model.case.name
+        model.name
     );
     assert!(
         backward <= n_eps,
         "{}: backward error {backward:e}",
-        model.case.name
+        model.name
     );
-    assert!(
-        rel <= 1e-8,
-        "{}: equilibrium residual {rel:e}",
-        model.case.name
-    );
+    assert!(rel <= 1e-8, "{}: equilibrium residual {rel:e}", model.name);
     for k in 0..6 {
         assert_eq!(
             sol.master_displacement[k],
@@ -127,7 +123,7 @@ fn check_solution(model: &Model, load: [f64; 6], sol: &ContactSolution) {
 fn paper_loads_full_model_is_consistent_and_in_equilibrium() {
     for name in Case::BUILTIN {
         let model = Model::from_case_name(name).unwrap();
-        let load = model.case.master_load();
+        let load = model.master_load();
         let w = model.joint.pairs();
         for l in [load, neg(load)] {
             let sol = solve_timed(&model, l, &ContactOptions::default());
@@ -147,7 +143,7 @@ fn paper_loads_full_model_is_consistent_and_in_equilibrium() {
 fn reversing_the_load_changes_the_contact_set() {
     for name in Case::BUILTIN {
         let model = Model::from_case_name(name).unwrap();
-        let load = model.case.master_load();
+        let load = model.master_load();
         let opts = ContactOptions::default();
         let a = contact_static_full(&model, load, &opts).unwrap();
         let b = contact_static_full(&model, neg(load), &opts).unwrap();
@@ -172,7 +168,7 @@ fn closed_start_gives_the_same_unique_solution() {
     // The energy is strictly convex, so both starts must end at the same state.
     for name in Case::BUILTIN {
         let model = Model::from_case_name(name).unwrap();
-        let load = model.case.master_load();
+        let load = model.master_load();
         let open = contact_static_full(&model, load, &ContactOptions::default()).unwrap();
         let closed = contact_static_full(
             &model,
@@ -202,8 +198,8 @@ fn reduced_with_identity_basis_reproduces_full_solution() {
         let model = Model::from_case_name(name).unwrap();
         let n = model.dofs();
         let w = model.joint.pairs();
-        let k_n = model.case.contact.normal_stiffness;
-        let load = model.case.master_load();
+        let k_n = model.contact.normal_stiffness;
+        let load = model.master_load();
         // Φ = I: K_r = K, B_n Φ = B_n, f_r = f.
         let k_red = model.stiffness.to_dense();
         let phi = Mat::<f64>::identity(n, n);
@@ -306,7 +302,7 @@ fn iteration_cap_is_an_error() {
         max_iterations: 1,
         ..ContactOptions::default()
     };
-    let err = contact_static_full(&model, model.case.master_load(), &opts).unwrap_err();
+    let err = contact_static_full(&model, model.master_load(), &opts).unwrap_err();
     println!("{err}");
     assert!(matches!(err, Error::LinearAlgebra(_)));
     assert!(err.to_string().contains("did not converge in 1 iterations"));
@@ -372,8 +368,8 @@ fn reduced_with_modal_basis_is_a_consistent_contact_solution() {
     for name in Case::BUILTIN {
         let model = Model::from_case_name(name).unwrap();
         let (n, w) = (model.dofs(), model.joint.pairs());
-        let k_n = model.case.contact.normal_stiffness;
-        let load = model.case.master_load();
+        let k_n = model.contact.normal_stiffness;
+        let load = model.master_load();
         let modes = model.modes(20, jointrom::Interface::Free).unwrap();
         let stat = model.static_linear(&[load]).unwrap().remove(0).displacement;
         let r = 21;

@@ -14,11 +14,11 @@ fn paper_dof_counts() {
     let fb = Model::from_case_name("friction_bar").unwrap();
     assert_eq!(fb.dofs(), 906);
     assert_eq!(fb.joint_dofs(), 648);
-    assert_eq!(fb.mesh.pairs.len(), 54);
+    assert_eq!(fb.pair_count(), 54);
     let ml = Model::from_case_name("multilayer_sheet").unwrap();
     assert_eq!(ml.dofs(), 834);
     assert_eq!(ml.joint_dofs(), 828);
-    assert_eq!(ml.mesh.pairs.len(), 92);
+    assert_eq!(ml.pair_count(), 92);
 }
 
 #[test]
@@ -40,17 +40,19 @@ fn free_structure_has_exactly_six_rigid_body_modes() {
 #[test]
 fn clamp_and_rigid_tie_are_exact() {
     let model = Model::from_case_name("friction_bar").unwrap();
-    let load = model.case.master_load();
+    let load = model.master_load();
     let sol = model.static_linear(&[load]).unwrap().remove(0);
     let u = model.dof_map.expand(&sol.displacement);
-    for &c in &model.mesh.clamped {
+    for &c in &model.mesh().unwrap().clamped {
         assert!(u[6 * c..6 * c + 6].iter().all(|&v| v == 0.0));
     }
-    let m = model.mesh.tie.master;
-    let xm = model.mesh.nodes[m];
+    let m = model.mesh().unwrap().tie.master;
+    let xm = model.mesh().unwrap().nodes[m];
     let (um, th) = (&u[6 * m..6 * m + 3], &u[6 * m + 3..6 * m + 6]);
-    for &s in &model.mesh.tie.slaves {
-        let r: Vec<f64> = (0..3).map(|k| model.mesh.nodes[s][k] - xm[k]).collect();
+    for &s in &model.mesh().unwrap().tie.slaves {
+        let r: Vec<f64> = (0..3)
+            .map(|k| model.mesh().unwrap().nodes[s][k] - xm[k])
+            .collect();
         let rigid = [
             um[0] + th[1] * r[2] - th[2] * r[1],
             um[1] + th[2] * r[0] - th[0] * r[2],

@@ -128,7 +128,7 @@ fn tvd_count_residual_sign_flip_and_normalization() {
     let model = Model::from_case_name("friction_bar").unwrap();
     let n = model.dofs();
     let w = model.joint.pairs();
-    let kn = model.case.contact.normal_stiffness;
+    let kn = model.contact.normal_stiffness;
     let base = craig_bampton(&model, 10).unwrap();
     let opts = TvdOptions::default();
     let tvd = trial_vector_derivatives(&model, base.as_ref(), &opts).unwrap();
@@ -417,7 +417,7 @@ fn build_basis_and_reduced_model() {
         (rm.b_phi.nrows(), rm.b_phi.ncols()),
         (model.joint.rows(), r)
     );
-    let f = model.case.load.master.to_array();
+    let f = model.load.master.to_array();
     let mut full = vec![0.0; model.dofs()];
     for (d, &dof) in model.master_dofs().iter().enumerate() {
         full[dof] = f[d];
@@ -529,7 +529,7 @@ fn weighted_pod_of_tvd_resolves_small_eigenvalues() {
     );
     let n = model.dofs();
     let w = model.joint.pairs();
-    let kn = model.case.contact.normal_stiffness;
+    let kn = model.contact.normal_stiffness;
     // Z' and G'.
     let mut bt = Mat::<f64>::zeros(n, w);
     for z in 0..w {
@@ -610,7 +610,7 @@ fn weighted_pod_of_tvd_resolves_small_eigenvalues() {
         },
     )
     .unwrap();
-    let load = model.case.master_load();
+    let load = model.master_load();
     let full = contact_static_full(&model, load, &ContactOptions::default()).unwrap();
     let red = ReducedModel::new(&model, b.phi).unwrap();
     let r = red.dim();

@@ -50,7 +50,7 @@ fn reduced_statics_exact_with_the_whole_joint_space() {
         assert_eq!(dropped, 0, "{case}");
         let rm = ReducedModel::new(&model, phi).unwrap();
         let opts = ContactOptions::default();
-        let full = contact_static_full(&model, model.case.master_load(), &opts).unwrap();
+        let full = contact_static_full(&model, model.master_load(), &opts).unwrap();
         let red = reduced_contact_static(&model, &rm, 1.0, &opts).unwrap();
         let rel = (full.state.contact_force_norm - red.state.contact_force_norm).abs()
             / full.state.contact_force_norm;
@@ -139,7 +139,7 @@ fn friction_bar_study() {
     let model = Model::from_case_name("friction_bar").unwrap();
     let opts = StudyOptions::default();
     let s = run_study(&model, &opts).unwrap();
-    let full = contact_static_full(&model, model.case.master_load(), &opts.contact).unwrap();
+    let full = contact_static_full(&model, model.master_load(), &opts.contact).unwrap();
     assert_eq!(s.full.contact_force_norm, full.state.contact_force_norm);
     let names: Vec<&str> = s.series.iter().map(|x| x.name.as_str()).collect();
     for want in ["tvd", "tvd-plain", "tvd-kt", "modes"] {
@@ -258,7 +258,7 @@ fn chart_log_axis_and_errors() {
 fn assert_equilibrium(model: &Model, rm: &ReducedModel, scale: f64, eta: &[f64], what: &str) {
     let w = model.joint.pairs();
     let r = rm.dim();
-    let k_n = model.case.contact.normal_stiffness;
+    let k_n = model.contact.normal_stiffness;
     let b = |i: usize, j: usize| rm.b_phi[(3 * i + NORMAL, j)];
     let gaps: Vec<f64> = (0..w)
         .map(|i| (0..r).map(|j| b(i, j) * eta[j]).sum())

@@ -314,7 +314,7 @@ fn full_rhs_matches_a_direct_computation() {
         let law = *ode.law();
         let p = pair_forces_direct(&law, &u, &s);
         let mut f = vec![0.0; n];
-        let fm = model.case.load.master_at(t);
+        let fm = model.load.master_at(t);
         for (d, &dof) in model.master_dofs().iter().enumerate() {
             f[dof] += fm[d];
         }

@@ -36,8 +36,8 @@ fn a_shape_is_written_with_its_expansion_and_the_mesh() {
     let path = tmp("shape.vtu");
     vtu::write_shapes(&model, "test", q.as_ref(), &path).unwrap();
     let doc = std::fs::read_to_string(&path).unwrap();
-    let nodes = model.mesh.nodes.len();
-    let cells = model.mesh.shells.len() + model.mesh.beams.len();
+    let nodes = model.mesh().unwrap().nodes.len();
+    let cells = model.mesh().unwrap().shells.len() + model.mesh().unwrap().beams.len();
     assert!(doc.contains(&format!(
         "NumberOfPoints=\"{nodes}\" NumberOfCells=\"{cells}\""
     )));
@@ -49,22 +49,22 @@ fn a_shape_is_written_with_its_expansion_and_the_mesh() {
     assert_eq!(offsets.len(), cells);
     assert_eq!(
         *offsets.last().unwrap() as usize,
-        4 * model.mesh.shells.len() + 2 * model.mesh.beams.len()
+        4 * model.mesh().unwrap().shells.len() + 2 * model.mesh().unwrap().beams.len()
     );
     let u = array(&doc, "test_01_u");
     assert_eq!(u.len(), 3 * nodes);
     // Tied nodes move rigidly with the master: uy = 1, ux = uz = 0; clamped nodes stay at rest.
-    for &s in &model.mesh.tie.slaves {
+    for &s in &model.mesh().unwrap().tie.slaves {
         assert!((u[3 * s + 1] - 1.0).abs() < 1e-12 && u[3 * s].abs() < 1e-12);
     }
-    for &c in &model.mesh.clamped {
+    for &c in &model.mesh().unwrap().clamped {
         assert!(u[3 * c..3 * c + 3].iter().all(|v| *v == 0.0));
     }
     // A rotation θx of the master: slaves follow u = θ × (x_s − x_m), a rigid motion, so the
     // relative displacement of any two slaves is perpendicular to their distance.
     let u2 = array(&doc, "test_02_u");
     let r2 = array(&doc, "test_02_rot");
-    let slaves = &model.mesh.tie.slaves;
+    let slaves = &model.mesh().unwrap().tie.slaves;
     for &s in slaves {
         assert!(
             (r2[3 * s] - 0.01).abs() < 1e-14,
@@ -73,8 +73,8 @@ fn a_shape_is_written_with_its_expansion_and_the_mesh() {
     }
     for w in slaves.windows(2) {
         let (a, b) = (w[0], w[1]);
-        let xa = model.mesh.nodes[a];
-        let xb = model.mesh.nodes[b];
+        let xa = model.mesh().unwrap().nodes[a];
+        let xb = model.mesh().unwrap().nodes[b];
         let d: Vec<f64> = (0..3).map(|k| xb[k] - xa[k]).collect();
         let du: Vec<f64> = (0..3).map(|k| u2[3 * b + k] - u2[3 * a + k]).collect();
         let stretch: f64 = d.iter().zip(&du).map(|(x, y)| x * y).sum();

@@ -364,7 +364,18 @@ fn check_material(case: &Case, ctx: &Ctx) -> Result<(), Error> {
 
 /// The contact law, the load and the end time.
 fn check_contact_and_load(case: &Case, ctx: &Ctx) -> Result<(), Error> {
-    let c = &case.contact;
+    check_contact_load(&case.contact, &case.load, case.end_time, ctx.file)
+}
+
+/// Checks a contact law, a master load and an end time (fields `contact.*`, `load.*`,
+/// `end_time` of a case file or a matrix map named `file`).
+pub(crate) fn check_contact_load(
+    c: &super::ContactSpec,
+    load: &super::LoadSpec,
+    end_time: f64,
+    file: &str,
+) -> Result<(), Error> {
+    let ctx = &Ctx { file };
     ctx.positive("contact.normal_stiffness", c.normal_stiffness, " N/mm")?;
     let mu = c.friction_coefficient;
     if !(mu.is_finite() && mu >= 0.0) {
@@ -374,7 +385,7 @@ fn check_contact_and_load(case: &Case, ctx: &Ctx) -> Result<(), Error> {
         ));
     }
     ctx.positive("contact.stick_stiffness", c.stick_stiffness, " N/mm")?;
-    let m = &case.load.master;
+    let m = &load.master;
     for (key, v, unit) in [
         ("fx", m.fx, " N"),
         ("fy", m.fy, " N"),
@@ -385,8 +396,8 @@ fn check_contact_and_load(case: &Case, ctx: &Ctx) -> Result<(), Error> {
     ] {
         ctx.finite(&format!("load.master.{key}"), v, unit)?;
     }
-    ctx.positive("load.ramp.duration", case.load.ramp.duration, " s")?;
-    ctx.positive("end_time", case.end_time, " s")
+    ctx.positive("load.ramp.duration", load.ramp.duration, " s")?;
+    ctx.positive("end_time", end_time, " s")
 }
 
 /// Checks every sheet's own fields and numbers the nodes.

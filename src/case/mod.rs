@@ -61,6 +61,9 @@
 mod build;
 mod parse;
 
+pub(crate) use build::check_contact_load;
+pub(crate) use parse::parse_object;
+
 use std::path::Path;
 
 use serde::{Deserialize, Serialize};

@@ -5,23 +5,33 @@ use crate::error::Error;
 
 /// Parses `text` (the whole text must be one JSON object; unknown fields are rejected).
 pub(super) fn parse(text: &str, file: &str) -> Result<Case, Error> {
-    // serde's derived structs also accept a JSON array (fields by position); a case file is an
-    // object.
+    parse_object(text, file, "a case file")
+}
+
+/// Parses `text` as one JSON object of type `T`; errors are [`Error::Case`] naming `file` and
+/// the JSON path. `what` names the kind of file in the error for a non-object.
+pub(crate) fn parse_object<T: serde::de::DeserializeOwned>(
+    text: &str,
+    file: &str,
+    what: &str,
+) -> Result<T, Error> {
+    // serde's derived structs also accept a JSON array (fields by position); these files are
+    // objects.
     let first = text.trim_start().chars().next();
     if first.is_some_and(|c| c != '{') {
         return Err(Error::Case {
             file: file.to_string(),
             path: "$".to_string(),
-            reason: "a case file must be one JSON object `{ ... }`".to_string(),
+            reason: format!("{what} must be one JSON object `{{ ... }}`"),
         });
     }
     let mut de = serde_json::Deserializer::from_str(text);
-    let case: Case = serde_path_to_error::deserialize(&mut de).map_err(|e| {
+    let value: T = serde_path_to_error::deserialize(&mut de).map_err(|e| {
         let path = e.path().to_string();
         serde_error(file, &path, e.inner())
     })?;
     de.end().map_err(|e| serde_error(file, ".", &e))?;
-    Ok(case)
+    Ok(value)
 }
 
 /// One serde_json error as [`Error::Case`]: the path as `serde_path_to_error` renders it (its

@@ -107,26 +107,29 @@ pub struct JointInterfaceModes {
     pub in_plane_dofs: usize,
 }
 
-/// The interior (non-master) independent DOF of the joint nodes in the `Normal` (y) or
-/// `InPlane` (x, z) set, node by node in ascending node order. Errors if a joint node's
+/// The interior (non-master) independent DOF of the joint nodes in the `Normal` or `InPlane`
+/// set, node by node in ascending node order: the global axis closest to the node's pair normal
+/// (y for generated sheets), or the other two axes (x, z). Errors if a joint node's
 /// translation is not an independent interior DOF (clamped, tied or the master node).
 pub fn jim_dofs(model: &Model, set: JimSet) -> Result<Vec<usize>, Error> {
-    let dirs: &[usize] = match set {
-        JimSet::Normal => &[1],
-        JimSet::InPlane => &[0, 2],
-        JimSet::Both => &[1, 0, 2],
-    };
-    let mut nodes: Vec<usize> = model
-        .mesh
+    // Per joint node, the global axis closest to its pair's normal (y for generated sheets).
+    let mut nodes: Vec<(usize, usize)> = model
         .pairs
         .iter()
-        .flat_map(|p| [p.lower, p.upper])
+        .flat_map(|p| [(p.lower, p.normal_axis()), (p.upper, p.normal_axis())])
         .collect();
-    nodes.sort_unstable();
-    nodes.dedup();
+    nodes.sort_unstable_by_key(|e| e.0);
+    nodes.dedup_by_key(|e| e.0);
     let m = model.dofs().saturating_sub(6);
-    let mut out = Vec::with_capacity(nodes.len() * dirs.len());
-    for &node in &nodes {
+    let mut out = Vec::with_capacity(nodes.len() * 3);
+    for &(node, a) in &nodes {
+        let in_plane = [(a + 1) % 3, (a + 2) % 3];
+        let in_plane = [in_plane[0].min(in_plane[1]), in_plane[0].max(in_plane[1])];
+        let dirs: &[usize] = match set {
+            JimSet::Normal => &[a],
+            JimSet::InPlane => &in_plane,
+            JimSet::Both => &[a, in_plane[0], in_plane[1]],
+        };
         let deps = model.dof_map.nodes.get(node).ok_or_else(|| {
             Error::Invalid(format!(
                 "joint pair names node {node}, which does not exist"

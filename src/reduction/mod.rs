@@ -91,7 +91,7 @@ impl ReducedModel {
         let m = compensated_gram(&model.mass, phi.as_ref());
         let r = phi.ncols();
         let b_phi = model.joint.reduce(phi.as_ref());
-        let f = model.case.load.master.to_array();
+        let f = model.load.master.to_array();
         let master = model.master_dofs();
         let load = (0..r)
             .map(|c| (0..6).map(|d| phi[(master[d], c)] * f[d]).sum())

@@ -218,8 +218,8 @@ pub fn trial_vector_derivatives(
     }
     let joint = &model.joint;
     let w = joint.pairs();
-    let kn = model.case.contact.normal_stiffness;
-    let kt = model.case.contact.stick_stiffness;
+    let kn = model.contact.normal_stiffness;
+    let kt = model.contact.stick_stiffness;
     let nb = base.ncols();
     let bphi = joint.reduce(base); // 3w × nb
                                    // Joint rows that receive stiffness, B_u (m of them), and each one's stiffness.
@@ -582,7 +582,7 @@ mod tests {
         let act = &tvd.active[j][if k < 0 { 0 } else { 1 }];
         let mut b = vec![0.0; model.joint.rows()];
         model.joint.apply(&col(base, i), &mut b);
-        let kn = model.case.contact.normal_stiffness;
+        let kn = model.contact.normal_stiffness;
         let p: Vec<f64> = (0..b.len())
             .map(|r| {
                 if r % 3 == NORMAL && act[r / 3] {
