@@ -929,12 +929,15 @@ struct TransientArgs {
     vtu_frames: usize,
 }
 
+/// Kept states: (time in s, state).
+type Frames = Vec<(f64, Vec<f64>)>;
+
 /// A transient run that keeps every `every`-th state (with its time) when `every` is given.
 fn run_keeping<S: jointrom::system::SecondOrderSystem>(
     sys: S,
     opts: &TransientOptions,
     every: Option<usize>,
-) -> Result<(transient::TransientResult, Vec<(f64, Vec<f64>)>), Error> {
+) -> Result<(transient::TransientResult, Frames), Error> {
     let Some(every) = every else {
         return Ok((transient::run(sys, opts)?, Vec::new()));
     };
@@ -1013,7 +1016,7 @@ fn transient_options(a: &TransientArgs) -> Result<TransientOptions, Error> {
 }
 
 /// Reduced states `q` (r) to physical DOF `Φ q` (n).
-fn expand_frames(rom: &ReducedModel, kept: Vec<(f64, Vec<f64>)>) -> Vec<(f64, Vec<f64>)> {
+fn expand_frames(rom: &ReducedModel, kept: Frames) -> Frames {
     kept.into_iter()
         .map(|(t, q)| {
             let u = (0..rom.phi.nrows())
@@ -1044,7 +1047,7 @@ fn transient_command(
         }
     };
     // Kept states in physical DOF (reduced states are expanded with Φ).
-    let mut frames: Vec<(f64, Vec<f64>)> = Vec::new();
+    let mut frames: Frames = Vec::new();
     let t0 = Instant::now();
     let (res, basis_size, g_used, training) = match a.model.as_str() {
         "full" => {
