@@ -145,6 +145,8 @@ pub struct PaperAnchor {
 pub struct Report {
     /// Case name.
     pub case: String,
+    /// The CASE argument that reproduces the model: a built-in name, a case file or a matrix map.
+    pub source: String,
     /// The command line.
     pub command_line: Vec<String>,
     /// Quick variant.
@@ -474,6 +476,11 @@ pub fn run_report(
     let anchors = paper_anchors(&case);
     let mut report = Report {
         case: case.clone(),
+        source: model
+            .source
+            .strip_prefix("builtin:")
+            .unwrap_or(&model.source)
+            .to_string(),
         command_line: std::env::args().collect(),
         quick: opts.quick,
         dofs: model.dofs(),
@@ -848,7 +855,7 @@ fn markdown(rep: &Report, stab: &Path, stability: bool) -> String {
             s,
             "No stored map under `{}`: run `jointrom stability {}` (about 17 min on 2 cores).\n",
             stab.display(),
-            rep.case
+            rep.source
         );
     }
     s
