@@ -4,7 +4,7 @@
 //! maps and matrices are rejected naming the file and the field.
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
+use std::process::{Command, Output};
 
 use jointrom::contact::{contact_static_full, ContactOptions};
 use jointrom::reduction::{build_basis, BasisKind, BasisOptions, ReducedModel};
@@ -198,35 +198,43 @@ fn rows_in_another_order_with_spc_rows_give_the_same_model() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-#[test]
-fn cli_info_and_quick_report_on_a_matrix_model() {
-    let dir = tmp_dir("cli");
-    let exe = env!("CARGO_BIN_EXE_jointrom");
-    let out = Command::new(exe)
-        .args(["export-matrices", "friction_bar", "--json", "--out"])
-        .arg(&dir)
+/// Runs the jointrom binary with `args`; its output.
+fn jointrom<S: AsRef<std::ffi::OsStr>>(args: &[S]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_jointrom"))
+        .args(args)
         .output()
-        .unwrap();
+        .unwrap()
+}
+
+/// Runs the jointrom binary with `args`, asserting success; its standard output.
+fn jointrom_ok<S: AsRef<std::ffi::OsStr>>(args: &[S]) -> Vec<u8> {
+    let out = jointrom(args);
     assert!(
         out.status.success(),
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
+    out.stdout
+}
+
+#[test]
+fn cli_info_and_quick_report_on_a_matrix_model() {
+    let dir = tmp_dir("cli");
+    let out_arg = dir.to_str().unwrap();
+    jointrom_ok(&[
+        "export-matrices",
+        "friction_bar",
+        "--json",
+        "--out",
+        out_arg,
+    ]);
     let map = dir.join("model.json");
+    let map_arg = map.to_str().unwrap();
     let info = |arg: &str| -> Value {
-        let out = Command::new(exe)
-            .args(["info", "--json", arg])
-            .output()
-            .unwrap();
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        serde_json::from_slice(&out.stdout).unwrap()
+        serde_json::from_slice(&jointrom_ok(&["info", "--json", arg])).unwrap()
     };
     let a = info("friction_bar");
-    let b = info(map.to_str().unwrap());
+    let b = info(map_arg);
     assert_eq!(b["origin"], "matrices");
     assert_eq!(a["origin"], "case");
     for k in [
@@ -246,55 +254,43 @@ fn cli_info_and_quick_report_on_a_matrix_model() {
 
     // The transient displacement field of a ROM run on the matrices, as a VTU series.
     let vtu = dir.join("vtu");
-    let out = Command::new(exe)
-        .args(["transient", map.to_str().unwrap(), "--end-time", "0.01"])
-        .args(["--vtu-frames", "5", "--vtu"])
-        .arg(&vtu)
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let vtu_arg = vtu.to_str().unwrap();
+    jointrom_ok(&[
+        "transient",
+        map_arg,
+        "--end-time",
+        "0.01",
+        "--vtu-frames",
+        "5",
+        "--vtu",
+        vtu_arg,
+    ]);
     let pvd = std::fs::read_to_string(vtu.join("u.pvd")).unwrap();
     let frames = pvd.matches("<DataSet").count();
     assert!((5..=7).contains(&frames), "{frames} frames");
     let last = std::fs::read_to_string(vtu.join(format!("u_{:04}.vtu", frames - 1))).unwrap();
     assert!(last.contains(r#"Name="u_u""#));
-    let out = Command::new(exe)
-        .args([
-            "transient",
-            map.to_str().unwrap(),
-            "--vtu-frames",
-            "0",
-            "--vtu",
-        ])
-        .arg(&vtu)
-        .output()
-        .unwrap();
+    let out = jointrom(&["transient", map_arg, "--vtu-frames", "0", "--vtu", vtu_arg]);
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("--vtu-frames"));
 
     // The main job's quick report on the matrices: same accuracy figures as on the case.
     let report = |arg: &str, sub: &str| -> Value {
         let out_dir = dir.join(sub);
-        let out = Command::new(exe)
-            .args(["run", arg, "--quick", "--json", "--out"])
-            .arg(&out_dir)
-            .output()
-            .unwrap();
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
+        jointrom_ok(&[
+            "run",
+            arg,
+            "--quick",
+            "--json",
+            "--out",
+            out_dir.to_str().unwrap(),
+        ]);
         let text = std::fs::read_to_string(out_dir.join("friction_bar/results.json")).unwrap();
         assert!(out_dir.join("friction_bar/speed_accuracy.png").is_file());
         serde_json::from_str(&text).unwrap()
     };
     let ra = report("friction_bar", "case");
-    let rb = report(map.to_str().unwrap(), "matrices");
+    let rb = report(map_arg, "matrices");
     assert_eq!(ra["g_chosen"], rb["g_chosen"]);
     let errors = |r: &Value| -> Vec<(Value, Value, Value)> {
         r["runs"]
