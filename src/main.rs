@@ -1015,15 +1015,13 @@ fn transient_options(a: &TransientArgs) -> Result<TransientOptions, Error> {
     Ok(o)
 }
 
-/// Reduced states `q` (r) to physical DOF `Φ q` (n).
+/// Reduced states `q` (r) to physical DOF `Φ q` (n): one product `Φ [q_1 … q_f]`.
 fn expand_frames(rom: &ReducedModel, kept: Frames) -> Frames {
-    kept.into_iter()
-        .map(|(t, q)| {
-            let u = (0..rom.phi.nrows())
-                .map(|i| (0..q.len()).map(|c| rom.phi[(i, c)] * q[c]).sum())
-                .collect();
-            (t, u)
-        })
+    let q = faer::Mat::from_fn(rom.dim(), kept.len(), |i, j| kept[j].1[i]);
+    let u = &rom.phi * &q;
+    kept.iter()
+        .enumerate()
+        .map(|(j, &(t, _))| (t, u.col(j).iter().copied().collect()))
         .collect()
 }
 
