@@ -765,17 +765,19 @@ pub fn write(model: &Model, dir: &Path) -> Result<Vec<PathBuf>, Error> {
     let cells = geo
         .cells
         .iter()
-        .map(|c| {
-            let (kind, nodes) = match c.nodes {
-                CellNodes::Quad4(n) => (MapCellKind::Quad4, n.to_vec()),
-                CellNodes::Line2(n) => (MapCellKind::Line2, n.to_vec()),
-            };
-            MapCell {
-                kind,
-                nodes: nodes.iter().map(|&i| geo.node_ids[i]).collect(),
-                group: c.group,
-                size: c.size,
-            }
+        .map(|c| MapCell {
+            kind: match c.nodes {
+                CellNodes::Quad4(_) => MapCellKind::Quad4,
+                CellNodes::Line2(_) => MapCellKind::Line2,
+            },
+            nodes: c
+                .nodes
+                .as_slice()
+                .iter()
+                .map(|&i| geo.node_ids[i])
+                .collect(),
+            group: c.group,
+            size: c.size,
         })
         .collect();
     let map = MatrixMap {

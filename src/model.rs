@@ -79,6 +79,16 @@ pub enum CellNodes {
     Line2([usize; 2]),
 }
 
+impl CellNodes {
+    /// The node indices, in cell order.
+    pub fn as_slice(&self) -> &[usize] {
+        match self {
+            CellNodes::Quad4(n) => n,
+            CellNodes::Line2(n) => n,
+        }
+    }
+}
+
 /// A cell of the display geometry (VTU output, pictures; not used by the mechanics).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Cell {

@@ -65,13 +65,9 @@ fn document(model: &Model, shapes: &[(String, Vec<f64>)]) -> String {
         r#"<DataArray type="Int64" Name="connectivity" format="ascii">"#
     );
     for c in &geo.cells {
-        match c.nodes {
-            CellNodes::Quad4(n) => {
-                let _ = writeln!(s, "{} {} {} {}", n[0], n[1], n[2], n[3]);
-            }
-            CellNodes::Line2(n) => {
-                let _ = writeln!(s, "{} {}", n[0], n[1]);
-            }
+        let n = c.nodes.as_slice();
+        for (k, i) in n.iter().enumerate() {
+            let _ = write!(s, "{i}{}", if k + 1 < n.len() { " " } else { "\n" });
         }
     }
     let _ = writeln!(s, "</DataArray>");
@@ -81,10 +77,7 @@ fn document(model: &Model, shapes: &[(String, Vec<f64>)]) -> String {
     );
     let mut off = 0usize;
     for c in &geo.cells {
-        off += match c.nodes {
-            CellNodes::Quad4(_) => 4,
-            CellNodes::Line2(_) => 2,
-        };
+        off += c.nodes.as_slice().len();
         let _ = write!(s, "{off} ");
     }
     let _ = writeln!(s, "\n</DataArray>");
