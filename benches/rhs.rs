@@ -13,10 +13,10 @@ use std::hint::black_box;
 use std::time::Duration;
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use jointrom::ode::OdeProblem;
+use jointrom::integrate::mechanical::{run, MechanicalOde, ProblemOptions, TransientOptions};
+use jointrom::integrate::problem::OdeProblem;
 use jointrom::reduction::{build_basis, BasisKind, BasisOptions, ReducedModel};
 use jointrom::system::{FullSystem, ReducedSystem, SecondOrderSystem};
-use jointrom::transient::{run, MechanicalOde, ProblemOptions, TransientOptions};
 use jointrom::Model;
 
 /// Mean time of `f` over a calibrated number of calls, ns.

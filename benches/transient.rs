@@ -1,6 +1,6 @@
 //! Transient benchmarks (issue 4): the friction bar with friction, at the paper's Table 1
 //! tolerances (rtol 1e-8, atol 1e-6 mm) with the transient defaults (BDF max order 2, velocity
-//! atol 1e3 1/s × atol, events off, see `jointrom::transient`):
+//! atol 1e3 1/s × atol, events off, see `jointrom::integrate::mechanical`):
 //!
 //! - ROM with the w(g)-chosen TVD basis, functional iteration and Newton (structured solve);
 //! - full FE model, functional iteration and Newton (structured sparse solve).
@@ -16,10 +16,10 @@
 use std::time::Duration;
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use jointrom::ode::{Iteration, NewtonLinear, OdeOptions};
+use jointrom::integrate::mechanical::{run, ProblemOptions, TransientOptions, TransientResult};
+use jointrom::integrate::problem::{Iteration, NewtonLinear, OdeOptions};
 use jointrom::reduction::{build_basis, BasisKind, BasisOptions, ReducedModel};
 use jointrom::system::{FullSystem, ReducedSystem};
-use jointrom::transient::{run, ProblemOptions, TransientOptions, TransientResult};
 use jointrom::Model;
 
 fn options(iteration: Iteration, end: f64) -> TransientOptions {

@@ -26,33 +26,31 @@
 // All FFI `unsafe` lives in `sundials`.
 #![deny(unsafe_code)]
 
-pub mod assembly;
+pub mod linalg;
+
 pub mod case;
-pub mod chart;
-pub mod contact;
-pub mod element;
-pub mod error;
-pub mod export;
-pub mod friction;
-pub mod heatmap;
-pub mod joint;
-pub mod matrices;
+
 pub mod mesh;
+
+pub mod element;
+
+pub mod assembly;
+
+pub mod joint;
+
 pub mod model;
-pub mod modes;
-pub mod ode;
-pub mod reduction;
-pub mod report;
-pub mod shapes;
-pub mod stability;
-pub mod statics;
-pub mod study;
-#[allow(unsafe_code)]
-pub mod sundials;
-pub mod sweep;
+
 pub mod system;
-pub mod transient;
-pub mod vtu;
+
+pub mod reduction;
+
+pub mod integrate;
+
+pub mod studies;
+
+pub mod report;
+
+pub mod error;
 
 pub use error::Error;
 pub use model::{Interface, Model};

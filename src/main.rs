@@ -7,11 +7,15 @@ use std::time::Instant;
 use clap::{Parser, Subcommand, ValueEnum};
 use serde_json::{json, Value};
 
-use jointrom::ode::{Iteration, NewtonLinear};
+use jointrom::integrate::mechanical::{self as transient, TransientOptions};
+use jointrom::integrate::problem::{Iteration, NewtonLinear};
+use jointrom::joint::statics as contact;
+use jointrom::reduction::rom_file as export;
 use jointrom::reduction::{build_basis, snapshot_basis, BasisKind, BasisOptions, ReducedModel};
+use jointrom::report::main_job as report;
+use jointrom::studies::convergence as study;
 use jointrom::system::{FullSystem, ReducedSystem};
-use jointrom::transient::{self, TransientOptions};
-use jointrom::{contact, export, report, study, Error, Interface, Model};
+use jointrom::{Error, Interface, Model};
 
 #[derive(Parser)]
 #[command(
@@ -68,7 +72,7 @@ enum Command {
         #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
         scale: f64,
         /// Solve the reduced model on this basis instead of the full FE model: tvd, tvd-plain,
-        /// modes, ... (see `jointrom::study::BASIS_KINDS`).
+        /// modes, ... (see `jointrom::studies::convergence::BASIS_KINDS`).
         #[arg(long)]
         basis: Option<String>,
         /// Enrichment vectors of the basis (joint modes; extra modes for `modes`); default: the
@@ -129,7 +133,7 @@ enum Command {
     /// Stability map of the transient methods: model × iteration × k_n × friction × events ×
     /// max order → status (ok or the CVODE flag and time reached), cost, error; writes
     /// OUT/CASE/stability.json, stability.md and heat maps (SVG/PNG).
-    Stability(jointrom::stability::StabilityArgs),
+    Stability(jointrom::studies::stability::StabilityArgs),
 
     /// Transient run from rest (CVODE): contact force norm, friction force norm and master uy
     /// over time, solver statistics and wall time.
@@ -240,7 +244,7 @@ enum Command {
         json: bool,
     },
     /// Writes a reduced model as a versioned JSON file (schema `jointrom-rom` v1: M̃, K̃, BΦ,
-    /// master rows, reduced loads, contact law, load ramp; see `jointrom::export`).
+    /// master rows, reduced loads, contact law, load ramp; see `jointrom::reduction::rom_file`).
     Export {
         /// Case file, matrix map (`jointrom-matrices` JSON) or built-in name.
         case: String,
@@ -258,7 +262,7 @@ enum Command {
         out: PathBuf,
     },
     /// Writes a model's K and M as MatrixMarket files plus the JSON map (`K.mtx`, `M.mtx`,
-    /// `model.json`; see `jointrom::matrices`): the format a user's own model comes in. Any
+    /// `model.json`; see `jointrom::model::matrices`): the format a user's own model comes in. Any
     /// command takes `DIR/model.json` where it takes a case.
     ExportMatrices {
         /// Case file, matrix map or built-in name.
@@ -358,7 +362,8 @@ fn static_json(model: &Model, scale: f64) -> Result<Value, Error> {
 
 fn contact_json(model: &Model, scale: f64) -> Result<Value, Error> {
     let load = model.master_load().map(|v| v * scale);
-    let sol = contact::contact_static_full(model, load, &contact::ContactOptions::default())?;
+    let sol =
+        jointrom::model::contact_static_full(model, load, &contact::ContactOptions::default())?;
     Ok(json!({
         "case": model.name,
         "linear": false,
@@ -532,7 +537,7 @@ fn run(command: Command) -> Result<(), Error> {
             }
         }
         Command::Stability(args) => {
-            let v = jointrom::stability::stability_command(&args)?;
+            let v = jointrom::studies::stability::stability_command(&args)?;
             println!(
                 "{}",
                 serde_json::to_string_pretty(&v)
@@ -641,9 +646,9 @@ fn run(command: Command) -> Result<(), Error> {
             nu,
         } => {
             let model = Model::from_case_name(&case)?;
-            let s = jointrom::shapes::shapes(&model, nu, count)?;
+            let s = jointrom::report::shapes::shapes(&model, nu, count)?;
             let dir = out.join(&model.name);
-            for f in jointrom::shapes::write_shapes(&model, &s, &dir)? {
+            for f in jointrom::report::shapes::write_shapes(&model, &s, &dir)? {
                 println!("{}", f.display());
             }
         }
@@ -657,7 +662,7 @@ fn run(command: Command) -> Result<(), Error> {
             json,
         } => {
             let model = Model::from_case_name(&case)?;
-            let list = jointrom::sweep::read_variants(&variants)?;
+            let list = jointrom::studies::sweep::read_variants(&variants)?;
             let kind = BasisKind::from_name(&basis)
                 .map_err(|e| Error::Invalid(format!("--basis: {e}")))?;
             let t0 = Instant::now();
@@ -676,7 +681,7 @@ fn run(command: Command) -> Result<(), Error> {
             if let Some(t) = end_time {
                 opts.end_time = Some(positive("end-time", t)?);
             }
-            let res = jointrom::sweep::run_sweep(&model, &rom, &list, &opts, !sequential)?;
+            let res = jointrom::studies::sweep::run_sweep(&model, &rom, &list, &opts, !sequential)?;
             if json {
                 print_json(&json!({
                     "case": model.name,
@@ -720,7 +725,7 @@ fn run(command: Command) -> Result<(), Error> {
         }
         Command::ExportMatrices { case, out, json } => {
             let model = Model::from_case_name(&case)?;
-            let files = jointrom::matrices::write(&model, &out)?;
+            let files = jointrom::model::matrices::write(&model, &out)?;
             if json {
                 print_json(&json!({
                     "case": model.name,
@@ -1183,7 +1188,7 @@ fn transient_command(
     });
     if let Some(dir) = &a.vtu {
         let (times, states): (Vec<f64>, Vec<Vec<f64>>) = frames.into_iter().unzip();
-        let pvd = jointrom::vtu::write_series(&model, "u", &times, &states, dir)?;
+        let pvd = jointrom::report::vtu::write_series(&model, "u", &times, &states, dir)?;
         eprintln!("{} frames → {}", times.len(), pvd.display());
     }
     if let Some(dir) = out {

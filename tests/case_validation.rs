@@ -2,10 +2,19 @@
 //! an `Error::Case` naming the file, the JSON path and the problem in plain words.
 
 use jointrom::case::Case;
+use jointrom::mesh::Mesh;
 use jointrom::Error;
 use serde_json::{json, Value};
 
 const FILE: &str = "edited_friction_bar.json";
+
+/// Parses and validates a case as every command does: the fields when the file is read, the
+/// geometry when its mesh is generated.
+fn validated(text: &str, file: &str) -> Result<Case, Error> {
+    let case = Case::from_json_str(text, file)?;
+    Mesh::from_case(&case)?;
+    Ok(case)
+}
 
 fn friction_bar() -> Value {
     serde_json::from_str(include_str!("../cases/friction_bar.json")).expect("builtin is JSON")
@@ -14,7 +23,7 @@ fn friction_bar() -> Value {
 /// Parses `text` and checks the error's file, path and that the reason contains `word`
 /// (case-insensitive).
 fn expect_text_err(text: &str, path: &str, word: &str) {
-    match Case::from_json_str(text, FILE) {
+    match validated(text, FILE) {
         Err(Error::Case {
             file,
             path: got,
@@ -47,7 +56,7 @@ fn edited(edit: impl FnOnce(&mut Value), path: &str, word: &str) {
 fn expect_mesh_err(edit: impl FnOnce(&mut Case), path: &str, word: &str) {
     let mut case = Case::builtin("friction_bar").unwrap().unwrap();
     edit(&mut case);
-    match case.build_mesh() {
+    match Mesh::from_case(&case) {
         Err(Error::Case {
             file,
             path: got,
@@ -71,7 +80,7 @@ fn remove(v: &mut Value, key: &str) {
 
 #[test]
 fn the_unedited_friction_bar_is_accepted() {
-    Case::from_json_str(&friction_bar().to_string(), FILE).expect("valid");
+    validated(&friction_bar().to_string(), FILE).expect("valid");
 }
 
 #[test]
@@ -106,7 +115,7 @@ fn missing_fields() {
     let mut case = friction_bar();
     remove(&mut case, "description");
     case["load"]["master"] = json!({});
-    let case = Case::from_json_str(&case.to_string(), FILE).expect("optional fields");
+    let case = validated(&case.to_string(), FILE).expect("optional fields");
     assert_eq!(case.description, None);
     assert_eq!(case.master_load(), [0.0; 6]);
 }
@@ -144,7 +153,7 @@ fn wrong_types() {
 fn malformed_json() {
     let text = friction_bar().to_string();
     let cut = &text[..text.len() / 2];
-    match Case::from_json_str(cut, FILE) {
+    match validated(cut, FILE) {
         Err(Error::Case { file, reason, .. }) => {
             assert_eq!(file, FILE);
             assert!(
@@ -286,7 +295,7 @@ fn contact_parameters() {
     // Frictionless contact is allowed.
     let mut case = friction_bar();
     case["contact"]["friction_coefficient"] = json!(0.0);
-    Case::from_json_str(&case.to_string(), FILE).expect("mu = 0 is valid");
+    validated(&case.to_string(), FILE).expect("mu = 0 is valid");
 }
 
 #[test]
@@ -463,7 +472,7 @@ fn joints_need_zero_clearance() {
     // Within the tolerance 1e-9 of the scale the sheets touch.
     let mut case = friction_bar();
     case["sheets"][1]["y"] = json!(0.5 + 1e-12);
-    Case::from_json_str(&case.to_string(), FILE).expect("touching within tolerance");
+    validated(&case.to_string(), FILE).expect("touching within tolerance");
 }
 
 #[test]
@@ -488,9 +497,7 @@ fn overlapping_joint_sheets_must_coincide() {
         "joints[0]",
         "overlapping sheets that do not coincide",
     );
-    let reason = Case::from_json_str(&case.to_string(), FILE)
-        .unwrap_err()
-        .to_string();
+    let reason = validated(&case.to_string(), FILE).unwrap_err().to_string();
     assert!(reason.contains("`A`") && reason.contains("`B`"), "{reason}");
     // Shifted across z by a quarter element.
     edited(
@@ -526,8 +533,8 @@ fn joints_must_be_between_two_distinct_sheets_once() {
 fn explicit_joint_points() {
     let mut case = friction_bar();
     case["joints"][0]["points"] = json!([[105.0, 12.5], [60.0, 12.5], [60.0, 0.0]]);
-    let case = Case::from_json_str(&case.to_string(), FILE).expect("explicit points");
-    let mesh = case.build_mesh().unwrap();
+    let case = validated(&case.to_string(), FILE).expect("explicit points");
+    let mesh = Mesh::from_case(&case).unwrap();
     let pairs: Vec<(usize, usize)> = mesh.pairs.iter().map(|p| (p.lower, p.upper)).collect();
     assert_eq!(
         pairs,
@@ -585,10 +592,7 @@ fn implicit_pairs_skip_clamped_and_tied_nodes() {
     let mut case = friction_bar();
     push(&mut case["clamps"], json!({"x": 40.0, "sheets": ["B"]}));
     case["rigid_tie"] = json!({"x": 125.0, "sheets": ["A", "B"], "master": [125.0, 0.25, 12.5]});
-    let mesh = Case::from_json_str(&case.to_string(), FILE)
-        .unwrap()
-        .build_mesh()
-        .unwrap();
+    let mesh = Mesh::from_case(&validated(&case.to_string(), FILE).unwrap()).unwrap();
     assert_eq!(mesh.pairs.len(), 54 - 6);
     // A joint whose every pair is clamped or tied is an error.
     let mut case = friction_bar();
@@ -612,7 +616,7 @@ fn no_node_may_be_both_clamped_and_tied() {
 fn build_mesh_labels_errors_with_the_source() {
     let mut case = Case::builtin("friction_bar").unwrap().unwrap();
     case.sheets[0].thickness = -1.0;
-    let Err(err) = case.build_mesh() else {
+    let Err(err) = Mesh::from_case(&case) else {
         panic!("negative thickness accepted by build_mesh");
     };
     assert_eq!(

@@ -8,17 +8,16 @@
 use std::time::Instant;
 
 use faer::{Mat, MatRef};
-use jointrom::assembly::SymCsc;
 use jointrom::case::Case;
-use jointrom::contact::{
-    contact_static_full, contact_static_reduced, ContactOptions, ContactState,
-};
+use jointrom::joint::statics::{contact_static_reduced, ContactOptions, ContactState};
 use jointrom::joint::NORMAL;
+use jointrom::linalg::cholesky::SparseCholesky;
+use jointrom::linalg::SymCsc;
+use jointrom::model::contact_static_full;
 use jointrom::reduction::{
     alldof_vectors, build_basis, jim_dofs, joint_interface_modes, snapshot_basis, snapshot_pod,
     BasisKind, BasisOptions, JimSet, ReducedModel,
 };
-use jointrom::statics::SparseCholesky;
 use jointrom::{Error, Model};
 
 fn mul(a: &SymCsc, x: &[f64]) -> Vec<f64> {

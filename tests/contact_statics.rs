@@ -6,11 +6,11 @@ use std::time::Instant;
 
 use faer::Mat;
 use jointrom::case::Case;
-use jointrom::contact::{
-    active_set_newton, contact_static_full, contact_static_reduced, ActiveStart, ContactOptions,
-    ContactSolution,
+use jointrom::joint::statics::{
+    active_set_newton, contact_static_reduced, ActiveStart, ContactOptions, ContactSolution,
 };
 use jointrom::joint::NORMAL;
+use jointrom::model::contact_static_full;
 use jointrom::{Error, Model};
 
 fn master_force(model: &Model, load: [f64; 6]) -> Vec<f64> {

@@ -1,13 +1,13 @@
-//! The safe CVODE wrapper (`jointrom::sundials::Cvode`) against exact solutions: accuracy for
+//! The safe CVODE wrapper (`jointrom::integrate::sundials::Cvode`) against exact solutions: accuracy for
 //! every iteration type, Newton iteration counts of the problem's solver vs CVODE's dense one,
 //! stiffness, callback panics and NaN, events, options, statistics and create/drop cycles.
 
 use std::f64::consts::PI;
 
-use jointrom::ode::{
+use jointrom::integrate::problem::{
     CallbackError, Iteration, Method, NewtonLinear, OdeOptions, OdeProblem, OdeStats, Stop,
 };
-use jointrom::sundials::Cvode;
+use jointrom::integrate::sundials::Cvode;
 use jointrom::Error;
 
 /// ω of the test oscillator, rad/s (100 Hz).

@@ -5,10 +5,10 @@
 use std::path::PathBuf;
 use std::process::Command;
 
-use jointrom::export::{BasisInfo, RomFile};
+use jointrom::integrate::mechanical::{self as transient, TransientOptions};
+use jointrom::reduction::rom_file::{BasisInfo, RomFile};
 use jointrom::reduction::{build_basis, BasisKind, BasisOptions, ReducedModel};
 use jointrom::system::ReducedSystem;
-use jointrom::transient::{self, TransientOptions};
 use jointrom::Model;
 
 fn tmp(name: &str) -> PathBuf {

@@ -1,7 +1,7 @@
-//! The pair law of `jointrom::friction`: hysteresis loop against the exact Coulomb dissipation,
+//! The pair law of `jointrom::joint::law`: hysteresis loop against the exact Coulomb dissipation,
 //! non-negative dissipation, no force when open, isotropy, derivatives against finite differences.
 
-use jointrom::friction::{PairLaw, PairState, DEFAULT_TAU};
+use jointrom::joint::law::{PairLaw, PairState, DEFAULT_TAU};
 
 fn law() -> PairLaw {
     PairLaw {
@@ -272,7 +272,7 @@ fn tangent_matches_finite_differences() {
 /// `evaluate_pairs` agrees with the pair-wise law.
 #[test]
 fn switch_function_and_slice_evaluation_agree_with_the_law() {
-    use jointrom::friction::evaluate_pairs;
+    use jointrom::joint::law::evaluate_pairs;
     let law = law();
     let u = [
         -1e-5, 1e-8, 2e-8, // stick

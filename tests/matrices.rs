@@ -1,4 +1,4 @@
-//! Users' own models (`jointrom::matrices`): the friction bar exported as MatrixMarket K, M plus
+//! Users' own models (`jointrom::model::matrices`): the friction bar exported as MatrixMarket K, M plus
 //! the JSON map and read back gives bit-identical matrices, bases, statics and transients; rows
 //! in another order with SPC'd rows left in give the same model; the report runs on it; damaged
 //! maps and matrices are rejected naming the file and the field.
@@ -6,10 +6,11 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-use jointrom::contact::{contact_static_full, ContactOptions};
+use jointrom::integrate::mechanical::{self as transient, TransientOptions};
+use jointrom::joint::statics::ContactOptions;
+use jointrom::model::contact_static_full;
 use jointrom::reduction::{build_basis, BasisKind, BasisOptions, ReducedModel};
 use jointrom::system::{FullSystem, ReducedSystem};
-use jointrom::transient::{self, TransientOptions};
 use jointrom::Model;
 use serde_json::Value;
 
@@ -23,7 +24,7 @@ fn tmp_dir(name: &str) -> PathBuf {
 fn exported(name: &str) -> (Model, PathBuf) {
     let model = Model::from_case_name("friction_bar").unwrap();
     let dir = tmp_dir(name);
-    let files = jointrom::matrices::write(&model, &dir).unwrap();
+    let files = jointrom::model::matrices::write(&model, &dir).unwrap();
     assert_eq!(files.len(), 3);
     (model, dir)
 }

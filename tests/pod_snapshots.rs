@@ -5,10 +5,10 @@
 use std::process::Command;
 
 use faer::Mat;
+use jointrom::integrate::mechanical::{self as transient, TransientOptions, TransientResult};
 use jointrom::reduction::{build_basis, snapshot_basis, BasisKind, BasisOptions, ReducedModel};
-use jointrom::stability::relative_l2;
+use jointrom::studies::stability::relative_l2;
 use jointrom::system::{FullSystem, ReducedSystem};
-use jointrom::transient::{self, TransientOptions, TransientResult};
 use jointrom::Model;
 
 const END: f64 = 5e-3;

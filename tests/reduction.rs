@@ -7,15 +7,16 @@
 use std::time::Instant;
 
 use faer::{Mat, MatRef};
-use jointrom::assembly::SymCsc;
 use jointrom::case::Case;
-use jointrom::contact::{contact_static_full, contact_static_reduced, ContactOptions};
+use jointrom::joint::statics::{contact_static_reduced, ContactOptions};
 use jointrom::joint::NORMAL;
+use jointrom::linalg::cholesky::SparseCholesky;
+use jointrom::linalg::SymCsc;
+use jointrom::model::contact_static_full;
 use jointrom::reduction::{
     active_pairs, build_basis, craig_bampton, final_basis, pod, pod_tvd, trial_vector_derivatives,
     BasisKind, BasisOptions, ReducedModel, TvdOptions, DEFAULT_THRESHOLD,
 };
-use jointrom::statics::SparseCholesky;
 use jointrom::Model;
 
 fn col(a: MatRef<'_, f64>, c: usize) -> Vec<f64> {

@@ -3,7 +3,7 @@
 
 use std::path::PathBuf;
 
-use jointrom::report::{run_report, ReportOptions};
+use jointrom::report::main_job::{run_report, ReportOptions};
 use jointrom::Model;
 
 fn tmp_dir(name: &str) -> PathBuf {
@@ -99,7 +99,8 @@ fn quick_report_on_the_friction_bar() {
     // Functional and Newton iteration solve the same ROM: same curves within the tolerances.
     let fun = run("tvd", g, "functional");
     if fun.status == "ok" {
-        let d = jointrom::stability::relative_l2(&fun.t, &fun.fc, &chosen.t, &chosen.fc).unwrap();
+        let d = jointrom::studies::stability::relative_l2(&fun.t, &fun.fc, &chosen.t, &chosen.fc)
+            .unwrap();
         assert!(d < 1e-2, "functional vs Newton ‖f_c‖ differ by {d}");
     }
     // Speed-ups are CPU ratios; the Pareto front is non-empty and not dominated.

@@ -4,9 +4,9 @@
 use faer::{Mat, Side};
 use jointrom::assembly::{assemble_structure, Structure};
 use jointrom::element::{Material, Shell4};
+use jointrom::linalg::cholesky::solve_spd;
+use jointrom::linalg::eigen::{dense_modes, lowest_modes};
 use jointrom::mesh::{Mesh, RigidTie, SheetGrid, ShellElem};
-use jointrom::modes::{dense_modes, lowest_modes};
-use jointrom::statics::solve_spd;
 
 const STEEL: Material = Material::STEEL;
 const STEEL_NU0: Material = Material {

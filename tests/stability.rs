@@ -2,7 +2,7 @@
 //! fail is reported with its CVODE flag, and the JSON, table and heat maps are written.
 
 use jointrom::case::Case;
-use jointrom::stability::{
+use jointrom::studies::stability::{
     relative_l2, run_sweep, write_outputs, IterKind, ModelKind, SweepOptions,
 };
 

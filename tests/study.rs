@@ -1,18 +1,19 @@
-//! The static convergence study (`jointrom::study`) and the chart helpers (`jointrom::chart`).
+//! The static convergence study (`jointrom::studies::convergence`) and the chart helpers (`jointrom::report::chart`).
 
 #![allow(clippy::needless_range_loop)]
 
 use std::path::PathBuf;
 
 use faer::Mat;
-use jointrom::chart::{LineChart, Reference, Series};
-use jointrom::contact::{contact_static_full, ContactOptions};
+use jointrom::joint::statics::ContactOptions;
 use jointrom::joint::NORMAL;
+use jointrom::linalg::cholesky::SparseCholesky;
+use jointrom::model::contact_static_full;
 use jointrom::reduction::{
     build_basis, craig_bampton, final_basis, BasisKind, BasisOptions, ReducedModel,
 };
-use jointrom::statics::SparseCholesky;
-use jointrom::study::{
+use jointrom::report::chart::{LineChart, Reference, Series};
+use jointrom::studies::convergence::{
     basis_static, dense_fixed_interface_modes, reduced_contact_static,
     reduced_contact_static_damped, reduced_contact_static_restarting, run_study, within,
     write_charts, StudyOptions,

@@ -1,10 +1,10 @@
 //! `jointrom sweep`: variants of one shared reduced model, run in parallel, give the same curves
 //! as run one by one and as a direct run of the case; the variant file is validated.
 
+use jointrom::integrate::mechanical::{self as transient, TransientOptions};
 use jointrom::reduction::{build_basis, BasisKind, BasisOptions, ReducedModel};
-use jointrom::sweep::{read_variants, run_sweep, Variant};
+use jointrom::studies::sweep::{read_variants, run_sweep, Variant};
 use jointrom::system::ReducedSystem;
-use jointrom::transient::{self, TransientOptions};
 use jointrom::Model;
 
 fn variant(name: &str, mu: Option<f64>, scale: Option<f64>) -> Variant {

@@ -1,14 +1,14 @@
-//! The second-order systems (`jointrom::system`) and the mechanical ODE (`jointrom::transient`):
+//! The second-order systems (`jointrom::system`) and the mechanical ODE (`jointrom::integrate::mechanical`):
 //! right-hand side against a direct computation, the structured Newton solve against
 //! `I − γJ` by differences, and a Φ = I reduced system against the full one.
 
 use faer::Mat;
-use jointrom::friction::{PairLaw, PairState};
-use jointrom::ode::OdeOptions;
-use jointrom::ode::OdeProblem;
+use jointrom::integrate::mechanical::{run, MechanicalOde, ProblemOptions, TransientOptions};
+use jointrom::integrate::problem::OdeOptions;
+use jointrom::integrate::problem::OdeProblem;
+use jointrom::joint::law::{PairLaw, PairState};
 use jointrom::reduction::ReducedModel;
 use jointrom::system::{FullSystem, ReducedSystem, SecondOrderSystem};
-use jointrom::transient::{run, MechanicalOde, ProblemOptions, TransientOptions};
 use jointrom::Model;
 
 struct Rng(u64);
@@ -267,7 +267,7 @@ fn newton_residual<S: SecondOrderSystem>(
     (exact_rel, backward, inf_norm(&res) / inf_norm(&r))
 }
 
-/// The pair forces, computed independently of `jointrom::friction` (the law written out).
+/// The pair forces, computed independently of `jointrom::joint::law` (the law written out).
 fn pair_forces_direct(law: &PairLaw, u: &[f64], s: &[f64]) -> Vec<f64> {
     let w = u.len() / 3;
     let mut p = vec![0.0; 3 * w];

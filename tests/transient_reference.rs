@@ -7,11 +7,11 @@
 //! - Reduced models (TVD basis, K-weighted POD) are compared with the stored full-FE curves over
 //!   the whole 0.2 s: g = 0 (Craig–Bampton only) misses the contact force by a factor of ~30, the
 //!   w(g)-chosen g (w ≥ 0.999, g = 12) by ~20 % in ‖f_c‖ (the static study finds the same gap,
-//!   see `jointrom::study`), and the largest POD basis (g = 48) meets the 2 %.
+//!   see `jointrom::studies::convergence`), and the largest POD basis (g = 48) meets the 2 %.
 
+use jointrom::integrate::mechanical::{run, Curves, TransientOptions};
 use jointrom::reduction::{build_basis, BasisKind, BasisOptions, ReducedModel};
 use jointrom::system::{FullSystem, ReducedSystem};
-use jointrom::transient::{run, Curves, TransientOptions};
 use jointrom::Model;
 use serde_json::Value;
 

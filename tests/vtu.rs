@@ -5,7 +5,8 @@
 use std::path::PathBuf;
 
 use faer::Mat;
-use jointrom::{vtu, Model};
+use jointrom::report::vtu;
+use jointrom::Model;
 
 fn tmp(name: &str) -> PathBuf {
     std::env::temp_dir().join(format!("jointrom-vtu-{name}-{}", std::process::id()))

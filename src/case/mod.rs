@@ -1,5 +1,5 @@
 //! Case files: the serde schema of a jointed sheet structure (units mm, N, t, s), its validation
-//! with JSON paths, and the generation of the [`Mesh`].
+//! with JSON paths (the mesh is generated from it by `crate::mesh::Mesh::from_case`).
 //!
 //! A case file describes flat sheets parallel to the x–z plane, the clamps that support them, one
 //! rigid tie (NASTRAN RBE2) from the free end to a master node that carries the load, weld spots
@@ -55,22 +55,22 @@
 //!   (x, z), or overlap without coinciding nodes; an explicit joint point that is not a node of
 //!   both sheets, is listed twice, or is clamped or tied; a joint left without pairs.
 //!
-//! [`Case::build_mesh`] re-runs the same checks, so a `Case` edited in code cannot produce a
-//! broken mesh either.
+//! [`Case::from_json_str`] checks the fields (material, contact, load, end time); the checks of
+//! the geometry above need the node grids and run while `crate::mesh::Mesh::from_case` generates
+//! the mesh, which re-runs the field checks too — so a `Case` edited in code cannot produce a
+//! broken mesh either, and the validator and the generator cannot disagree.
 
-mod build;
 mod parse;
 
-pub(crate) use build::check_contact_load;
+pub(crate) mod validate;
 pub(crate) use parse::parse_object;
+pub(crate) use validate::check_contact_load;
 
 use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
-use crate::element::Material;
 use crate::error::Error;
-use crate::mesh::Mesh;
 
 /// Two coordinates closer than this (mm) in each axis denote the same node.
 pub const NODE_TOLERANCE: f64 = 1e-6;
@@ -296,12 +296,16 @@ impl Case {
     /// Names of the built-in cases (files `cases/<name>.json` compiled into the crate).
     pub const BUILTIN: &'static [&'static str] = &["friction_bar", "multilayer_sheet"];
 
-    /// Parses a case from JSON text (unknown fields rejected) and validates it. `file` labels
-    /// the text in errors and becomes [`Case::source`].
+    /// Parses a case from JSON text (unknown fields rejected) and validates its fields (material,
+    /// contact law, load, end time); the geometry (sheets, clamps, welds, joints) is validated
+    /// when the mesh is generated ([`crate::mesh::Mesh::from_case`]). `file` labels the text in
+    /// errors and becomes [`Case::source`].
     pub fn from_json_str(text: &str, file: &str) -> Result<Case, Error> {
         let mut case = parse::parse(text, file)?;
         case.source = file.to_string();
-        build::build(&case)?;
+        let ctx = validate::Ctx { file };
+        validate::check_material(&case, &ctx)?;
+        validate::check_contact_and_load(&case, &ctx)?;
         Ok(case)
     }
 
@@ -345,21 +349,6 @@ impl Case {
                 ),
             ),
         })
-    }
-
-    /// Validates the case and generates its mesh (see [`Mesh`] and the module docs for the
-    /// numbering). Errors are those of [`Case::from_json_str`], labelled with [`Case::source`].
-    pub fn build_mesh(&self) -> Result<Mesh, Error> {
-        build::build(self)
-    }
-
-    /// The material of all sheets and welds.
-    pub fn material(&self) -> Material {
-        Material {
-            youngs_modulus: self.material.youngs_modulus,
-            poisson_ratio: self.material.poisson_ratio,
-            density: self.material.density,
-        }
     }
 
     /// The final master-node load `[Fx, Fy, Fz (N), Mx, My, Mz (N·mm)]`, before the ramp.

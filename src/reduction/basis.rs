@@ -1,18 +1,15 @@
-//! The final basis `Φ = [Φ_S Φ_V Φ̃_T]` (Algorithm 2, output), its M-orthonormalization and the
-//! one-call builder [`build_basis`].
+//! The final basis `Φ = [Φ_S Φ_V Φ̃_T]` (Algorithm 2, output): its M-orthonormalization, the
+//! rotation to the reduced eigenbasis, and the options and result types of
+//! [`super::build_basis`].
 
 use faer::{Mat, MatRef, Side};
 
-use crate::assembly::SymCsc;
+use super::pod::DEFAULT_THRESHOLD;
+use super::tvd::TvdOptions;
 use crate::error::Error;
+use crate::linalg::compensated::{split, two_product_sums};
+use crate::linalg::sparse::{sym_mul_vec_into, SymCsc};
 use crate::model::Model;
-
-use super::alldof::{alldof_vectors, split, two_product_sums};
-use super::craig_bampton::craig_bampton;
-use super::jim::{jim_vectors, JimSet};
-use super::pod::{pod_tvd, DEFAULT_THRESHOLD};
-use super::tvd::{trial_vector_derivatives, TvdOptions};
-use crate::statics::sym_mul_vec_into;
 
 /// Default relative drop tolerance of [`final_basis`].
 pub const DEFAULT_DROP_TOL: f64 = 1e-8;
@@ -96,62 +93,26 @@ pub fn final_basis(
     Ok((Mat::from_fn(n, q.len(), |r, c| q[c][r]), dropped))
 }
 
-/// Which enrichment of the Craig–Bampton basis [`build_basis`] uses.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum BasisKind {
-    /// TVD joint modes from the K-weighted POD (eqs. 24–25; the paper's choice).
-    Tvd,
-    /// TVD joint modes from the plain (Euclidean) POD (eqs. 20–22).
-    TvdPlain,
-    /// No joint modes: Craig–Bampton with ν + g fixed-interface modes instead (the paper's
-    /// comparison, Figure 7).
-    Modes,
-    /// Craig–Bampton plus the g lowest Joint Interface Modes (Witteveen & Irschik 2009; the
-    /// paper's Section 5.3 and Figure 19), of the set [`BasisOptions::jim_set`]; see
-    /// [`super::jim`].
-    Jim,
-    /// Craig–Bampton plus the static constraint modes of every joint pair's relative normal DOF
-    /// (all joint DOF kept, the paper's Section 5.1); g is ignored and reported as the number of
-    /// pairs; see [`super::alldof`].
-    AllDof,
+/// Which joint DOF the Joint Interface Modes are condensed to.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum JimSet {
+    /// The out-of-plane (y) translations of the joint nodes: the normal (gap) direction.
+    Normal,
+    /// The in-plane (x and z) translations of the joint nodes: the slip directions.
+    InPlane,
+    /// Both sets, condensed separately, their modes merged by eigenfrequency ascending. Default.
+    #[default]
+    Both,
 }
 
-impl BasisKind {
-    /// Every kind, in the order of [`BasisKind::NAMES`].
-    pub const ALL: [BasisKind; 5] = [
-        BasisKind::Tvd,
-        BasisKind::TvdPlain,
-        BasisKind::Modes,
-        BasisKind::Jim,
-        BasisKind::AllDof,
-    ];
-
-    /// The accepted names: `tvd`, `tvd-plain`, `modes`, `jim`, `alldof`.
-    pub const NAMES: [&'static str; 5] = ["tvd", "tvd-plain", "modes", "jim", "alldof"];
-
-    /// The kind's name (as accepted by [`BasisKind::from_name`] and the CLI's `--basis`).
+impl JimSet {
+    /// `"normal"`, `"in-plane"` or `"both"`.
     pub fn name(self) -> &'static str {
         match self {
-            BasisKind::Tvd => "tvd",
-            BasisKind::TvdPlain => "tvd-plain",
-            BasisKind::Modes => "modes",
-            BasisKind::Jim => "jim",
-            BasisKind::AllDof => "alldof",
+            JimSet::Normal => "normal",
+            JimSet::InPlane => "in-plane",
+            JimSet::Both => "both",
         }
-    }
-
-    /// Parses a name of [`BasisKind::NAMES`] (exact, lower case); anything else is an
-    /// [`Error::Invalid`] listing the accepted names.
-    pub fn from_name(name: &str) -> Result<BasisKind, Error> {
-        BasisKind::ALL
-            .into_iter()
-            .find(|k| k.name() == name)
-            .ok_or_else(|| {
-                Error::Invalid(format!(
-                    "unknown basis `{name}`: expected one of {}",
-                    BasisKind::NAMES.join(", ")
-                ))
-            })
     }
 }
 
@@ -213,86 +174,6 @@ pub struct Basis {
     /// With `modal`: the reduced eigenvalues `ω² = diag(ΦᵀKΦ)` (1/s²), ascending, one per
     /// column; empty otherwise.
     pub eigenvalues: Vec<f64>,
-}
-
-/// Builds `Φ = [Φ_S Φ_V Φ̃_T]` (Algorithm 2) for a model: Craig–Bampton with ν modes, TVD of
-/// all 6 + ν vectors, POD (weighted for `Tvd`, plain for `TvdPlain`), the first g POMs,
-/// M-orthonormalization ([`final_basis`]) and, with `opts.modal` (default), the rotation to the
-/// reduced eigenbasis ([`modal_rotation`]). The competitors replace `Φ̃_T`:
-///
-/// - `Modes`: Craig–Bampton with ν + g fixed-interface modes;
-/// - `Jim`: the g lowest Joint Interface Modes of `opts.jim_set` ([`jim_vectors`]);
-/// - `AllDof`: the constraint modes of all pairs' normal DOF ([`alldof_vectors`]), g = w.
-///
-/// For `Modes` and `Jim` with `g = None` the TVD and their K-weighted POD are still computed, to
-/// choose g exactly as `Tvd` would (the smallest g with `w(g) ≥ opts.threshold`), so the
-/// competitors are compared at the same number of added vectors; `Basis::w` is then that POD's.
-pub fn build_basis(model: &Model, kind: BasisKind, opts: &BasisOptions) -> Result<Basis, Error> {
-    let need_tvd = match kind {
-        BasisKind::Tvd | BasisKind::TvdPlain => true,
-        BasisKind::Modes | BasisKind::Jim => opts.g.is_none(),
-        BasisKind::AllDof => false,
-    };
-    let cb = craig_bampton(model, opts.nu)?;
-    let (w, g, tvd_total, tvd_nonzero, joint_modes) = if need_tvd {
-        let tvd = trial_vector_derivatives(model, cb.as_ref(), &opts.tvd)?;
-        let p = pod_tvd(model, &tvd, kind != BasisKind::TvdPlain)?;
-        let g = opts
-            .g
-            .unwrap_or_else(|| p.choose_g(opts.threshold))
-            .min(p.lambda.len());
-        let jm = p.leading(g).to_owned();
-        (p.w, g, tvd.total, tvd.nonzero(), jm)
-    } else {
-        (
-            Vec::new(),
-            opts.g.unwrap_or(0),
-            0,
-            0,
-            Mat::zeros(model.dofs(), 0),
-        )
-    };
-    let (phi, dropped, g) = match kind {
-        BasisKind::Modes => {
-            let cbg = craig_bampton(model, opts.nu + g)?;
-            let (phi, dropped) = final_basis(&[cbg.as_ref()], &model.mass, opts.drop_tol)?;
-            (phi, dropped, g)
-        }
-        BasisKind::Jim => {
-            let jim = jim_vectors(model, g, opts.jim_set)?;
-            let (phi, dropped) =
-                final_basis(&[cb.as_ref(), jim.as_ref()], &model.mass, opts.drop_tol)?;
-            (phi, dropped, g)
-        }
-        BasisKind::AllDof => {
-            let psi = alldof_vectors(model)?;
-            let (phi, dropped) =
-                final_basis(&[cb.as_ref(), psi.as_ref()], &model.mass, opts.drop_tol)?;
-            (phi, dropped, psi.ncols())
-        }
-        BasisKind::Tvd | BasisKind::TvdPlain => {
-            let (phi, dropped) = final_basis(
-                &[cb.as_ref(), joint_modes.as_ref()],
-                &model.mass,
-                opts.drop_tol,
-            )?;
-            (phi, dropped, g)
-        }
-    };
-    let (phi, eigenvalues) = if opts.modal {
-        modal_rotation(model, phi)?
-    } else {
-        (phi, Vec::new())
-    };
-    Ok(Basis {
-        phi,
-        w,
-        g,
-        tvd_total,
-        tvd_nonzero,
-        dropped,
-        eigenvalues,
-    })
 }
 
 /// Rotates an M-orthonormal basis Φ (n × r) to the eigenbasis of the reduced problem:

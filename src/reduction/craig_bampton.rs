@@ -3,9 +3,9 @@
 use faer::Mat;
 
 use crate::error::Error;
+use crate::linalg::cholesky::SparseCholesky;
+use crate::linalg::eigen::lowest_modes_factored;
 use crate::model::Model;
-use crate::modes::lowest_modes_factored;
-use crate::statics::SparseCholesky;
 
 /// The Craig–Bampton basis `[Φ_S | Φ_V]` (n × (6 + ν)) of a model whose master node's six DOF
 /// are the last six independent DOF (the boundary set `b`, interior `i` = the leading n − 6).

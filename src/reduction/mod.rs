@@ -39,27 +39,28 @@
 //! Not implemented: the inertia-corrected TVD of eq. (15) for vibration modes (it needs a
 //! factorization of the indefinite `K − Ω_i² M` per mode).
 
-pub mod alldof;
-mod basis;
-mod craig_bampton;
-pub mod jim;
-mod pod;
-pub mod snapshots;
-mod tvd;
+pub mod basis;
+mod build;
+pub mod competitors;
+pub mod craig_bampton;
+pub mod pod;
+pub mod rom_file;
+pub mod tvd;
 
-pub use alldof::alldof_vectors;
-pub use basis::{
-    build_basis, final_basis, modal_rotation, Basis, BasisKind, BasisOptions, DEFAULT_DROP_TOL,
+pub use basis::{final_basis, modal_rotation, Basis, BasisOptions, JimSet, DEFAULT_DROP_TOL};
+pub use build::{build_basis, BasisKind};
+pub use competitors::{
+    alldof_vectors, jim_dofs, jim_vectors, joint_interface_modes, snapshot_basis, snapshot_pod,
+    JointInterfaceModes,
 };
 pub use craig_bampton::craig_bampton;
-pub use jim::{jim_dofs, jim_vectors, joint_interface_modes, JimSet, JointInterfaceModes};
 pub use pod::{pod, pod_tvd, sigma_zero, Pod, DEFAULT_THRESHOLD, ZERO_EIGENVALUE};
-pub use snapshots::{snapshot_basis, snapshot_pod};
 pub use tvd::{active_pairs, trial_vector_derivatives, Tvd, TvdFactor, TvdIndex, TvdOptions};
 
 use faer::Mat;
 
 use crate::error::Error;
+use crate::linalg::compensated::compensated_gram;
 use crate::model::Model;
 
 /// A model reduced on a basis Φ (eq. 7).
@@ -109,31 +110,4 @@ impl ReducedModel {
     pub fn dim(&self) -> usize {
         self.phi.ncols()
     }
-}
-
-/// `Φᵀ A Φ` (symmetrized) with `A Φ` and every inner product accumulated in double-double and
-/// rounded once. The thin-shell K is ill-conditioned (cond ≈ 2e10): `K φ` for a smooth φ is a
-/// small difference of large terms, so a plain product loses up to cond·eps of `K̃`'s smallest
-/// eigenvalues' accuracy; the compensated product keeps `K̃` the exact projection of the
-/// assembled K to working precision (measured: the alldof basis then reproduces the full contact
-/// statics to ≤ 1e-8, against ≈ 5e-7 with plain products on the multilayer sheet).
-pub(crate) fn compensated_gram(
-    a: &crate::assembly::SymCsc,
-    phi: faer::MatRef<'_, f64>,
-) -> Mat<f64> {
-    let aphi = alldof::sym_mul_compensated(a, phi, 1.0, None);
-    let r = phi.ncols();
-    let n = phi.nrows();
-    let mut g = Mat::<f64>::zeros(r, r);
-    for j in 0..r {
-        for i in 0..=j {
-            let mut acc = alldof::Dot2::new(0.0);
-            for k in 0..n {
-                acc.add_product(phi[(k, i)], aphi[(k, j)]);
-            }
-            g[(i, j)] = acc.value();
-            g[(j, i)] = g[(i, j)];
-        }
-    }
-    g
 }

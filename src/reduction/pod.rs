@@ -2,10 +2,10 @@
 
 use faer::{Mat, MatRef, Side};
 
-use crate::assembly::SymCsc;
 use crate::error::Error;
+use crate::linalg::sparse::sym_mul_mat;
+use crate::linalg::SymCsc;
 use crate::model::Model;
-use crate::statics::sym_mul_mat;
 
 use super::tvd::Tvd;
 #[allow(unused_imports)] // doc links

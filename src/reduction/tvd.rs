@@ -56,13 +56,14 @@ use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
 use faer::sparse::{SparseColMat, SymbolicSparseColMat};
 use faer::{Mat, MatRef};
 
-use crate::assembly::SymCsc;
 use crate::error::Error;
 use crate::joint::{JointOperator, NORMAL, T1, T2};
+use crate::linalg::cholesky::SparseCholesky;
+use crate::linalg::sparse::{sym_mul_mat, sym_mul_vec_into};
+use crate::linalg::SymCsc;
 use crate::model::Model;
-use crate::statics::{sym_mul_mat, sym_mul_vec_into, SparseCholesky};
 
-use super::alldof::solve_refined_steps;
+use crate::linalg::compensated::solve_refined_steps;
 
 /// Options of [`trial_vector_derivatives`]. Defaults: `tol = 1e-6`, `zero_gap_active = true`,
 /// `tangential = false`.

@@ -1,0 +1,339 @@
+//! Global assembly on the independent DOF.
+//!
+//! Every node carries 6 DOF `[ux, uy, uz, rx, ry, rz]`. The constraints are eliminated exactly
+//! (no penalty): clamped DOF are dropped, and the DOF of a rigidly tied (RBE2) slave node are
+//! linear combinations of the master's, `u_s = u_m + θ_m × (x_s − x_m)`, `θ_s = θ_m`. Writing
+//! all node DOF as `u = T q` with `q` the independent DOF, the assembled matrices are
+//! `K = Σ_e T_eᵀ K_e T_e`, `M = Σ_e T_eᵀ M_e T_e`.
+//!
+//! The independent DOF are numbered node by node in mesh order (free nodes' 6 DOF each), the
+//! master node's 6 DOF last; so the first `n − 6` DOF are the Craig–Bampton interior and the
+//! last 6 the boundary.
+//!
+//! The sparsity pattern (compressed sparse columns, full symmetric storage, sorted rows) and
+//! each element's scatter positions are computed once by [`Assembler::new`]; values are filled
+//! by [`Assembler::assemble`] as often as needed.
+
+use faer::Mat;
+
+use crate::element::{Beam2, Shell4};
+use crate::error::Error;
+use crate::linalg::SymCsc;
+use crate::mesh::Mesh;
+
+/// The assembled linear structure: DOF map, stiffness and mass on the independent DOF.
+#[derive(Clone, Debug)]
+pub struct Structure {
+    /// Node DOF → independent DOF.
+    pub dof_map: DofMap,
+    /// Stiffness, N/mm (N, N·mm/rad for rotational DOF).
+    pub stiffness: SymCsc,
+    /// Mass, t (t·mm, t·mm² for rotational DOF).
+    pub mass: SymCsc,
+}
+
+/// Builds every `Shell4` and `Beam2` of the mesh and assembles K and M on the independent DOF.
+pub fn assemble_structure(mesh: &Mesh) -> Result<Structure, Error> {
+    let material = mesh.material;
+    let shells = mesh
+        .shells
+        .iter()
+        .map(|s| Shell4::new(s.nodes.map(|i| mesh.nodes[i]), s.thickness, material))
+        .collect::<Result<Vec<_>, _>>()?;
+    let beams = mesh
+        .beams
+        .iter()
+        .map(|b| {
+            Beam2::circular(
+                mesh.nodes[b.nodes[0]],
+                mesh.nodes[b.nodes[1]],
+                b.diameter,
+                material,
+            )
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    let dof_map = DofMap::new(mesh);
+    let element_nodes: Vec<&[usize]> = mesh
+        .shells
+        .iter()
+        .map(|s| &s.nodes[..])
+        .chain(mesh.beams.iter().map(|b| &b.nodes[..]))
+        .collect();
+    let assembler = Assembler::new(&dof_map, element_nodes);
+    let ns = shells.len();
+    let stiffness = assembler.assemble(|e| {
+        if e < ns {
+            shells[e].stiffness()
+        } else {
+            beams[e - ns].stiffness()
+        }
+    });
+    let mass = assembler.assemble(|e| {
+        if e < ns {
+            shells[e].mass()
+        } else {
+            beams[e - ns].mass()
+        }
+    });
+    Ok(Structure {
+        dof_map,
+        stiffness,
+        mass,
+    })
+}
+
+/// How one node DOF depends on the independent DOF: `u = Σ coef_k q[idx_k]` (at most 3 terms).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DofDep {
+    idx: [usize; 3],
+    coef: [f64; 3],
+    len: u8,
+}
+
+impl DofDep {
+    pub(crate) const FIXED: DofDep = DofDep {
+        idx: [0; 3],
+        coef: [0.0; 3],
+        len: 0,
+    };
+    pub(crate) fn single(i: usize) -> DofDep {
+        DofDep {
+            idx: [i, 0, 0],
+            coef: [1.0, 0.0, 0.0],
+            len: 1,
+        }
+    }
+    /// The 6 DOF of a node tied rigidly (RBE2) to a master node with independent DOF `master`
+    /// `[ux, uy, uz, rx, ry, rz]`, at offset `r = x_s − x_m` (mm): `u_s = u_m + θ_m × r`,
+    /// `θ_s = θ_m`.
+    pub(crate) fn rigid_follower(master: [usize; 6], r: [f64; 3]) -> [DofDep; 6] {
+        let [ux, uy, uz, rx, ry, rz] = master;
+        let mut dep = [DofDep::FIXED; 6];
+        dep[0].push(ux, 1.0);
+        dep[0].push(ry, r[2]);
+        dep[0].push(rz, -r[1]);
+        dep[1].push(uy, 1.0);
+        dep[1].push(rz, r[0]);
+        dep[1].push(rx, -r[2]);
+        dep[2].push(uz, 1.0);
+        dep[2].push(rx, r[1]);
+        dep[2].push(ry, -r[0]);
+        dep[3].push(rx, 1.0);
+        dep[4].push(ry, 1.0);
+        dep[5].push(rz, 1.0);
+        dep
+    }
+    fn push(&mut self, i: usize, c: f64) {
+        if c != 0.0 {
+            self.idx[self.len as usize] = i;
+            self.coef[self.len as usize] = c;
+            self.len += 1;
+        }
+    }
+    /// The terms `(independent DOF, coefficient)`.
+    pub fn terms(&self) -> impl Iterator<Item = (usize, f64)> + '_ {
+        (0..self.len as usize).map(|k| (self.idx[k], self.coef[k]))
+    }
+    /// The independent DOF if this node DOF is itself independent.
+    pub fn as_free(&self) -> Option<usize> {
+        (self.len == 1 && self.coef[0] == 1.0).then_some(self.idx[0])
+    }
+}
+
+/// Map from node DOF to independent DOF.
+#[derive(Clone, Debug)]
+pub struct DofMap {
+    /// Per node, its 6 DOF.
+    pub nodes: Vec<[DofDep; 6]>,
+    /// Number of independent DOF.
+    pub n: usize,
+    /// The master node's independent DOF `[ux, uy, uz, rx, ry, rz]` (the last six).
+    pub master: [usize; 6],
+}
+
+impl DofMap {
+    /// Builds the map for a mesh: clamped nodes fixed, tie slaves dependent on the master.
+    pub fn new(mesh: &Mesh) -> DofMap {
+        let nn = mesh.nodes.len();
+        let mut fixed = vec![false; nn];
+        for &c in &mesh.clamped {
+            fixed[c] = true;
+        }
+        let mut slave = vec![false; nn];
+        for &s in &mesh.tie.slaves {
+            slave[s] = true;
+        }
+        let master_node = mesh.tie.master;
+        let mut nodes = vec![[DofDep::FIXED; 6]; nn];
+        let mut next = 0;
+        for (i, node) in nodes.iter_mut().enumerate() {
+            if fixed[i] || slave[i] || i == master_node {
+                continue;
+            }
+            for (d, dep) in node.iter_mut().enumerate() {
+                *dep = DofDep::single(next + d);
+            }
+            next += 6;
+        }
+        let master = [0, 1, 2, 3, 4, 5].map(|d| next + d);
+        for (d, dep) in nodes[master_node].iter_mut().enumerate() {
+            *dep = DofDep::single(master[d]);
+        }
+        let xm = mesh.nodes[master_node];
+        for &s in &mesh.tie.slaves {
+            let xs = mesh.nodes[s];
+            nodes[s] =
+                DofDep::rigid_follower(master, [xs[0] - xm[0], xs[1] - xm[1], xs[2] - xm[2]]);
+        }
+        DofMap {
+            nodes,
+            n: next + 6,
+            master,
+        }
+    }
+
+    /// The independent DOF of a node's 6 DOF if the node is free (neither clamped nor tied).
+    pub fn free_dofs(&self, node: usize) -> Option<[usize; 6]> {
+        let d = &self.nodes[node];
+        let mut out = [0; 6];
+        for k in 0..6 {
+            out[k] = d[k].as_free()?;
+        }
+        Some(out)
+    }
+
+    /// Expands independent DOF values `q` to all node DOF `u = T q` (6 per node).
+    pub fn expand(&self, q: &[f64]) -> Vec<f64> {
+        let mut u = vec![0.0; 6 * self.nodes.len()];
+        for (i, node) in self.nodes.iter().enumerate() {
+            for (d, dep) in node.iter().enumerate() {
+                u[6 * i + d] = dep.terms().map(|(k, c)| c * q[k]).sum();
+            }
+        }
+        u
+    }
+}
+
+/// One element's scatter information.
+#[derive(Clone, Debug)]
+struct Scatter {
+    /// Independent DOF touched by the element (sorted).
+    dofs: Vec<usize>,
+    /// `T_e`: element DOF × `dofs` (None when it is the identity map onto `dofs` in order).
+    te: Option<Mat<f64>>,
+    /// Position in `values` of entry (dofs[a], dofs[b]) at `a * len + b`.
+    positions: Vec<usize>,
+}
+
+/// Pattern-once, values-many assembler for elements given by their node lists.
+#[derive(Clone, Debug)]
+pub struct Assembler {
+    n: usize,
+    col_ptr: Vec<usize>,
+    row_idx: Vec<usize>,
+    elements: Vec<Scatter>,
+}
+
+impl Assembler {
+    /// Builds the sparsity pattern for elements with the given node lists (6 DOF per node).
+    pub fn new<'a>(map: &DofMap, element_nodes: impl IntoIterator<Item = &'a [usize]>) -> Self {
+        let n = map.n;
+        let mut elements = Vec::new();
+        let mut pairs: Vec<(usize, usize)> = Vec::new(); // (col, row)
+        for nodes in element_nodes {
+            let deps: Vec<DofDep> = nodes.iter().flat_map(|&i| map.nodes[i]).collect();
+            let mut dofs: Vec<usize> = deps.iter().flat_map(|d| d.terms().map(|t| t.0)).collect();
+            dofs.sort_unstable();
+            dofs.dedup();
+            let identity = deps.len() == dofs.len()
+                && deps.iter().zip(&dofs).all(|(d, &k)| d.as_free() == Some(k));
+            let te = (!identity).then(|| {
+                let mut t = Mat::zeros(deps.len(), dofs.len());
+                for (a, d) in deps.iter().enumerate() {
+                    for (k, c) in d.terms() {
+                        let b = dofs.binary_search(&k).expect("dof listed");
+                        t[(a, b)] += c;
+                    }
+                }
+                t
+            });
+            for &c in &dofs {
+                for &r in &dofs {
+                    pairs.push((c, r));
+                }
+            }
+            elements.push(Scatter {
+                dofs,
+                te,
+                positions: Vec::new(),
+            });
+        }
+        pairs.sort_unstable();
+        pairs.dedup();
+        let mut col_ptr = vec![0; n + 1];
+        for &(c, _) in &pairs {
+            col_ptr[c + 1] += 1;
+        }
+        for j in 0..n {
+            col_ptr[j + 1] += col_ptr[j];
+        }
+        let row_idx: Vec<usize> = pairs.iter().map(|p| p.1).collect();
+        for e in &mut elements {
+            let len = e.dofs.len();
+            e.positions = Vec::with_capacity(len * len);
+            for &r in &e.dofs {
+                for &c in &e.dofs {
+                    let rows = &row_idx[col_ptr[c]..col_ptr[c + 1]];
+                    let p = rows.binary_search(&r).expect("pattern holds the pair");
+                    e.positions.push(col_ptr[c] + p);
+                }
+            }
+        }
+        Assembler {
+            n,
+            col_ptr,
+            row_idx,
+            elements,
+        }
+    }
+
+    /// Number of stored entries.
+    pub fn nnz(&self) -> usize {
+        self.row_idx.len()
+    }
+
+    /// Assembles `Σ T_eᵀ A_e T_e` from the element matrices (in node-DOF order) into a new
+    /// matrix with the shared pattern.
+    pub fn assemble(&self, element_matrix: impl Fn(usize) -> Mat<f64>) -> SymCsc {
+        let mut values = vec![0.0; self.row_idx.len()];
+        self.assemble_into(element_matrix, &mut values);
+        SymCsc {
+            n: self.n,
+            col_ptr: self.col_ptr.clone(),
+            row_idx: self.row_idx.clone(),
+            values,
+        }
+    }
+
+    /// Like [`Assembler::assemble`] but into an existing value array (same pattern).
+    pub fn assemble_into(&self, element_matrix: impl Fn(usize) -> Mat<f64>, values: &mut [f64]) {
+        values.iter_mut().for_each(|v| *v = 0.0);
+        for (e, sc) in self.elements.iter().enumerate() {
+            let ae = element_matrix(e);
+            let reduced;
+            let a = match &sc.te {
+                None => &ae,
+                Some(t) => {
+                    reduced = t.transpose() * &ae * t;
+                    &reduced
+                }
+            };
+            let len = sc.dofs.len();
+            for i in 0..len {
+                for j in 0..len {
+                    values[sc.positions[i * len + j]] += a[(i, j)];
+                }
+            }
+        }
+    }
+}

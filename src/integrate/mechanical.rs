@@ -1,0 +1,876 @@
+//! The transient mechanical problem as a first-order ODE ([`crate::integrate::problem::OdeProblem`]) for any
+//! [`SecondOrderSystem`], full or reduced.
+//!
+//! ## State
+//!
+//! ```text
+//! y = [q (n), v (n), s (2w, friction on only), W, D]
+//! q' = v
+//! M v' = f(t) − K q − Bᵀ p(B q, s)                 (paper eq. 6 / eq. 7)
+//! s' = ṡ(B q, s)                                   (viscoplastic slip memory, crate::joint::law)
+//! W' = f(t) · v                                    (external work, N·mm)
+//! D' = Σ_pairs p_t · ṡ                             (dissipated energy, N·mm)
+//! ```
+//!
+//! The `s`, `W`, `D` states are stored in units of [`ProblemOptions::slip_scale`] (mm) and
+//! [`ProblemOptions::energy_scale`] (N·mm), 1e-3 by default, so that the integrator's scalar
+//! absolute tolerance (1e-6) means 1e-9 mm of slip: the stick radius `μ|p_n|/k_t` is ~1e-6 mm
+//! for a pair force of 0.04 N, and with s in mm the slip memory would be resolved to no digit.
+//!
+//! With friction off the state has no `s` block (the tangential forces are zero and there is no
+//! memory to carry) and `D' = 0`. `W` and `D` are integrated by the integrator itself (so they
+//! are as accurate as the motion, independent of the output spacing); they do not feed back into
+//! the motion. The energy balance
+//! `E_kin + E_strain + E_pair − W + D = 0` (from rest, [`EnergySample::balance`]) then closes up
+//! to the integration error and the viscoplastic lag of [`crate::joint::law`].
+//!
+//! ## The Newton solve
+//!
+//! CVODE's Newton matrix is `I − γJ`. With `P_u = ∂p/∂(Bq)`, `P_s = ∂p/∂s = −[0; T]`
+//! (`T = ∂p_t/∂u_t`), `D_s = ∂ṡ/∂u_t = −∂ṡ/∂s`, `φ_g = ∂ṡ/∂g`, the system
+//! `(I − γJ) [a; b; c; z_W; z_D] = [r_q; r_v; r_s; r_W; r_D]` reads
+//!
+//! ```text
+//! a − γ b = r_q
+//! M b + γ K a + γ Bᵀ (P_u B a + P_s c) = M r_v
+//! (I + γ D_s) c = r_s + γ D_s B_t a + γ φ_g B_n a          (per pair, 2×2)
+//! ```
+//!
+//! Eliminating `b = (a − r_q)/γ` and `c` gives (the `φ_g` term drops out: `T φ_g = 0`)
+//!
+//! ```text
+//! (M + γ² (K + Bᵀ K_c B)) a = M r_q + γ M r_v + γ² Bᵀ [0; T (I + γ D_s)⁻¹ r_s]
+//! K_c per pair = [[∂p_n/∂g, 0], [0, T (I + γ D_s)⁻¹]]
+//! ```
+//!
+//! `T (I + γD_s)⁻¹` is symmetric for every branch (stick: `k_t I`, open: 0, slip:
+//! `μ|p_n|/|e| / (1 + γρ/τ) · (I − n nᵀ)`, `ρ = (|e| − c)/|e|`). The only term dropped is the
+//! non-symmetric `∂p_t/∂g = −μ k_n n` of sliding pairs (the friction force follows the normal
+//! force), so that the matrix stays symmetric positive definite for a Cholesky factorization:
+//! the solve is exact when no pair slides, otherwise a modified Newton direction that CVODE's
+//! iteration corrects. `z_W = r_W + γ f(t)·b` and `z_D = r_D + γ ∇D'·[a; c]` are exact.
+
+//!
+//! ## Running
+//!
+//! [`run`] drives a [`MechanicalOde`] with [`crate::integrate::sundials::Cvode`] from rest to the case's
+//! end time, sampling [`EnergySample`]s into [`Curves`] every `output_step` (1e-4 s by
+//! default). With events on, every located root (a gap or a stick/slip switch changing sign)
+//! re-initialises the integrator (order 1, history discarded); 1000 roots in a row without
+//! progress in time end the run with an error (a chattering switch).
+//!
+//! Measured on the friction bar ROM (TVD basis, r = 28, 0.02 s, friction on, Newton with the
+//! structured solve): ~1.3 Newton iterations per step whether or not the factorization is
+//! redone for every new γ (so it is not: CVODE decides when to call the setup); at atol 1e-6
+//! ~30 000 steps and the energy balance closes to 3e-4 of the external work, at atol 1e-8
+//! ~24 000 steps and 2e-6. With events on, gaps of nearly closed pairs cross zero tens of
+//! thousands of times in 0.02 s and each restart costs a low-order step: ~20× slower.
+//!
+//! ## Step size of the full model: defaults
+//!
+//! The full FE model (friction bar, 906 DOF) took ~1e5 steps of ~1e-8 s per millisecond with
+//! CVODE's defaults. Measured on the first 5 ms (Newton, structured solve, rtol 1e-8, atol 1e-6
+//! mm; `vs` = [`ProblemOptions::velocity_scale`], velocity atol = `vs · atol` mm/s; wall times on
+//! 2 cores loaded by other jobs, so compare steps):
+//!
+//! | friction | max order | vs (1/s) | steps | Newton its | conv. fails | last h (s) | wall (s) |
+//! |---|---|---|---|---|---|---|---|
+//! | off | 5 | 1 | > 300 s, not finished | | | | |
+//! | off | 5 | 1e2 | > 300 s, not finished | | | | |
+//! | off | 5 | 1e3 | 15 081 | 16 682 | 84 | 1.4e-8 | 11.7 |
+//! | off | 5 | 1e4 | 307 986 | 328 455 | 61 | 6.2e-9 | 179 |
+//! | off | 5 + stab. lim. det. | 1e3 | 22 937 | 25 955 | 84 | 6.4e-9 | 16.1 |
+//! | off | 2 | 1 | 25 253 | 26 465 | 16 | 8.4e-8 | 11.7 |
+//! | off | 2 | 1e2 | 1 467 | 1 841 | 59 | 7.4e-7 | 6.2 |
+//! | off | 2 | 1e3 | 1 439 | 1 929 | 87 | 1.4e-5 | 1.0 |
+//! | off | 2 | 1e4 | 1 142 | 1 675 | 114 | 2.6e-6 | 0.9 |
+//! | on | 2 | 1 | 25 072 | 26 295 | 11 | 6.8e-8 | 109 |
+//! | on | 2 | 1e2 | 1 996 | 2 491 | 78 | 6.2e-7 | 8.8 |
+//! | on | 2 (and 5: identical) | 1e3 | 1 193 | 1 802 | 126 | 1.9e-6 | 1.5 |
+//! | on | 2 | 1e4 | 1 361 | 2 263 | 245 | 4.3e-6 | 12.4 |
+//!
+//! Two causes, both legitimately removable:
+//!
+//! 1. **BDF orders 3–5 on an undamped structure.** The FE model has modes up to ~10⁶–10⁷ rad/s
+//!    (shell membrane/drilling, the penalty springs on nodal masses of ~1e-7 t) that the motion
+//!    does not excite. BDF3–5 are not A-stable: their stability regions miss a sector around the
+//!    imaginary axis, and on an undamped mode `hω` must stay small or the mode grows; CVODE's error
+//!    test then keeps `h` near 1e-8 s while the order climbs (15 081 steps, and 307 986 when a
+//!    looser velocity tolerance lets it climb further). Stability-limit detection
+//!    (`CVodeSetStabLimDet`) does not cure it (22 937). BDF2 is A-stable and damps the unresolved
+//!    modes numerically (the ROM has none of them: its highest mode is the truncation's):
+//!    **max order 2** ([`DEFAULT_MAX_ORDER`]), 10× fewer steps. With friction on the order never
+//!    rose above 2 anyway (the −1/τ eigenvalues of open and sliding pairs).
+//! 2. **The velocity tolerance.** With one number for both (vs = 1 1/s, velocity atol 1e-6 mm/s)
+//!    every mode above 0.16 Hz is held to atol/ω in displacement — 1e-12 mm for a 10⁶ rad/s mode
+//!    — and even BDF2 needs 25 000 steps. vs = ω_ref makes the displacement tolerance rule modes
+//!    below ω_ref and the velocity tolerance modes above it (see [`DEFAULT_VELOCITY_SCALE`]):
+//!    **vs = 1e3 1/s** (ω_ref ≈ 160 Hz, between the friction bar's first two fixed-interface
+//!    modes, 87 and 217 Hz); 1e4 saves nothing more (more Newton failures).
+//!
+//! Newton is not the bottleneck: 1.1–1.6 iterations per step, and the convergence failures
+//! (contact pairs opening/closing within a step) cost ~10 % of the steps. With these defaults the
+//! full friction bar runs 0.2 s in 28 000–38 000 steps (~20 s CPU) and the TVD ROM (r = 28) in
+//! 7 000–11 000 steps; the same settings apply to both (tolerances in mm of the physical field,
+//! [`OdeProblem::atol_scale`]). Accuracy: see `cases/reference/SOURCE.md` (default vs 100×
+//! tighter tolerances).
+
+use crate::error::Error;
+use crate::integrate::problem::{CallbackError, OdeOptions, OdeProblem, OdeStats, Stop};
+use crate::integrate::sundials::Cvode;
+use crate::joint::law::{evaluate_pairs, PairLaw, PairState, DEFAULT_TAU};
+use crate::system::SecondOrderSystem;
+
+/// Default [`ProblemOptions::velocity_scale`], 1/s: velocities are held to `atol · ω_ref` with
+/// ω_ref = 1e3 rad/s (160 Hz, between the friction bar's 1st and 2nd fixed-interface modes,
+/// 87 and 217 Hz). A mode of circular frequency ω and displacement error ε has a velocity error
+/// ω ε, so modes below ω_ref are controlled by the displacement tolerance (ε ≤ atol) and modes
+/// above by the velocity tolerance (ε ≤ atol · ω_ref/ω, tighter). With ω_ref = 1 rad/s (one
+/// number for both, the paper's Table 1 read literally) every mode above 0.16 Hz — all of them —
+/// is held to atol/ω in displacement, 10⁻¹¹ mm for a 1 MHz shell mode: see the module docs.
+pub const DEFAULT_VELOCITY_SCALE: f64 = 1e3;
+
+/// Default maximum BDF order of [`TransientOptions`]: 2 (see the module docs — BDF orders 3–5
+/// are not A-stable, and the undamped FE model's high-frequency modes on the imaginary axis
+/// then force steps of ~1e-8 s).
+pub const DEFAULT_MAX_ORDER: usize = 2;
+
+/// Options of the mechanical problem.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct ProblemOptions {
+    /// Friction (tangential forces and slip memory) on.
+    pub friction: bool,
+    /// Root functions: gaps (w) and, with friction, stick/slip switches (w).
+    pub events: bool,
+    /// Relaxation time τ of the slip memory, s.
+    pub tau: f64,
+    /// Unit of the slip-memory states, mm (state = s / slip_scale). The integrator's absolute
+    /// tolerance applies to the states, and the stick radius `μ|p_n|/k_t` is only ~1e-6 mm at
+    /// p_n = 0.04 N: with atol 1e-6 on s in mm the slip memory (and the dissipation) would be
+    /// resolved to no digit. Default 1e-3 (atol 1e-6 ↔ 1e-9 mm).
+    pub slip_scale: f64,
+    /// Unit of the energy states W and D, N·mm (default 1e-3: atol 1e-6 ↔ 1e-9 N·mm).
+    pub energy_scale: f64,
+    /// Velocity tolerance per displacement tolerance, 1/s: a velocity's absolute tolerance is
+    /// `atol · velocity_scale` (mm/s) while a displacement's is `atol` (mm). 1 applies the one
+    /// number of the paper's Table 1 to both.
+    pub velocity_scale: f64,
+}
+
+impl Default for ProblemOptions {
+    fn default() -> Self {
+        ProblemOptions {
+            friction: true,
+            events: false,
+            tau: DEFAULT_TAU,
+            slip_scale: 1e-3,
+            energy_scale: 1e-3,
+            velocity_scale: DEFAULT_VELOCITY_SCALE,
+        }
+    }
+}
+
+/// One pair's linearization kept between Newton setup and solves.
+#[derive(Clone, Copy, Debug, Default)]
+struct PairLin {
+    /// `(I + γ D_s)⁻¹`.
+    inv: [[f64; 2]; 2],
+    /// `D_s = ∂ṡ/∂u_t`.
+    sdot_u: [[f64; 2]; 2],
+    /// `φ_g = ∂ṡ/∂g`.
+    sdot_g: [f64; 2],
+    /// `T (I + γ D_s)⁻¹` (symmetric).
+    t_eff: [[f64; 2]; 2],
+    /// `T = ∂p_t/∂u_t`.
+    pt_u: [[f64; 2]; 2],
+    /// `∂p_n/∂g`.
+    pn_g: f64,
+    /// `∂d/∂u_t`, `∂d/∂g`.
+    diss_u: [f64; 2],
+    diss_g: f64,
+}
+
+/// The mechanical ODE of a second-order system with joint pairs.
+pub struct MechanicalOde<S: SecondOrderSystem> {
+    sys: S,
+    law: PairLaw,
+    events: bool,
+    n: usize,
+    w: usize,
+    /// Work buffers (no allocation in callbacks).
+    u: Vec<f64>,
+    p: Vec<f64>,
+    srate: Vec<f64>,
+    f: Vec<f64>,
+    tmp: Vec<f64>,
+    tmp2: Vec<f64>,
+    kc: Vec<f64>,
+    lin: Vec<PairLin>,
+    lin_gamma: f64,
+    have_lin: bool,
+    /// Sliding pairs at the last Newton setup.
+    slipping_at_setup: usize,
+    /// Slip memory in mm (the states times `s_scale`).
+    s_phys: Vec<f64>,
+    s_scale: f64,
+    e_scale: f64,
+    v_scale: f64,
+}
+
+impl<S: SecondOrderSystem> MechanicalOde<S> {
+    /// Wraps a system with the case's contact law.
+    pub fn new(sys: S, opts: &ProblemOptions) -> Result<MechanicalOde<S>, Error> {
+        let c = sys.contact();
+        if !(opts.tau.is_finite() && opts.tau > 0.0) {
+            return Err(Error::Invalid(format!(
+                "tau (slip relaxation time) must be finite and positive, got {} s",
+                opts.tau
+            )));
+        }
+        for (name, v) in [
+            ("slip_scale", opts.slip_scale),
+            ("energy_scale", opts.energy_scale),
+            ("velocity_scale", opts.velocity_scale),
+        ] {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(Error::Invalid(format!(
+                    "{name} must be finite and positive, got {v}"
+                )));
+            }
+        }
+        let law = PairLaw {
+            k_n: c.normal_stiffness,
+            friction: opts.friction,
+            mu: c.friction_coefficient,
+            k_t: c.stick_stiffness,
+            tau: opts.tau,
+        };
+        let n = sys.dim();
+        let w = sys.pairs();
+        Ok(MechanicalOde {
+            law,
+            events: opts.events,
+            n,
+            w,
+            u: vec![0.0; 3 * w],
+            p: vec![0.0; 3 * w],
+            srate: vec![0.0; 2 * w],
+            f: vec![0.0; n],
+            tmp: vec![0.0; n],
+            tmp2: vec![0.0; n],
+            kc: vec![0.0; 9 * w],
+            lin: vec![PairLin::default(); w],
+            lin_gamma: f64::NAN,
+            have_lin: false,
+            slipping_at_setup: 0,
+            s_phys: vec![0.0; if opts.friction { 2 * w } else { 0 }],
+            s_scale: opts.slip_scale,
+            e_scale: opts.energy_scale,
+            v_scale: opts.velocity_scale,
+            sys,
+        })
+    }
+
+    /// The system.
+    pub fn system(&self) -> &S {
+        &self.sys
+    }
+
+    /// The pair law in use.
+    pub fn law(&self) -> &PairLaw {
+        &self.law
+    }
+
+    /// Number of structural coordinates n.
+    pub fn coords(&self) -> usize {
+        self.n
+    }
+
+    /// Number of slip-memory states (2w with friction, else 0).
+    fn ns(&self) -> usize {
+        if self.law.friction {
+            2 * self.w
+        } else {
+            0
+        }
+    }
+
+    /// Index of the external-work state W (D follows).
+    pub fn work_index(&self) -> usize {
+        2 * self.n + self.ns()
+    }
+
+    /// Unit of the slip-memory states, mm.
+    pub fn slip_scale(&self) -> f64 {
+        self.s_scale
+    }
+
+    /// Unit of the energy states, N·mm.
+    pub fn energy_scale(&self) -> f64 {
+        self.e_scale
+    }
+
+    /// Copies the slip memory of `y` into `s_phys` (mm).
+    fn load_slip(&mut self, y: &[f64]) {
+        let i0 = 2 * self.n;
+        for (o, &x) in self.s_phys.iter_mut().zip(&y[i0..]) {
+            *o = self.s_scale * x;
+        }
+    }
+
+    /// Pairs sliding at the last Newton setup.
+    pub fn slipping_at_setup(&self) -> usize {
+        self.slipping_at_setup
+    }
+
+    /// The initial state: at rest, undeformed, no slip, no work.
+    pub fn initial_state(&self) -> Vec<f64> {
+        vec![0.0; self.dim()]
+    }
+
+    /// Outputs at `(t, y)`: force norms, master displacement, energies.
+    pub fn sample(&mut self, t: f64, y: &[f64]) -> EnergySample {
+        let n = self.n;
+        self.load_slip(y);
+        let (q, rest) = y.split_at(n);
+        let (v, rest) = rest.split_at(n);
+        let rest = &rest[self.ns()..];
+        let s = &self.s_phys;
+        self.sys.joint_apply_into(q, &mut self.u);
+        evaluate_pairs(&self.law, &self.u, s, &mut self.p, &mut self.srate);
+        let mut fc = 0.0;
+        let mut fr = 0.0;
+        let mut pair = 0.0;
+        for k in 0..self.w {
+            fc += self.p[3 * k].powi(2);
+            fr += self.p[3 * k + 1].powi(2) + self.p[3 * k + 2].powi(2);
+            let sk = if self.law.friction {
+                [s[2 * k], s[2 * k + 1]]
+            } else {
+                [0.0; 2]
+            };
+            pair += self
+                .law
+                .stored_energy([self.u[3 * k], self.u[3 * k + 1], self.u[3 * k + 2]], sk);
+        }
+        self.sys.mul_m_into(v, &mut self.tmp);
+        let kinetic = 0.5 * dot(v, &self.tmp);
+        self.sys.mul_k_into(q, &mut self.tmp);
+        let strain = 0.5 * dot(q, &self.tmp);
+        EnergySample {
+            t,
+            contact_force_norm: fc.sqrt(),
+            friction_force_norm: fr.sqrt(),
+            master: self.sys.master_displacement(q),
+            kinetic,
+            strain,
+            pair,
+            external_work: self.e_scale * rest[0],
+            dissipated: self.e_scale * rest[1],
+        }
+    }
+}
+
+/// Outputs at one time.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct EnergySample {
+    /// Time, s.
+    pub t: f64,
+    /// ‖f_c‖: Euclidean norm of all pair normal forces, N.
+    pub contact_force_norm: f64,
+    /// ‖f_R‖: Euclidean norm of all tangential (x, z) pair forces, N.
+    pub friction_force_norm: f64,
+    /// Master node `[ux, uy, uz (mm), rx, ry, rz (rad)]`.
+    pub master: [f64; 6],
+    /// `½ vᵀ M v`, N·mm.
+    pub kinetic: f64,
+    /// `½ qᵀ K q`, N·mm.
+    pub strain: f64,
+    /// Pair (penalty + elastic stick) energy, N·mm.
+    pub pair: f64,
+    /// `∫ f · v dt`, N·mm.
+    pub external_work: f64,
+    /// `∫ Σ p_t · ṡ dt`, N·mm.
+    pub dissipated: f64,
+}
+
+impl EnergySample {
+    /// `E_kin + E_strain + E_pair + D − W` (zero for an exact solution from rest), N·mm.
+    pub fn balance(&self) -> f64 {
+        self.kinetic + self.strain + self.pair + self.dissipated - self.external_work
+    }
+}
+
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
+fn mul2(a: &[[f64; 2]; 2], x: [f64; 2]) -> [f64; 2] {
+    [
+        a[0][0] * x[0] + a[0][1] * x[1],
+        a[1][0] * x[0] + a[1][1] * x[1],
+    ]
+}
+
+fn matmul2(a: &[[f64; 2]; 2], b: &[[f64; 2]; 2]) -> [[f64; 2]; 2] {
+    let mut c = [[0.0; 2]; 2];
+    for i in 0..2 {
+        for j in 0..2 {
+            c[i][j] = a[i][0] * b[0][j] + a[i][1] * b[1][j];
+        }
+    }
+    c
+}
+
+fn non_finite(what: &str, x: &[f64]) -> Result<(), CallbackError> {
+    if x.iter().all(|v| v.is_finite()) {
+        Ok(())
+    } else {
+        Err(CallbackError::Recoverable(format!("{what} is not finite")))
+    }
+}
+
+impl<S: SecondOrderSystem> MechanicalOde<S> {
+    /// Builds K_c and the per-pair data for γ from the stored linearization.
+    fn apply_gamma(&mut self, gamma: f64) {
+        for (k, l) in self.lin.iter_mut().enumerate() {
+            let a = [
+                [1.0 + gamma * l.sdot_u[0][0], gamma * l.sdot_u[0][1]],
+                [gamma * l.sdot_u[1][0], 1.0 + gamma * l.sdot_u[1][1]],
+            ];
+            let det = a[0][0] * a[1][1] - a[0][1] * a[1][0];
+            l.inv = [
+                [a[1][1] / det, -a[0][1] / det],
+                [-a[1][0] / det, a[0][0] / det],
+            ];
+            let te = matmul2(&l.pt_u, &l.inv);
+            let off = 0.5 * (te[0][1] + te[1][0]);
+            l.t_eff = [[te[0][0], off], [off, te[1][1]]];
+            let b = &mut self.kc[9 * k..9 * k + 9];
+            b.fill(0.0);
+            b[0] = l.pn_g;
+            b[4] = l.t_eff[0][0];
+            b[5] = l.t_eff[0][1];
+            b[7] = l.t_eff[1][0];
+            b[8] = l.t_eff[1][1];
+        }
+        self.lin_gamma = gamma;
+    }
+}
+
+impl<S: SecondOrderSystem> OdeProblem for MechanicalOde<S> {
+    fn dim(&self) -> usize {
+        2 * self.n + self.ns() + 2
+    }
+
+    /// Displacements: `atol` in mm (or rad) of the physical field, i.e. `atol / size` for a
+    /// coordinate moving nodes by `size` per unit; velocities: `velocity_scale` times that;
+    /// slip memory and energies: their state units (`slip_scale`, `energy_scale`).
+    fn atol_scale(&self, scale: &mut [f64]) -> bool {
+        let n = self.n;
+        let (q, rest) = scale.split_at_mut(n);
+        self.sys.coordinate_size_into(q);
+        q.iter_mut().for_each(|x| *x = 1.0 / *x);
+        let (v, rest) = rest.split_at_mut(n);
+        for (vi, qi) in v.iter_mut().zip(q.iter()) {
+            *vi = qi * self.v_scale;
+        }
+        rest.iter_mut().for_each(|x| *x = 1.0);
+        true
+    }
+
+    fn rhs(&mut self, t: f64, y: &[f64], ydot: &mut [f64]) -> Result<(), CallbackError> {
+        let n = self.n;
+        let ns = self.ns();
+        self.load_slip(y);
+        let (q, rest) = y.split_at(n);
+        let v = &rest[..n];
+        self.sys.joint_apply_into(q, &mut self.u);
+        let tot = evaluate_pairs(
+            &self.law,
+            &self.u,
+            &self.s_phys,
+            &mut self.p,
+            &mut self.srate,
+        );
+        self.sys.load_into(t, &mut self.f);
+        self.sys.mul_k_into(q, &mut self.tmp);
+        self.sys.joint_transpose_add(&self.p, &mut self.tmp);
+        let (dq, drest) = ydot.split_at_mut(n);
+        let (dv, drest) = drest.split_at_mut(n);
+        dq.copy_from_slice(v);
+        for ((o, fi), ki) in dv.iter_mut().zip(&self.f).zip(&self.tmp) {
+            *o = fi - ki;
+        }
+        self.sys.solve_m_in_place(dv);
+        let inv_s = 1.0 / self.s_scale;
+        for (o, &r) in drest[..ns].iter_mut().zip(&self.srate) {
+            *o = inv_s * r;
+        }
+        drest[ns] = dot(&self.f, v) / self.e_scale;
+        drest[ns + 1] = tot.dissipation / self.e_scale;
+        non_finite("the right-hand side", ydot)
+    }
+
+    fn num_roots(&self) -> usize {
+        if !self.events {
+            0
+        } else if self.law.friction {
+            2 * self.w
+        } else {
+            self.w
+        }
+    }
+
+    fn roots(&mut self, _t: f64, y: &[f64], g: &mut [f64]) -> Result<(), CallbackError> {
+        let n = self.n;
+        self.sys.joint_apply_into(&y[..n], &mut self.u);
+        for k in 0..self.w {
+            g[k] = self.u[3 * k];
+        }
+        if self.law.friction {
+            self.load_slip(y);
+            let s = &self.s_phys;
+            for k in 0..self.w {
+                g[self.w + k] = self.law.switch(
+                    [self.u[3 * k], self.u[3 * k + 1], self.u[3 * k + 2]],
+                    [s[2 * k], s[2 * k + 1]],
+                );
+            }
+        }
+        Ok(())
+    }
+
+    fn has_newton_solver(&self) -> bool {
+        true
+    }
+
+    fn newton_setup(
+        &mut self,
+        _t: f64,
+        y: &[f64],
+        _fy: &[f64],
+        jok: bool,
+        gamma: f64,
+    ) -> Result<bool, CallbackError> {
+        let n = self.n;
+        let jcur = !(jok && self.have_lin);
+        if jcur {
+            self.sys.joint_apply_into(&y[..n], &mut self.u);
+            self.load_slip(y);
+            let s = &self.s_phys;
+            let mut slipping = 0;
+            for k in 0..self.w {
+                let uk = [self.u[3 * k], self.u[3 * k + 1], self.u[3 * k + 2]];
+                let sk = if self.law.friction {
+                    [s[2 * k], s[2 * k + 1]]
+                } else {
+                    [0.0; 2]
+                };
+                let tg = self.law.tangent(uk, sk);
+                if self.law.friction && self.law.eval(uk, sk).state == PairState::Slip {
+                    slipping += 1;
+                }
+                self.lin[k] = PairLin {
+                    sdot_u: tg.sdot_u,
+                    sdot_g: tg.sdot_g,
+                    pt_u: tg.pt_u,
+                    pn_g: tg.pn_g,
+                    diss_u: tg.diss_u,
+                    diss_g: tg.diss_g,
+                    ..PairLin::default()
+                };
+            }
+            self.slipping_at_setup = slipping;
+            self.have_lin = true;
+        }
+        self.apply_gamma(gamma);
+        self.sys
+            .newton_factor(gamma, &self.kc)
+            .map_err(|e| CallbackError::Recoverable(e.to_string()))?;
+        Ok(jcur)
+    }
+
+    fn newton_solve(
+        &mut self,
+        t: f64,
+        _y: &[f64],
+        r: &[f64],
+        z: &mut [f64],
+        gamma: f64,
+    ) -> Result<(), CallbackError> {
+        if !self.have_lin {
+            return Err(CallbackError::Fatal(
+                "newton_solve called before newton_setup".into(),
+            ));
+        }
+        // CVODE re-runs the setup only when γ has changed by more than ~30 %; between setups
+        // the current γ is used in the elimination (so `a − γ b = r_q` holds exactly) with the
+        // factorization and `(I + γ D_s)⁻¹` of the setup's γ.
+        let g = gamma;
+        let n = self.n;
+        let ns = self.ns();
+        let fr = self.law.friction;
+        let (rq, rest) = r.split_at(n);
+        let (rv, rest) = rest.split_at(n);
+        let (rs, rest) = rest.split_at(ns);
+        // Residuals and corrections of s, W, D in physical units (mm, N·mm) inside.
+        let ss = self.s_scale;
+        // rhs_a = M (r_q + γ r_v) + γ² Bᵀ [0; T_eff r_s]
+        for ((o, a), b) in self.tmp2.iter_mut().zip(rq).zip(rv) {
+            *o = a + g * b;
+        }
+        self.sys.mul_m_into(&self.tmp2, &mut self.tmp);
+        if fr {
+            for k in 0..self.w {
+                let l = &self.lin[k];
+                let x = mul2(&l.inv, [ss * rs[2 * k], ss * rs[2 * k + 1]]);
+                let h = mul2(&l.pt_u, x);
+                self.p[3 * k] = 0.0;
+                self.p[3 * k + 1] = g * g * h[0];
+                self.p[3 * k + 2] = g * g * h[1];
+            }
+            self.sys.joint_transpose_add(&self.p, &mut self.tmp);
+        }
+        let (za, zrest) = z.split_at_mut(n);
+        za.copy_from_slice(&self.tmp);
+        self.sys.newton_solve_in_place(za);
+        let (zb, zrest) = zrest.split_at_mut(n);
+        for ((b, a), q) in zb.iter_mut().zip(za.iter()).zip(rq) {
+            *b = (a - q) / g;
+        }
+        let (zs, ze) = zrest.split_at_mut(ns);
+        let mut zd = self.e_scale * rest[1];
+        if fr {
+            self.sys.joint_apply_into(za, &mut self.u);
+            for k in 0..self.w {
+                let l = &self.lin[k];
+                let ba = [self.u[3 * k], self.u[3 * k + 1], self.u[3 * k + 2]];
+                let du = mul2(&l.sdot_u, [ba[1], ba[2]]);
+                let rhs = [
+                    ss * rs[2 * k] + g * (du[0] + l.sdot_g[0] * ba[0]),
+                    ss * rs[2 * k + 1] + g * (du[1] + l.sdot_g[1] * ba[0]),
+                ];
+                let c = mul2(&l.inv, rhs);
+                zs[2 * k] = c[0] / ss;
+                zs[2 * k + 1] = c[1] / ss;
+                zd += g
+                    * (l.diss_u[0] * (ba[1] - c[0])
+                        + l.diss_u[1] * (ba[2] - c[1])
+                        + l.diss_g * ba[0]);
+            }
+        }
+        self.sys.load_into(t, &mut self.f);
+        ze[0] = rest[0] + g * dot(&self.f, zb) / self.e_scale;
+        ze[1] = zd / self.e_scale;
+        non_finite("the Newton correction", z)
+    }
+}
+
+/// Options of [`run`]. Defaults: the integrator's defaults ([`OdeOptions::default`]: BDF,
+/// Newton with the structured solve, rtol 1e-8, atol 1e-6 — the paper's Table 1) except the
+/// maximum order [`DEFAULT_MAX_ORDER`] = 2, velocity tolerance [`DEFAULT_VELOCITY_SCALE`] × atol,
+/// friction on, events off, τ = 1e-6 s, outputs every 1e-4 s, the case's end time.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct TransientOptions {
+    /// Integrator options.
+    pub ode: OdeOptions,
+    /// Friction, events, τ.
+    pub problem: ProblemOptions,
+    /// Spacing of the output times, s (> 0).
+    pub output_step: f64,
+    /// End of the run, s (`None`: the case's `end_time`).
+    pub end_time: Option<f64>,
+}
+
+impl Default for TransientOptions {
+    fn default() -> Self {
+        TransientOptions {
+            ode: OdeOptions {
+                max_order: DEFAULT_MAX_ORDER,
+                ..OdeOptions::default()
+            },
+            problem: ProblemOptions::default(),
+            output_step: 1e-4,
+            end_time: None,
+        }
+    }
+}
+
+/// Output curves of a run, one entry per output time.
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
+pub struct Curves {
+    /// Output times, s.
+    pub t: Vec<f64>,
+    /// ‖f_c‖, N.
+    pub contact_force_norm: Vec<f64>,
+    /// ‖f_R‖, N.
+    pub friction_force_norm: Vec<f64>,
+    /// Master node u_y, mm.
+    pub master_uy: Vec<f64>,
+    /// Kinetic energy, N·mm.
+    pub kinetic: Vec<f64>,
+    /// Strain energy, N·mm.
+    pub strain: Vec<f64>,
+    /// Pair (penalty and stick) energy, N·mm.
+    pub pair: Vec<f64>,
+    /// External work, N·mm.
+    pub external_work: Vec<f64>,
+    /// Dissipated energy, N·mm.
+    pub dissipated: Vec<f64>,
+}
+
+impl Curves {
+    fn push(&mut self, s: &EnergySample) {
+        self.t.push(s.t);
+        self.contact_force_norm.push(s.contact_force_norm);
+        self.friction_force_norm.push(s.friction_force_norm);
+        self.master_uy.push(s.master[1]);
+        self.kinetic.push(s.kinetic);
+        self.strain.push(s.strain);
+        self.pair.push(s.pair);
+        self.external_work.push(s.external_work);
+        self.dissipated.push(s.dissipated);
+    }
+
+    /// The energy balance `E_kin + E_strain + E_pair + D − W` at each output, N·mm.
+    pub fn balance(&self) -> Vec<f64> {
+        (0..self.t.len())
+            .map(|i| {
+                self.kinetic[i] + self.strain[i] + self.pair[i] + self.dissipated[i]
+                    - self.external_work[i]
+            })
+            .collect()
+    }
+}
+
+/// The result of [`run`].
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct TransientResult {
+    /// Integrator statistics.
+    pub stats: OdeStats,
+    /// Wall-clock time of the integration (excluding the system's construction), s.
+    pub wall_s: f64,
+    /// Process CPU time of the integration, s (from `/proc/self/stat`, 10 ms resolution; NaN
+    /// where unavailable).
+    pub cpu_s: f64,
+    /// Events located (and re-initialisations done) with events on.
+    pub events: u64,
+    /// Output curves.
+    pub curves: Curves,
+    /// Final state `y` (q, v, s, W, D).
+    pub final_state: Vec<f64>,
+}
+
+/// Roots in a row at the same time after which [`run`] gives up.
+const MAX_STALLED_ROOTS: usize = 1000;
+
+/// Process CPU time (user + system), s, from `/proc/self/stat` (clock ticks of 1/100 s); NaN
+/// where unavailable.
+pub fn cpu_time() -> f64 {
+    std::fs::read_to_string("/proc/self/stat")
+        .ok()
+        .and_then(|s| {
+            // Fields after the command name (which is in parentheses and may contain spaces).
+            let rest = &s[s.rfind(')')? + 2..];
+            let f: Vec<&str> = rest.split_whitespace().collect();
+            let ut: f64 = f.get(11)?.parse().ok()?;
+            let st: f64 = f.get(12)?.parse().ok()?;
+            Some((ut + st) / 100.0)
+        })
+        .unwrap_or(f64::NAN)
+}
+
+/// Integrates a system from rest over `[0, end]` with CVODE and samples the outputs every
+/// `output_step`. With events on, each located root (gap or stick/slip switch) restarts the
+/// integrator there (`CVodeReInit`: order 1, history discarded — the right-hand side is only
+/// piecewise smooth across a switch).
+///
+/// # Errors
+/// [`Error::Invalid`] for a non-positive or non-finite `output_step`/`end_time` or `tau`; any
+/// integrator error ([`Error::Sundials`] with the flag and time reached, callback errors).
+pub fn run<S: SecondOrderSystem>(
+    system: S,
+    opts: &TransientOptions,
+) -> Result<TransientResult, Error> {
+    run_observed(system, opts, |_, _| {})
+}
+
+/// [`run`], calling `observe(t, q)` with the system's coordinates `q` (the first `dim` entries
+/// of the state) at t = 0 and at every output time — e.g. to keep displacement snapshots of a
+/// full-FE run for a POD basis ([`crate::reduction::snapshot_basis`]).
+///
+/// # Errors
+/// As [`run`].
+pub fn run_observed<S: SecondOrderSystem>(
+    system: S,
+    opts: &TransientOptions,
+    mut observe: impl FnMut(f64, &[f64]),
+) -> Result<TransientResult, Error> {
+    let end = opts.end_time.unwrap_or_else(|| system.end_time());
+    if !(end.is_finite() && end > 0.0) {
+        return Err(Error::Invalid(format!(
+            "end_time must be finite and positive, got {end} s"
+        )));
+    }
+    if !(opts.output_step.is_finite() && opts.output_step > 0.0) {
+        return Err(Error::Invalid(format!(
+            "output_step must be finite and positive, got {} s",
+            opts.output_step
+        )));
+    }
+    let mut ode = MechanicalOde::new(system, &opts.problem)?;
+    let dim = ode.coords();
+    let y0 = ode.initial_state();
+    let mut curves = Curves::default();
+    curves.push(&ode.sample(0.0, &y0));
+    observe(0.0, &y0[..dim]);
+    let wall = std::time::Instant::now();
+    let cpu0 = cpu_time();
+    let mut cv = Cvode::new(ode, 0.0, &y0, &opts.ode)?;
+    let steps = (end / opts.output_step - 1e-9).ceil().max(1.0) as usize;
+    let mut events = 0u64;
+    let mut last_root_t = f64::NEG_INFINITY;
+    let mut stalled = 0usize;
+    for k in 1..=steps {
+        let tout = (k as f64 * opts.output_step).min(end);
+        loop {
+            match cv.solve_to(tout)? {
+                Stop::Reached(_) => break,
+                Stop::Root { t, .. } => {
+                    events += 1;
+                    // Guard against chattering: roots that make no progress in time.
+                    if t - last_root_t <= 1e-13 * t.abs().max(1e-3) {
+                        stalled += 1;
+                        if stalled > MAX_STALLED_ROOTS {
+                            return Err(Error::Invalid(format!(
+                                "events: {MAX_STALLED_ROOTS} roots without progress at t = {t} s \
+                                 (chattering switch); run with events off"
+                            )));
+                        }
+                    } else {
+                        stalled = 0;
+                    }
+                    last_root_t = t;
+                    let y = cv.y().to_vec();
+                    cv.reinit(t, &y)?;
+                }
+            }
+        }
+        let t = cv.t();
+        let y = cv.y().to_vec();
+        let s = cv.problem_mut().sample(t, &y);
+        curves.push(&s);
+        observe(t, &y[..dim]);
+    }
+    let wall_s = wall.elapsed().as_secs_f64();
+    let cpu_s = cpu_time() - cpu0;
+    Ok(TransientResult {
+        stats: cv.stats(),
+        wall_s,
+        cpu_s,
+        events,
+        curves,
+        final_state: cv.y().to_vec(),
+    })
+}

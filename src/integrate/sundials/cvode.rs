@@ -1,0 +1,787 @@
+//! [`Cvode`]: a safe CVODE (SUNDIALS 6.4) integrator for any [`OdeProblem`].
+//!
+//! # The method
+//! CVODE integrates `y' = F(t, y)` with variable-order, variable-step linear multistep formulas
+//! `y_n = Σ α_j y_{n−j} + h β_0 F(t_n, y_n) + …` — BDF of orders 1–5 (the paper's choice for the
+//! stiff contact problems) or Adams–Moulton of orders 1–12. Each step solves the implicit
+//! equation `G(y_n) = y_n − γ F(t_n, y_n) − a_n = 0` (γ = h β_0) by
+//! - **functional iteration** (`SUNNonlinSol_FixedPoint`, optional Anderson acceleration of
+//!   depth m): `y ← γ F(t_n, y) + a_n`; it converges only while `γ ‖J‖ ≲ 1`, i.e. the step is
+//!   bounded by the stiffest mode, whatever the accuracy needs;
+//! - **modified Newton**: `(I − γ J) δ = −G(y)`, with either a dense LU of `I − γJ` and J by
+//!   CVODE's difference quotients ([`NewtonLinear::DenseDq`]) or the problem's own solver
+//!   ([`NewtonLinear::Problem`], e.g. the structured `M + γ C + γ² K_t` of a second-order model,
+//!   see [`super::problem_ls`]).
+//!
+//! Undamped structures have eigenvalues ±iω on the imaginary axis, where BDF of orders 3–5 are
+//! not A-stable; [`OdeOptions::stab_lim_det`] switches on CVODE's stability-limit detection,
+//! which lowers the order when it sees the instability.
+//!
+//! Events: with `problem.num_roots() > 0` CVODE locates sign changes of `g(t, y)` between steps
+//! (to about `100 U (|t| + |h|)`, U = 2.2e-16: ~1e-13 s for t ≤ 1 s, well below the paper's
+//! tolerance on time of 1e-10) and [`Cvode::solve_to`] stops there with [`Stop::Root`].
+//!
+//! # Ownership
+//! Each `Cvode` creates its own [`Context`] (a `SUNContext` is not thread-safe; `Cvode` is
+//! neither `Send` nor `Sync`) and owns, one RAII value per C object, the CVODE memory, the
+//! nonlinear solver (functional iteration only; CVODE owns its default Newton solver), the
+//! linear solver, the dense matrix, the state vector and the problem (boxed: its address is
+//! CVODE's `user_data`). They are freed in the order of the CVODE guide: `CVodeFree` →
+//! nonlinear solver → linear solver → matrix → vector → problem → context.
+//!
+//! # Errors
+//! Every return code is checked: [`Error::Sundials`] names the C function, the flag (CVODE's
+//! name, plus CVODE's own message where it gave one) and the time reached; a failing callback
+//! gives [`Error::Callback`] with the callback's name, last message, time and the flag. See
+//! [`super::callbacks`] for panics and NaN/Inf.
+
+use std::ffi::{c_int, c_long, c_void};
+use std::ptr::NonNull;
+
+use sundials_sys::{
+    CVode, CVodeCreate, CVodeGetCurrentTime, CVodeGetDky, CVodeGetLastOrder, CVodeGetLastStep,
+    CVodeGetNumErrTestFails, CVodeGetNumGEvals, CVodeGetNumJacEvals, CVodeGetNumLinRhsEvals,
+    CVodeGetNumLinSolvSetups, CVodeGetNumNonlinSolvConvFails, CVodeGetNumNonlinSolvIters,
+    CVodeGetNumPrecEvals, CVodeGetNumPrecSolves, CVodeGetNumRhsEvals, CVodeGetNumStabLimOrderReds,
+    CVodeGetNumSteps, CVodeGetRootInfo, CVodeInit, CVodeReInit, CVodeRootInit, CVodeSStolerances,
+    CVodeSVtolerances, CVodeSetEpsLin, CVodeSetErrHandlerFn, CVodeSetInitStep,
+    CVodeSetLinearSolver, CVodeSetMaxNumSteps, CVodeSetMaxOrd, CVodeSetMaxStep,
+    CVodeSetNoInactiveRootWarn, CVodeSetNonlinearSolver, CVodeSetPreconditioner,
+    CVodeSetRootDirection, CVodeSetStabLimDet, CVodeSetStopTime, CVodeSetUserData, SUNDenseMatrix,
+    SUNLinSol_Dense, SUNNonlinSol_FixedPoint, CV_ADAMS, CV_BDF, CV_NORMAL, CV_ROOT_RETURN,
+};
+
+use super::callbacks::{self, Failure, Shared};
+use super::owners::{CvodeMem, LinearSolver, Matrix, NonlinearSolver};
+use super::{cvode_flag_name, cvode_ls_flag_name, problem_ls, Context, SerialVector};
+use crate::integrate::problem::{
+    Iteration, Method, NewtonLinear, OdeOptions, OdeProblem, OdeStats, Stop,
+};
+use crate::Error;
+
+/// CVLS's tolerance factor ε_L for jointrom's problem solver: small, so that CVLS skips the
+/// Newton solve only when the residual is negligible (`‖b‖ ≤ ε_L · tq[4]`), as a direct solver
+/// never does. (CVODE's default 0.05 would let the first Newton iteration take `x = b`.)
+const PROBLEM_EPS_LIN: f64 = 1e-10;
+
+/// Which linear solver is attached (decides which counters [`Cvode::stats`] reads).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Linear {
+    /// Functional iteration: no linear solver.
+    None,
+    /// Dense LU with difference-quotient Jacobian.
+    DenseDq,
+    /// The problem's solver through [`problem_ls`].
+    Problem,
+}
+
+/// Owns the boxed [`Shared`] state whose address CVODE holds as `user_data`.
+struct SharedBox<P> {
+    ptr: NonNull<Shared<P>>,
+}
+
+impl<P> SharedBox<P> {
+    fn new(shared: Shared<P>) -> Self {
+        Self {
+            ptr: NonNull::from(Box::leak(Box::new(shared))),
+        }
+    }
+
+    /// The shared state. Valid while no CVODE call is under way (callbacks only run inside
+    /// methods taking `&mut Cvode`, which hold no reference from here across the call).
+    fn get(&self) -> &Shared<P> {
+        // SAFETY: the pointer came from Box::leak and is freed only in Drop / into_inner.
+        unsafe { self.ptr.as_ref() }
+    }
+
+    fn get_mut(&mut self) -> &mut Shared<P> {
+        // SAFETY: as in `get`; `&mut self` excludes other Rust references.
+        unsafe { self.ptr.as_mut() }
+    }
+
+    fn as_user_data(&self) -> *mut c_void {
+        self.ptr.as_ptr().cast()
+    }
+
+    fn into_inner(self) -> Shared<P> {
+        let this = std::mem::ManuallyDrop::new(self);
+        // SAFETY: the pointer came from Box::leak; `Drop` will not run for `this`.
+        *unsafe { Box::from_raw(this.ptr.as_ptr()) }
+    }
+}
+
+impl<P> Drop for SharedBox<P> {
+    fn drop(&mut self) {
+        // SAFETY: the pointer came from Box::leak and is freed only here (or in into_inner,
+        // which suppresses this Drop). The CVODE memory holding it is freed before (field order).
+        drop(unsafe { Box::from_raw(self.ptr.as_ptr()) });
+    }
+}
+
+/// A CVODE integrator driving an [`OdeProblem`] (see the module docs).
+///
+/// ```
+/// use jointrom::integrate::problem::{CallbackError, OdeOptions, OdeProblem, Stop};
+/// use jointrom::integrate::sundials::Cvode;
+///
+/// struct Decay;
+/// impl OdeProblem for Decay {
+///     fn dim(&self) -> usize { 1 }
+///     fn rhs(&mut self, _t: f64, y: &[f64], ydot: &mut [f64]) -> Result<(), CallbackError> {
+///         ydot[0] = -y[0];
+///         Ok(())
+///     }
+/// }
+/// let opts = OdeOptions { iteration: jointrom::integrate::problem::Iteration::Functional { anderson: 0 },
+///                         ..OdeOptions::default() };
+/// let mut cvode = Cvode::new(Decay, 0.0, &[1.0], &opts)?;
+/// assert_eq!(cvode.solve_to(1.0)?, Stop::Reached(1.0));
+/// assert!((cvode.y()[0] - (-1.0f64).exp()).abs() < 1e-5); // atol = 1e-6 per step
+/// # Ok::<(), jointrom::Error>(())
+/// ```
+pub struct Cvode<P: OdeProblem> {
+    // Field order = drop order: CVodeFree, nonlinear solver, linear solver, matrix, vector,
+    // problem, context.
+    mem: CvodeMem,
+    nls: Option<NonlinearSolver>,
+    ls: Option<LinearSolver>,
+    matrix: Option<Matrix>,
+    y: SerialVector,
+    shared: SharedBox<P>,
+    _context: Context,
+    /// Time of `y`, s.
+    t: f64,
+    linear: Linear,
+    /// Counters accumulated before the last `reinit` (CVodeReInit resets CVODE's).
+    base: OdeStats,
+    /// After `reinit`, CVLS's counters are reset only by the next `CVode` call.
+    ls_counters_stale: bool,
+    roots_found: u64,
+    /// `y` before the current `solve_to` (restored if CVODE cannot report its state).
+    saved_y: Vec<f64>,
+}
+
+impl<P: OdeProblem> Cvode<P> {
+    /// Creates the integrator for `problem` with `y(t0) = y0` and the options `opts`; creates
+    /// its own SUNDIALS context.
+    ///
+    /// # Errors
+    /// [`Error::Invalid`] naming the field for a bad option (`rtol`/`atol` negative or not
+    /// finite, `max_order` outside 1–5 (BDF) or 1–12 (Adams), `max_steps` 0, negative
+    /// `max_step`/`init_step`, `stab_lim_det` with Adams, Newton with the problem's solver for
+    /// a problem without one), a `y0` of the wrong length or with NaN/Inf, a zero dimension;
+    /// [`Error::Sundials`] naming the C function if SUNDIALS refuses something.
+    pub fn new(problem: P, t0: f64, y0: &[f64], opts: &OdeOptions) -> Result<Self, Error> {
+        let n = problem.dim();
+        let nroots = problem.num_roots();
+        validate(&problem, t0, y0, opts)?;
+        let context = Context::new()?;
+        let y = SerialVector::from_slice(&context, y0)?;
+        let lmm = match opts.method {
+            Method::Bdf => CV_BDF,
+            Method::Adams => CV_ADAMS,
+        };
+        // SAFETY: the context is live; CVodeCreate returns new memory or null.
+        let mem = CvodeMem::new(unsafe { CVodeCreate(lmm, context.as_raw()) }, &context)?;
+        let shared = SharedBox::new(Shared {
+            problem,
+            n,
+            nroots,
+            failure: None,
+            poisoned: false,
+            cvode_message: None,
+            warnings: 0,
+        });
+        let mut cvode = Cvode {
+            mem,
+            nls: None,
+            ls: None,
+            matrix: None,
+            y,
+            shared,
+            _context: context.clone(),
+            t: t0,
+            linear: Linear::None,
+            base: OdeStats::default(),
+            ls_counters_stale: false,
+            roots_found: 0,
+            saved_y: Vec::with_capacity(n),
+        };
+        // Per-component absolute tolerances (CVODE copies the vector).
+        let mut scale = vec![0.0; n];
+        let atol_vector = if cvode.shared.get().problem.atol_scale(&mut scale) {
+            if let Some((i, s)) = scale
+                .iter()
+                .enumerate()
+                .find(|(_, s)| !(s.is_finite() && **s > 0.0))
+            {
+                return Err(Error::Invalid(format!(
+                    "the problem's absolute-tolerance scale[{i}] = {s} is not finite and > 0"
+                )));
+            }
+            scale.iter_mut().for_each(|s| *s *= opts.atol);
+            Some(SerialVector::from_slice(&context, &scale)?)
+        } else {
+            None
+        };
+        let m = cvode.mem.as_raw();
+        let user_data = cvode.shared.as_user_data();
+        // SAFETY (all calls below): `m` is live CVODE memory owned by `cvode`; `user_data`
+        // points to the boxed Shared<P> that `cvode` frees only after CVodeFree; vectors,
+        // matrices and solvers passed are owned by `cvode` and outlive the memory (field
+        // order). The trampolines' type parameter is this problem type.
+        unsafe {
+            cvode.check_cv(
+                "CVodeSetErrHandlerFn",
+                CVodeSetErrHandlerFn(m, Some(callbacks::error_handler::<P>), user_data),
+            )?;
+            cvode.check_cv(
+                "CVodeInit",
+                CVodeInit(m, Some(callbacks::rhs::<P>), t0, cvode.y.as_raw()),
+            )?;
+            match &atol_vector {
+                Some(v) => cvode.check_cv(
+                    "CVodeSVtolerances",
+                    CVodeSVtolerances(m, opts.rtol, v.as_raw()),
+                )?,
+                None => cvode.check_cv(
+                    "CVodeSStolerances",
+                    CVodeSStolerances(m, opts.rtol, opts.atol),
+                )?,
+            }
+            // Before the linear solver: CVLS copies user_data as the preconditioner's data.
+            cvode.check_cv("CVodeSetUserData", CVodeSetUserData(m, user_data))?;
+        }
+        match opts.iteration {
+            Iteration::Functional { anderson } => {
+                let depth = c_int::try_from(anderson).map_err(|_| {
+                    Error::Invalid(format!("iteration.anderson = {anderson} is too large"))
+                })?;
+                // SAFETY: `y` is a live template vector; the context is live.
+                let raw =
+                    unsafe { SUNNonlinSol_FixedPoint(cvode.y.as_raw(), depth, context.as_raw()) };
+                let nls = NonlinearSolver::new(raw, "SUNNonlinSol_FixedPoint", &context)?;
+                let raw = nls.as_raw();
+                cvode.nls = Some(nls);
+                // SAFETY: see above; `cvode.nls` owns the solver and frees it after CVodeFree.
+                unsafe {
+                    cvode.check_cv("CVodeSetNonlinearSolver", CVodeSetNonlinearSolver(m, raw))?;
+                }
+            }
+            Iteration::Newton {
+                linear: NewtonLinear::DenseDq,
+            } => {
+                let nn = n as i64; // n ≤ i64::MAX: SerialVector::from_slice checked it.
+                                   // SAFETY: the context is live; SUNDenseMatrix returns a new matrix or null.
+                let a = Matrix::new(
+                    unsafe { SUNDenseMatrix(nn, nn, context.as_raw()) },
+                    "SUNDenseMatrix",
+                    &context,
+                )?;
+                // SAFETY: `y` and `a` are live and compatible (n × n, length n).
+                let ls = LinearSolver::new(
+                    unsafe { SUNLinSol_Dense(cvode.y.as_raw(), a.as_raw(), context.as_raw()) },
+                    "SUNLinSol_Dense",
+                    &context,
+                )?;
+                let (ls_raw, a_raw) = (ls.as_raw(), a.as_raw());
+                cvode.matrix = Some(a);
+                cvode.ls = Some(ls);
+                cvode.linear = Linear::DenseDq;
+                // SAFETY: see above. No Jacobian function: CVODE's difference quotients.
+                unsafe {
+                    cvode.check_ls(
+                        "CVodeSetLinearSolver",
+                        CVodeSetLinearSolver(m, ls_raw, a_raw),
+                    )?;
+                }
+            }
+            Iteration::Newton {
+                linear: NewtonLinear::Problem,
+            } => {
+                let ls = problem_ls::new(&context)?;
+                let ls_raw = ls.as_raw();
+                cvode.ls = Some(ls);
+                cvode.linear = Linear::Problem;
+                // SAFETY: see above; the solver is matrix-free (NULL matrix).
+                unsafe {
+                    cvode.check_ls(
+                        "CVodeSetLinearSolver",
+                        CVodeSetLinearSolver(m, ls_raw, std::ptr::null_mut()),
+                    )?;
+                    cvode.check_ls(
+                        "CVodeSetPreconditioner",
+                        CVodeSetPreconditioner(
+                            m,
+                            Some(callbacks::newton_setup::<P>),
+                            Some(callbacks::newton_solve::<P>),
+                        ),
+                    )?;
+                    cvode.check_ls("CVodeSetEpsLin", CVodeSetEpsLin(m, PROBLEM_EPS_LIN))?;
+                }
+            }
+        }
+        let max_order = opts.max_order as c_int; // validated ≤ 12
+        let max_steps = c_long::try_from(opts.max_steps).unwrap_or(c_long::MAX);
+        // SAFETY: see above.
+        unsafe {
+            cvode.check_cv("CVodeSetMaxOrd", CVodeSetMaxOrd(m, max_order))?;
+            cvode.check_cv("CVodeSetMaxNumSteps", CVodeSetMaxNumSteps(m, max_steps))?;
+            if opts.max_step > 0.0 {
+                cvode.check_cv("CVodeSetMaxStep", CVodeSetMaxStep(m, opts.max_step))?;
+            }
+            if opts.init_step > 0.0 {
+                cvode.check_cv("CVodeSetInitStep", CVodeSetInitStep(m, opts.init_step))?;
+            }
+            if opts.stab_lim_det {
+                cvode.check_cv("CVodeSetStabLimDet", CVodeSetStabLimDet(m, 1))?;
+            }
+            if nroots > 0 {
+                let nr = c_int::try_from(nroots)
+                    .map_err(|_| Error::Invalid(format!("num_roots() = {nroots} is too large")))?;
+                cvode.check_cv(
+                    "CVodeRootInit",
+                    CVodeRootInit(m, nr, Some(callbacks::roots::<P>)),
+                )?;
+                // Event functions that are identically zero at the start (e.g. the gap of an
+                // open contact at rest) are legitimate: no warning.
+                cvode.check_cv("CVodeSetNoInactiveRootWarn", CVodeSetNoInactiveRootWarn(m))?;
+            }
+        }
+        Ok(cvode)
+    }
+
+    /// Integrates to `tout` (CVODE's `CV_NORMAL` task: internal steps past `tout`, then
+    /// interpolation). Returns [`Stop::Reached`] with the time reached (`tout`, or the stop
+    /// time of [`Cvode::set_stop_time`] if that came first) or [`Stop::Root`] at an event; `y`
+    /// and `t` then hold the state there.
+    ///
+    /// # Errors
+    /// [`Error::Callback`] if a callback failed (error, panic, persistent NaN/Inf), naming it,
+    /// its last message and the CVODE flag; [`Error::Sundials`] naming `CVode`, the flag (e.g.
+    /// `CV_TOO_MUCH_WORK`, `CV_CONV_FAILURE`, `CV_ERR_FAILURE`) and the time reached;
+    /// [`Error::Invalid`] for a non-finite `tout`. After an error `t`/`y` hold the last state
+    /// CVODE reached.
+    pub fn solve_to(&mut self, tout: f64) -> Result<Stop, Error> {
+        if !tout.is_finite() {
+            return Err(Error::Invalid(format!(
+                "solve_to: tout = {tout} is not finite"
+            )));
+        }
+        if let Some(failure) = self.poisoned_failure() {
+            return Err(callback_error(
+                failure,
+                "not run: a callback panicked earlier (call reinit to continue)".into(),
+            ));
+        }
+        if tout == self.t {
+            return Ok(Stop::Reached(self.t));
+        }
+        {
+            let shared = self.shared.get_mut();
+            shared.failure = None;
+            shared.cvode_message = None;
+        }
+        self.saved_y.clear();
+        self.saved_y.extend_from_slice(self.y.as_slice());
+        let mut t = self.t;
+        // SAFETY: the memory and `y` are live and owned by `self`; no Rust reference to the
+        // shared state or to `y`'s data is held across the call (callbacks reach them through
+        // `user_data` and CVODE's own vectors).
+        let flag = unsafe { CVode(self.mem.as_raw(), tout, self.y.as_raw(), &mut t, CV_NORMAL) };
+        let t_before = self.t;
+        if t.is_finite() {
+            self.t = t;
+        }
+        if flag >= 0 || self.raw_counter(CVodeGetNumSteps) > 0 {
+            self.ls_counters_stale = false;
+        }
+        if flag == CV_ROOT_RETURN {
+            let nroots = self.shared.get().nroots;
+            let mut info = vec![0 as c_int; nroots];
+            // SAFETY: `info` holds `nroots` writable ints, the number given to CVodeRootInit.
+            let f = unsafe { CVodeGetRootInfo(self.mem.as_raw(), info.as_mut_ptr()) };
+            self.check_cv("CVodeGetRootInfo", f)?;
+            self.roots_found += 1;
+            return Ok(Stop::Root {
+                t: self.t,
+                roots: info,
+            });
+        }
+        if flag >= 0 {
+            return Ok(Stop::Reached(self.t));
+        }
+        let shared = self.shared.get_mut();
+        let failure = shared.failure.take();
+        let message = shared.cvode_message.take();
+        let flag_name = format!(
+            "{}{}",
+            cvode_flag_name(flag),
+            message.map(|m| format!(" ({m})")).unwrap_or_default()
+        );
+        // The time CVODE reached (CVode leaves `t` unset on some failures, e.g. of the roots).
+        let mut reached = self.t;
+        // SAFETY: memory live; valid out-pointer.
+        if unsafe { CVodeGetCurrentTime(self.mem.as_raw(), &mut reached) } != 0 {
+            reached = self.t;
+        }
+        // Make `t`/`y` consistent: CVODE may have left interpolated trial values in `y` (e.g.
+        // after a root-function failure). Take the solution at the time reached, or restore
+        // the state before the call if CVODE cannot give it.
+        // SAFETY: memory and `y` live; CVodeGetDky writes n entries into `y`.
+        if unsafe { CVodeGetDky(self.mem.as_raw(), reached, 0, self.y.as_raw()) } == 0 {
+            self.t = reached;
+        } else {
+            let saved = std::mem::take(&mut self.saved_y);
+            self.y.as_mut_slice().copy_from_slice(&saved);
+            self.saved_y = saved;
+            self.t = t_before;
+            reached = t_before;
+        }
+        // A callback failure explains the CVODE failure if it was fatal, or if it happened at
+        // or after the time reached (during the attempts of the step that failed).
+        match failure {
+            Some(f) if f.fatal || f.time >= reached => Err(callback_error(
+                f,
+                format!("CVode returned {flag_name} at t = {reached} s"),
+            )),
+            _ => Err(Error::Sundials {
+                function: "CVode",
+                flag: flag_name,
+                time: reached,
+            }),
+        }
+    }
+
+    /// Current time, s (the time of [`Cvode::y`]).
+    pub fn t(&self) -> f64 {
+        self.t
+    }
+
+    /// Current state.
+    pub fn y(&self) -> &[f64] {
+        self.y.as_slice()
+    }
+
+    /// Restarts the integration at `(t, y)` (`CVodeReInit`, e.g. after an event changed the
+    /// problem): order 1, new initial step, history discarded; options, solvers and event
+    /// functions are kept. Statistics stay cumulative. Clears the poisoning left by a panic.
+    ///
+    /// # Errors
+    /// [`Error::Invalid`] for a `y` of the wrong length or with NaN/Inf, or a non-finite `t`;
+    /// [`Error::Sundials`] naming `CVodeReInit`.
+    pub fn reinit(&mut self, t: f64, y: &[f64]) -> Result<(), Error> {
+        check_state("reinit", t, y, self.shared.get().n)?;
+        let accumulated = self.current_stats();
+        self.y.as_mut_slice().copy_from_slice(y);
+        // SAFETY: memory and vector live and owned by `self`; CVodeReInit copies `y`.
+        let flag = unsafe { CVodeReInit(self.mem.as_raw(), t, self.y.as_raw()) };
+        self.check_cv("CVodeReInit", flag)?;
+        self.base = accumulated;
+        self.ls_counters_stale = true;
+        self.t = t;
+        let shared = self.shared.get_mut();
+        shared.poisoned = false;
+        shared.failure = None;
+        Ok(())
+    }
+
+    /// Makes the integration stop exactly at `tstop` (`CVodeSetStopTime`): no step goes past
+    /// it, which matters when F is not smooth beyond it. `solve_to` returns
+    /// `Stop::Reached(tstop)` when it gets there first; CVODE then forgets the stop time.
+    ///
+    /// # Errors
+    /// [`Error::Invalid`] for a non-finite `tstop`; [`Error::Sundials`] naming
+    /// `CVodeSetStopTime` (e.g. `tstop` behind the current time).
+    pub fn set_stop_time(&mut self, tstop: f64) -> Result<(), Error> {
+        if !tstop.is_finite() {
+            return Err(Error::Invalid(format!(
+                "set_stop_time: tstop = {tstop} is not finite"
+            )));
+        }
+        // SAFETY: memory live and owned by `self`.
+        let flag = unsafe { CVodeSetStopTime(self.mem.as_raw(), tstop) };
+        self.check_cv("CVodeSetStopTime", flag)
+    }
+
+    /// Restricts event detection by direction (`CVodeSetRootDirection`): `+1` only rising
+    /// (g from negative to positive), `−1` only falling, `0` both (the default), one entry per
+    /// event function.
+    ///
+    /// There is no root *tolerance* to set: CVODE locates roots to `100 U (|t| + |h|)` in time
+    /// (module docs), far tighter than the paper's 1e-10 s.
+    ///
+    /// # Errors
+    /// [`Error::Invalid`] if `directions` does not have `num_roots()` entries of −1, 0, +1;
+    /// [`Error::Sundials`] naming `CVodeSetRootDirection`.
+    pub fn set_root_direction(&mut self, directions: &[i32]) -> Result<(), Error> {
+        let nroots = self.shared.get().nroots;
+        if directions.len() != nroots || directions.iter().any(|d| d.abs() > 1) {
+            return Err(Error::Invalid(format!(
+                "set_root_direction: need {nroots} entries of -1, 0, +1, got {directions:?}"
+            )));
+        }
+        if nroots == 0 {
+            return Ok(());
+        }
+        let mut dirs: Vec<c_int> = directions.to_vec();
+        // SAFETY: memory live; `dirs` holds `nroots` ints, read (copied) by CVODE.
+        let flag = unsafe { CVodeSetRootDirection(self.mem.as_raw(), dirs.as_mut_ptr()) };
+        self.check_cv("CVodeSetRootDirection", flag)
+    }
+
+    /// Solver statistics, cumulative since creation (across `reinit`). `last_order` and
+    /// `last_step` are those of the last step. `linear_solves` counts the problem solver's
+    /// solves (`CVodeGetNumPrecSolves`) for [`NewtonLinear::Problem`], and the Newton
+    /// iterations (one dense back-substitution each) for [`NewtonLinear::DenseDq`];
+    /// `jacobian_evals` counts difference-quotient Jacobians (`CVodeGetNumJacEvals`) or the
+    /// problem setups that recomputed the Jacobian (`CVodeGetNumPrecEvals`).
+    pub fn stats(&self) -> OdeStats {
+        self.current_stats()
+    }
+
+    /// Number of warnings CVODE reported (e.g. `t + h = t`), which are not printed.
+    pub fn warnings(&self) -> u64 {
+        self.shared.get().warnings
+    }
+
+    /// The problem.
+    pub fn problem(&self) -> &P {
+        &self.shared.get().problem
+    }
+
+    /// The problem, writable (e.g. to switch a contact state after an event, then `reinit`).
+    pub fn problem_mut(&mut self) -> &mut P {
+        &mut self.shared.get_mut().problem
+    }
+
+    /// Frees the integrator (in the guide's order) and returns the problem.
+    pub fn into_problem(self) -> P {
+        let Cvode {
+            mem,
+            nls,
+            ls,
+            matrix,
+            y,
+            shared,
+            _context,
+            ..
+        } = self;
+        drop(mem);
+        drop(nls);
+        drop(ls);
+        drop(matrix);
+        drop(y);
+        shared.into_inner().problem
+    }
+
+    /// The failure that poisoned the integrator, if a callback panicked.
+    fn poisoned_failure(&self) -> Option<Failure> {
+        let shared = self.shared.get();
+        shared.poisoned.then(|| {
+            shared.failure.clone().unwrap_or(Failure {
+                callback: "unknown",
+                message: "panicked".into(),
+                time: self.t,
+                fatal: true,
+            })
+        })
+    }
+
+    /// A CVODE counter (0 if CVODE refuses, which it does only without the module the counter
+    /// belongs to — never for the counters read here).
+    fn raw_counter(&self, get: unsafe extern "C" fn(*mut c_void, *mut c_long) -> c_int) -> u64 {
+        let mut value: c_long = 0;
+        // SAFETY: memory live; `value` is a valid out-pointer.
+        let flag = unsafe { get(self.mem.as_raw(), &mut value) };
+        if flag == 0 {
+            u64::try_from(value).unwrap_or(0)
+        } else {
+            0
+        }
+    }
+
+    /// `base` plus CVODE's current counters.
+    fn current_stats(&self) -> OdeStats {
+        let c = |get| self.raw_counter(get);
+        let ls = |get| {
+            if self.ls_counters_stale {
+                0
+            } else {
+                self.raw_counter(get)
+            }
+        };
+        let nni = c(CVodeGetNumNonlinSolvIters);
+        let (rhs_jac, jac, solves) = match self.linear {
+            Linear::None => (0, 0, 0),
+            Linear::DenseDq => (ls(CVodeGetNumLinRhsEvals), ls(CVodeGetNumJacEvals), nni),
+            Linear::Problem => (
+                ls(CVodeGetNumLinRhsEvals),
+                ls(CVodeGetNumPrecEvals),
+                ls(CVodeGetNumPrecSolves),
+            ),
+        };
+        let mut order: c_int = 0;
+        let mut step = 0.0;
+        // SAFETY: memory live; valid out-pointers.
+        unsafe {
+            if CVodeGetLastOrder(self.mem.as_raw(), &mut order) != 0 {
+                order = 0;
+            }
+            if CVodeGetLastStep(self.mem.as_raw(), &mut step) != 0 {
+                step = 0.0;
+            }
+        }
+        let b = &self.base;
+        OdeStats {
+            steps: b.steps + c(CVodeGetNumSteps),
+            rhs_evals: b.rhs_evals + c(CVodeGetNumRhsEvals),
+            rhs_evals_jac: b.rhs_evals_jac + rhs_jac,
+            nonlinear_iterations: b.nonlinear_iterations + nni,
+            nonlinear_conv_failures: b.nonlinear_conv_failures + c(CVodeGetNumNonlinSolvConvFails),
+            error_test_failures: b.error_test_failures + c(CVodeGetNumErrTestFails),
+            linear_setups: b.linear_setups + c(CVodeGetNumLinSolvSetups),
+            jacobian_evals: b.jacobian_evals + jac,
+            linear_solves: b.linear_solves + solves,
+            root_evals: b.root_evals
+                + if self.shared.get().nroots > 0 {
+                    c(CVodeGetNumGEvals)
+                } else {
+                    0
+                },
+            roots_found: self.roots_found,
+            last_order: if order > 0 { order } else { b.last_order },
+            last_step: if step != 0.0 { step } else { b.last_step },
+            stab_lim_order_reductions: b.stab_lim_order_reductions + c(CVodeGetNumStabLimOrderReds),
+        }
+    }
+
+    /// Checks a CVODE return code.
+    fn check_cv(&mut self, function: &'static str, flag: c_int) -> Result<(), Error> {
+        self.check(function, flag, cvode_flag_name)
+    }
+
+    /// Checks a CVLS (linear-solver interface) return code.
+    fn check_ls(&mut self, function: &'static str, flag: c_int) -> Result<(), Error> {
+        self.check(function, flag, cvode_ls_flag_name)
+    }
+
+    fn check(
+        &mut self,
+        function: &'static str,
+        flag: c_int,
+        name: fn(i32) -> String,
+    ) -> Result<(), Error> {
+        let message = self.shared.get_mut().cvode_message.take();
+        if flag >= 0 {
+            return Ok(());
+        }
+        Err(Error::Sundials {
+            function,
+            flag: match message {
+                Some(m) => format!("{} ({m})", name(flag)),
+                None => name(flag),
+            },
+            time: self.t,
+        })
+    }
+}
+
+/// The error for a callback failure.
+fn callback_error(f: Failure, flag: String) -> Error {
+    Error::Callback {
+        callback: f.callback,
+        message: f.message,
+        time: f.time,
+        flag,
+    }
+}
+
+/// Checks a state: finite `t`, `y` of length `n` with finite entries.
+fn check_state(what: &str, t: f64, y: &[f64], n: usize) -> Result<(), Error> {
+    if !t.is_finite() {
+        return Err(Error::Invalid(format!("{what}: t = {t} is not finite")));
+    }
+    if y.len() != n {
+        return Err(Error::Invalid(format!(
+            "{what}: y has {} entries, the problem's dimension is {n}",
+            y.len()
+        )));
+    }
+    if let Some(i) = y.iter().position(|v| !v.is_finite()) {
+        return Err(Error::Invalid(format!(
+            "{what}: y[{i}] = {} is not finite",
+            y[i]
+        )));
+    }
+    Ok(())
+}
+
+/// Checks the problem, initial state and options before any C call.
+fn validate<P: OdeProblem>(problem: &P, t0: f64, y0: &[f64], o: &OdeOptions) -> Result<(), Error> {
+    let n = problem.dim();
+    if n == 0 {
+        return Err(Error::Invalid(
+            "Cvode::new: the problem has dimension 0".into(),
+        ));
+    }
+    check_state("Cvode::new", t0, y0, n)?;
+    let bad = |field: &str, value: String, need: &str| {
+        Err(Error::Invalid(format!(
+            "OdeOptions.{field} = {value}: must be {need}"
+        )))
+    };
+    if !(o.rtol.is_finite() && o.rtol >= 0.0) {
+        return bad("rtol", o.rtol.to_string(), "finite and ≥ 0");
+    }
+    if !(o.atol.is_finite() && o.atol >= 0.0) {
+        return bad("atol", o.atol.to_string(), "finite and ≥ 0");
+    }
+    if o.rtol == 0.0 && o.atol == 0.0 {
+        return bad("rtol", "0 (with atol = 0)".into(), "positive if atol is 0");
+    }
+    let max = match o.method {
+        Method::Bdf => 5,
+        Method::Adams => 12,
+    };
+    if o.max_order == 0 || o.max_order > max {
+        return bad(
+            "max_order",
+            o.max_order.to_string(),
+            &format!("in 1..={max} for {:?}", o.method),
+        );
+    }
+    if o.max_steps == 0 {
+        return bad("max_steps", "0".into(), "≥ 1");
+    }
+    if !(o.max_step.is_finite() && o.max_step >= 0.0) {
+        return bad(
+            "max_step",
+            o.max_step.to_string(),
+            "finite and ≥ 0 (0: no limit)",
+        );
+    }
+    if !(o.init_step.is_finite() && o.init_step >= 0.0) {
+        return bad(
+            "init_step",
+            o.init_step.to_string(),
+            "finite and ≥ 0 (0: estimated)",
+        );
+    }
+    if o.stab_lim_det && o.method != Method::Bdf {
+        return bad("stab_lim_det", "true".into(), "false with Adams (BDF only)");
+    }
+    if o.iteration
+        == (Iteration::Newton {
+            linear: NewtonLinear::Problem,
+        })
+        && !problem.has_newton_solver()
+    {
+        return bad(
+            "iteration",
+            "Newton { linear: Problem }".into(),
+            "DenseDq or Functional: the problem has no Newton solver (has_newton_solver() is false)",
+        );
+    }
+    Ok(())
+}

@@ -1,0 +1,154 @@
+//! The joint operator: pair kinematics from the structure's DOF.
+//!
+//! For `w` joint pairs the sparse operator `B` (3w × n) maps the independent DOF `q` to three
+//! rows per pair, in the order **normal, t1, t2**:
+//!
+//! - normal gap `g = n · (u(upper) − u(lower))` (mm; zero initial clearance, contact when g < 0),
+//! - tangential slips `s1 = t1 · (u(upper) − u(lower))`, `s2 = t2 · (…)` (mm),
+//!
+//! with the pair's orthonormal frame `n, t1, t2` ([`PairFrame`]; for generated sheets `n = +y`,
+//! `t1 = +x`, `t2 = +z`, so the rows are `u_y`, `u_x`, `u_z` differences).
+//!
+//! These are node-to-node quantities at the shell mid-surface nodes, as in the paper's
+//! NASTRAN model (Section 4, "node-to-node contact and friction model"). Pair forces
+//! `p` (N, same row order, positive pulls the upper node along +n/+t1/+t2) return to the structure as
+//! `f = Bᵀ p`. For a reduced model `q = Φ η` the operator [`JointOperator::reduce`] gives the dense
+//! `B Φ` (3w × r) once, so a pseudoforce costs O(w r), never O(n).
+
+use faer::{Mat, MatRef};
+
+use crate::assembly::DofMap;
+use crate::error::Error;
+use crate::joint::PairFrame;
+
+/// Row kinds within a pair's three rows.
+pub const NORMAL: usize = 0;
+/// First tangential row (t1; x for generated sheets).
+pub const T1: usize = 1;
+/// Second tangential row (t2; z for generated sheets).
+pub const T2: usize = 2;
+
+/// Sparse joint operator B in compressed rows.
+#[derive(Clone, Debug)]
+pub struct JointOperator {
+    /// Number of pairs w.
+    pairs: usize,
+    /// Number of independent DOF n.
+    n: usize,
+    row_ptr: Vec<usize>,
+    col_idx: Vec<usize>,
+    values: Vec<f64>,
+}
+
+impl JointOperator {
+    /// Builds B for joint pairs with their frames. Errors if a pair node does not exist or has
+    /// a translation that is not an independent DOF (clamped or without a matrix row).
+    pub fn new(pairs: &[PairFrame], map: &DofMap) -> Result<JointOperator, Error> {
+        let mut row_ptr = vec![0];
+        let mut col_idx = Vec::new();
+        let mut values = Vec::new();
+        for (k, pair) in pairs.iter().enumerate() {
+            for dir in pair.directions() {
+                let mut entries: Vec<(usize, f64)> = Vec::new();
+                for (node, sign) in [(pair.upper, 1.0), (pair.lower, -1.0)] {
+                    let dep = map.nodes.get(node).ok_or_else(|| {
+                        Error::Invalid(format!(
+                            "joint pair {k} names node {node}, which does not exist"
+                        ))
+                    })?;
+                    for (axis, &w) in dir.iter().enumerate() {
+                        if w == 0.0 {
+                            continue;
+                        }
+                        let terms: Vec<(usize, f64)> = dep[axis].terms().collect();
+                        if terms.is_empty() {
+                            return Err(Error::Invalid(format!(
+                                "joint pair {k}: node {node} has no independent {} translation \
+                                 (clamped or not in the matrices); a joint node must move",
+                                ["x", "y", "z"][axis]
+                            )));
+                        }
+                        for (i, c) in terms {
+                            entries.push((i, sign * w * c));
+                        }
+                    }
+                }
+                entries.sort_by_key(|e| e.0);
+                let mut merged: Vec<(usize, f64)> = Vec::new();
+                for (i, c) in entries {
+                    match merged.last_mut() {
+                        Some(last) if last.0 == i => last.1 += c,
+                        _ => merged.push((i, c)),
+                    }
+                }
+                for (i, c) in merged {
+                    if c != 0.0 {
+                        col_idx.push(i);
+                        values.push(c);
+                    }
+                }
+                row_ptr.push(col_idx.len());
+            }
+        }
+        Ok(JointOperator {
+            pairs: pairs.len(),
+            n: map.n,
+            row_ptr,
+            col_idx,
+            values,
+        })
+    }
+
+    /// Number of joint pairs w.
+    pub fn pairs(&self) -> usize {
+        self.pairs
+    }
+
+    /// Number of rows, 3w.
+    pub fn rows(&self) -> usize {
+        3 * self.pairs
+    }
+
+    /// Number of structural DOF n.
+    pub fn dofs(&self) -> usize {
+        self.n
+    }
+
+    /// The (column, value) entries of row `r`.
+    pub fn row(&self, r: usize) -> impl Iterator<Item = (usize, f64)> + '_ {
+        (self.row_ptr[r]..self.row_ptr[r + 1]).map(|p| (self.col_idx[p], self.values[p]))
+    }
+
+    /// `out = B q` (3w values).
+    pub fn apply(&self, q: &[f64], out: &mut [f64]) {
+        for (r, o) in out.iter_mut().enumerate().take(self.rows()) {
+            *o = self.row(r).map(|(c, v)| v * q[c]).sum();
+        }
+    }
+
+    /// `f += Bᵀ p`.
+    pub fn apply_transpose_add(&self, p: &[f64], f: &mut [f64]) {
+        for r in 0..self.rows() {
+            let pr = p[r];
+            if pr != 0.0 {
+                for (c, v) in self.row(r) {
+                    f[c] += v * pr;
+                }
+            }
+        }
+    }
+
+    /// The normal gaps `g = B_n q` of all pairs (w values).
+    pub fn gaps(&self, q: &[f64], out: &mut [f64]) {
+        for (k, o) in out.iter_mut().enumerate().take(self.pairs) {
+            *o = self.row(3 * k + NORMAL).map(|(c, v)| v * q[c]).sum();
+        }
+    }
+
+    /// Dense `B Φ` (3w × r) for a basis Φ (n × r).
+    pub fn reduce(&self, phi: MatRef<'_, f64>) -> Mat<f64> {
+        Mat::from_fn(self.rows(), phi.ncols(), |r, j| {
+            self.row(r).map(|(c, v)| v * phi[(c, j)]).sum()
+        })
+    }
+}

@@ -1,0 +1,13 @@
+//! Linear algebra under everything else: symmetric sparse storage and products ([`sparse`]), the
+//! sparse SPD Cholesky factorization ([`cholesky`]), compensated double-double arithmetic for the
+//! ill-conditioned shell stiffness ([`compensated`]) and the generalized symmetric eigenproblem
+//! ([`eigen`]). Depends on nothing of jointrom but its error type.
+
+pub mod cholesky;
+pub mod compensated;
+pub mod eigen;
+pub mod sparse;
+
+pub use cholesky::{solve_spd, SparseCholesky};
+pub use eigen::{dense_modes, lowest_modes, Modes};
+pub use sparse::SymCsc;

@@ -1,0 +1,135 @@
+//! The discretised structure: nodes, `Shell4` sheets, `Beam2` weld spots, clamps, the rigid tie
+//! to the master node, and the joint node pairs. Built from a validated [`crate::case::Case`] by
+//! [`crate::case::Case::build_mesh`].
+//!
+//! Axes: x along the length, y normal to the sheets, z across the width (mm).
+
+use crate::case::Case;
+use crate::error::Error;
+
+mod build;
+
+/// A 4-node shell on a sheet's mid-surface. Nodes run counter-clockwise in the (x, z) plane:
+/// `(i, k), (i+1, k), (i+1, k+1), (i, k+1)` of the sheet's grid.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ShellElem {
+    /// Node indices into [`Mesh::nodes`].
+    pub nodes: [usize; 4],
+    /// Shell thickness, mm.
+    pub thickness: f64,
+    /// Index of the sheet (into [`Mesh::sheets`]).
+    pub sheet: usize,
+}
+
+/// A 2-node weld beam with a circular section.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BeamElem {
+    /// Node indices into [`Mesh::nodes`] (lower sheet first).
+    pub nodes: [usize; 2],
+    /// Section diameter, mm.
+    pub diameter: f64,
+}
+
+/// Rigid-body tie (NASTRAN RBE2, all 6 DOF): every slave node moves as
+/// `u_s = u_m + θ_m × (x_s − x_m)`, `θ_s = θ_m`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RigidTie {
+    /// The master node (index into [`Mesh::nodes`]); it belongs to no sheet.
+    pub master: usize,
+    /// The tied nodes, in increasing order.
+    pub slaves: Vec<usize>,
+}
+
+/// A node-to-node joint pair: the gap is `g = u_y(upper) − u_y(lower)`, zero initial clearance.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct JointPair {
+    /// Node on the lower sheet (smaller y).
+    pub lower: usize,
+    /// Node on the upper sheet (larger y), coincident in (x, z).
+    pub upper: usize,
+}
+
+/// Summary of one sheet's node grid: node `(i, k)` (i along x, k along z) has index
+/// `first_node + i * (elements[1] + 1) + k`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SheetGrid {
+    /// Name from the case file.
+    pub name: String,
+    /// Index of the sheet's first node.
+    pub first_node: usize,
+    /// Elements along x and along z.
+    pub elements: [usize; 2],
+}
+
+/// The whole discretised structure.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Mesh {
+    /// Node coordinates (x, y, z), mm. Sheet nodes first (sheet by sheet), the master node last.
+    pub nodes: Vec<[f64; 3]>,
+    /// The sheets' node grids, in case-file order.
+    pub sheets: Vec<SheetGrid>,
+    /// Shell elements.
+    pub shells: Vec<ShellElem>,
+    /// Weld beams.
+    pub beams: Vec<BeamElem>,
+    /// Nodes with all 6 DOF clamped, in increasing order.
+    pub clamped: Vec<usize>,
+    /// The rigid tie to the master node.
+    pub tie: RigidTie,
+    /// Joint pairs, interface by interface in case-file order, within an interface sorted by
+    /// (x, z).
+    pub pairs: Vec<JointPair>,
+    /// Material of all sheets and welds.
+    pub material: Material,
+}
+
+/// Linear elastic isotropic material.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Material {
+    /// Young's modulus E, N/mm².
+    pub youngs_modulus: f64,
+    /// Poisson's ratio ν, dimensionless.
+    pub poisson_ratio: f64,
+    /// Mass density ρ, t/mm³.
+    pub density: f64,
+}
+
+impl Material {
+    /// Structural steel as used in the paper: E = 210000 N/mm², ν = 0.3, ρ = 7.85e-9 t/mm³.
+    pub const STEEL: Material = Material {
+        youngs_modulus: 210_000.0,
+        poisson_ratio: 0.3,
+        density: 7.85e-9,
+    };
+
+    /// Shear modulus G = E / (2 (1 + ν)), N/mm².
+    pub fn shear_modulus(&self) -> f64 {
+        self.youngs_modulus / (2.0 * (1.0 + self.poisson_ratio))
+    }
+
+    /// Checks E > 0, -1 < ν < 0.5, ρ > 0.
+    pub fn validate(&self) -> Result<(), Error> {
+        let ok = self.youngs_modulus.is_finite()
+            && self.youngs_modulus > 0.0
+            && self.poisson_ratio > -1.0
+            && self.poisson_ratio < 0.5
+            && self.density.is_finite()
+            && self.density > 0.0;
+        if ok {
+            Ok(())
+        } else {
+            Err(Error::Element(format!(
+                "invalid material: E = {} N/mm², nu = {}, rho = {} t/mm³ (need E > 0, -1 < nu < 0.5, rho > 0)",
+                self.youngs_modulus, self.poisson_ratio, self.density
+            )))
+        }
+    }
+}
+
+impl Mesh {
+    /// Validates a case and generates its mesh (see the numbering in [`crate::case`]). Errors are
+    /// those of [`Case::from_json_str`], labelled with [`Case::source`].
+    pub fn from_case(case: &Case) -> Result<Mesh, Error> {
+        build::build(case)
+    }
+}

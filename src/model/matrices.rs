@@ -1,0 +1,875 @@
+//! Users' own models: K and M as MatrixMarket files plus a JSON map, read into a [`Model`] that
+//! the whole pipeline (bases, statics, transient runs, reports, exports) accepts.
+//!
+//! NASTRAN (DMAP `OUTPUT4`/pyNastran), Abaqus (`*MATRIX GENERATE`) and ANSYS (`HBMAT`/APDL Math)
+//! all export stiffness and mass matrices; converted to MatrixMarket (`%%MatrixMarket matrix
+//! coordinate real symmetric|general`, 1-based indices) they are read here with `sprs`. The map
+//! says what the rows mean. Any command that takes a CASE takes the map's path instead:
+//!
+//! ```text
+//! jointrom export-matrices friction_bar --out fb/      # K.mtx, M.mtx, model.json
+//! jointrom run fb/model.json                           # the main job on the matrices
+//! ```
+//!
+//! ## The map (`"schema": "jointrom-matrices"`, `"version": 1`)
+//!
+//! | field | type | meaning |
+//! |---|---|---|
+//! | `schema`, `version` | string, integer | `"jointrom-matrices"`, `1` |
+//! | `name` | string | model name (reports, output folders) |
+//! | `description` | string, optional | free text |
+//! | `stiffness`, `mass` | string | MatrixMarket files, relative to the map's folder; K in N/mm (N·mm/rad), M in t (t·mm²) |
+//! | `nodes` | array | `{ "id": u64, "xyz": [x, y, z] (mm), "rows": [ux, uy, uz, rx, ry, rz] }`; each entry a 1-based matrix row or `null` (no row: fixed, or not modelled) |
+//! | `master_node` | u64 | the load-introduction node; its 6 rows are the Craig–Bampton boundary and the output DOF |
+//! | `rigid_followers` | array of u64, optional | nodes tied rigidly (RBE2) to the master node; no rows of their own; shown in VTU as `u_m + θ_m × (x − x_m)` |
+//! | `fixed_rows` | array of rows, optional | rows removed from K and M before use (SPC'd DOF left in the export) |
+//! | `pair_frame` | object, optional | default `{ "normal", "t1", "t2" }` unit vectors for pairs that give none |
+//! | `pairs` | array | `{ "lower": id, "upper": id, "normal"?, "t1"?, "t2"? }`: node-to-node contact pairs, zero initial clearance, the normal pointing from lower to upper; `n, t1, t2` orthonormal |
+//! | `cells` | array, optional | display cells `{ "type": "quad4" \| "line2", "nodes": [ids], "group"?: i32, "size"?: mm }` |
+//! | `load` | object | as in a case file: `master` (`fx, fy, fz` N, `mx, my, mz` N·mm) and `ramp` |
+//! | `contact` | object | as in a case file: `normal_stiffness`, `friction_coefficient`, `stick_stiffness` |
+//! | `end_time` | number | simulated span, s |
+//!
+//! Rows that no node names stay in the model as internal DOF (e.g. scalar points). The kept
+//! rows are renumbered in ascending order with the master node's six moved last (the convention
+//! of [`Model`]); K and M are stored on the union of their patterns.
+//!
+//! ## Checks (each error names the file and the field, row or entry)
+//! Unknown fields, wrong schema or version, unreadable or non-real MatrixMarket, non-square or
+//! mismatched sizes, non-finite or non-symmetric entries (|a_ij − a_ji| > 1e-12 max|a|), a
+//! non-positive diagonal (a DOF without stiffness or mass), duplicate node ids, a row named
+//! twice, out of range or both named and fixed, a master node without six rows, a pair naming an
+//! unknown node or without translation rows along its frame, a frame that is not orthonormal
+//! (tolerance 1e-6), cells with unknown nodes; the contact law, load and end time as in a case.
+//! An indefinite K (unsupported structure) is reported by the first factorization.
+//!
+//! [`write`] goes the other way: any model to `K.mtx`, `M.mtx` (symmetric, shortest round-trip
+//! decimal, so the numbers come back bit for bit) and `model.json`. `tests/matrices.rs` exports
+//! the friction bar, reads it back and gets identical matrices, bases, statics and transients.
+
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+use crate::assembly::{DofDep, DofMap};
+use crate::case::{ContactSpec, LoadSpec};
+use crate::error::Error;
+use crate::joint::JointOperator;
+use crate::joint::PairFrame;
+use crate::linalg::SymCsc;
+use crate::model::{Cell, CellNodes, Geometry, Model, Origin};
+
+/// The map's `schema` value.
+pub const SCHEMA: &str = "jointrom-matrices";
+/// The map version this build reads and writes.
+pub const VERSION: u32 = 1;
+/// Tolerance of the symmetry check, relative to the largest entry.
+pub const SYMMETRY_TOLERANCE: f64 = 1e-12;
+/// Tolerance of the orthonormality check of pair frames.
+pub const FRAME_TOLERANCE: f64 = 1e-6;
+
+/// The JSON map (see the module docs for every field).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MatrixMap {
+    /// Always [`SCHEMA`].
+    pub schema: String,
+    /// Always [`VERSION`].
+    pub version: u32,
+    /// Model name.
+    pub name: String,
+    /// Free text.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub description: Option<String>,
+    /// Stiffness file (MatrixMarket), relative to the map's folder; N/mm, N·mm/rad.
+    pub stiffness: String,
+    /// Mass file (MatrixMarket), relative to the map's folder; t, t·mm².
+    pub mass: String,
+    /// Nodes with coordinates and rows.
+    pub nodes: Vec<MapNode>,
+    /// The master (load-introduction) node's id.
+    pub master_node: u64,
+    /// Nodes tied rigidly to the master node (display only; no rows).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub rigid_followers: Vec<u64>,
+    /// 1-based rows removed before use.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub fixed_rows: Vec<usize>,
+    /// Default pair frame.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pair_frame: Option<FrameSpec>,
+    /// Joint pairs.
+    pub pairs: Vec<MapPair>,
+    /// Display cells.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub cells: Vec<MapCell>,
+    /// Master load and ramp (as in a case file).
+    pub load: LoadSpec,
+    /// Contact and friction law (as in a case file).
+    pub contact: ContactSpec,
+    /// Simulated span, s.
+    pub end_time: f64,
+}
+
+/// A node of the map.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MapNode {
+    /// The user's node id (unique).
+    pub id: u64,
+    /// Coordinates, mm.
+    pub xyz: [f64; 3],
+    /// 1-based matrix rows of `[ux, uy, uz, rx, ry, rz]`, `null` for none.
+    pub rows: [Option<usize>; 6],
+}
+
+/// An orthonormal pair frame.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FrameSpec {
+    /// Unit normal, from the lower to the upper surface.
+    pub normal: [f64; 3],
+    /// First unit tangent.
+    pub t1: [f64; 3],
+    /// Second unit tangent.
+    pub t2: [f64; 3],
+}
+
+/// A joint pair of the map.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MapPair {
+    /// Lower node id.
+    pub lower: u64,
+    /// Upper node id.
+    pub upper: u64,
+    /// Unit normal (default: `pair_frame.normal`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub normal: Option<[f64; 3]>,
+    /// First tangent (default: `pair_frame.t1`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub t1: Option<[f64; 3]>,
+    /// Second tangent (default: `pair_frame.t2`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub t2: Option<[f64; 3]>,
+}
+
+/// Display cell kinds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum MapCellKind {
+    /// 4-node quadrilateral.
+    Quad4,
+    /// 2-node line.
+    Line2,
+}
+
+/// A display cell of the map.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MapCell {
+    /// Cell kind.
+    #[serde(rename = "type")]
+    pub kind: MapCellKind,
+    /// Node ids (4 or 2).
+    pub nodes: Vec<u64>,
+    /// Group (e.g. property id), −1 for none.
+    #[serde(default = "no_group")]
+    pub group: i32,
+    /// Thickness or diameter, mm (0 where unknown).
+    #[serde(default)]
+    pub size: f64,
+}
+
+fn no_group() -> i32 {
+    -1
+}
+
+/// `Some(path)` if `arg` is an existing file whose top-level `schema` is [`SCHEMA`]; `None` for
+/// anything else (a case file, a built-in name), which the case loader then reports on.
+pub fn map_file(arg: &str) -> Result<Option<PathBuf>, Error> {
+    #[derive(Deserialize)]
+    struct Peek {
+        schema: Option<String>,
+    }
+    let path = Path::new(arg);
+    if !path.is_file() {
+        return Ok(None);
+    }
+    let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
+        file: path.to_path_buf(),
+        source,
+    })?;
+    if !text.contains(SCHEMA) {
+        return Ok(None);
+    }
+    Ok(match serde_json::from_str::<Peek>(&text) {
+        Ok(Peek {
+            schema: Some(s), ..
+        }) if s == SCHEMA => Some(path.to_path_buf()),
+        _ => None,
+    })
+}
+
+fn field_err(file: &str, path: impl Into<String>, reason: impl Into<String>) -> Error {
+    Error::Case {
+        file: file.to_string(),
+        path: path.into(),
+        reason: reason.into(),
+    }
+}
+
+/// One stored entry (row, column, value), 0-based.
+type Triplet = (usize, usize, f64);
+
+/// Reads a MatrixMarket file into (size, triplets as (row, col, value), 0-based), checking
+/// square, finite and symmetric.
+fn read_mtx(path: &Path) -> Result<(usize, Vec<Triplet>), Error> {
+    let file = path.display().to_string();
+    if !path.is_file() {
+        return Err(Error::Io {
+            file: path.to_path_buf(),
+            source: std::io::Error::new(std::io::ErrorKind::NotFound, "no such file"),
+        });
+    }
+    let tri: sprs::TriMat<f64> = sprs::io::read_matrix_market(path).map_err(|e| match e {
+        sprs::io::IoError::Io(source) => Error::Io {
+            file: path.to_path_buf(),
+            source,
+        },
+        other => field_err(
+            &file,
+            "$",
+            format!(
+                "not a readable MatrixMarket `coordinate real` matrix ({other}); expected a \
+                 header `%%MatrixMarket matrix coordinate real symmetric|general`, a size line \
+                 `rows cols entries` and lines `row col value` with 1-based indices"
+            ),
+        ),
+    })?;
+    let (rows, cols) = tri.shape();
+    if rows != cols {
+        return Err(field_err(
+            &file,
+            "size",
+            format!("the matrix is {rows} × {cols}; K and M must be square"),
+        ));
+    }
+    let csc: sprs::CsMat<f64> = tri.to_csc();
+    let mut out = Vec::with_capacity(csc.nnz());
+    let mut max = 0.0f64;
+    for (&v, (i, j)) in csc.iter() {
+        if !v.is_finite() {
+            return Err(field_err(
+                &file,
+                format!("entry ({}, {})", i + 1, j + 1),
+                format!("not a finite number: {v}"),
+            ));
+        }
+        max = max.max(v.abs());
+        out.push((i, j, v));
+    }
+    let tol = SYMMETRY_TOLERANCE * max;
+    for &(i, j, v) in &out {
+        if i != j {
+            let t = csc.get(j, i).copied().unwrap_or(0.0);
+            if (v - t).abs() > tol {
+                return Err(field_err(
+                    &file,
+                    format!("entry ({}, {})", i + 1, j + 1),
+                    format!(
+                        "the matrix is not symmetric: a({0}, {1}) = {v:e} but a({1}, {0}) = {t:e}",
+                        i + 1,
+                        j + 1
+                    ),
+                ));
+            }
+        }
+    }
+    Ok((rows, out))
+}
+
+fn frame_check(file: &str, path: &str, f: &FrameSpec) -> Result<(), Error> {
+    let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    for (name, v) in [("normal", f.normal), ("t1", f.t1), ("t2", f.t2)] {
+        if v.iter().any(|x| !x.is_finite()) || (dot(v, v).sqrt() - 1.0).abs() > FRAME_TOLERANCE {
+            return Err(field_err(
+                file,
+                format!("{path}.{name}"),
+                format!("must be a unit vector, got {v:?}"),
+            ));
+        }
+    }
+    for (a, b, va, vb) in [
+        ("normal", "t1", f.normal, f.t1),
+        ("normal", "t2", f.normal, f.t2),
+        ("t1", "t2", f.t1, f.t2),
+    ] {
+        if dot(va, vb).abs() > FRAME_TOLERANCE {
+            return Err(field_err(
+                file,
+                format!("{path}.{b}"),
+                format!(
+                    "{a} and {b} must be orthogonal, their dot product is {:e}",
+                    dot(va, vb)
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Reads a map and its matrices into a [`Model`] (see the module docs).
+pub fn load(map_path: &Path) -> Result<Model, Error> {
+    let file = map_path.display().to_string();
+    let text = std::fs::read_to_string(map_path).map_err(|source| Error::Io {
+        file: map_path.to_path_buf(),
+        source,
+    })?;
+    let map: MatrixMap = crate::case::parse_object(&text, &file, "a matrix map")?;
+    if map.schema != SCHEMA {
+        return Err(field_err(
+            &file,
+            "schema",
+            format!("must be \"{SCHEMA}\", got \"{}\"", map.schema),
+        ));
+    }
+    if map.version != VERSION {
+        return Err(field_err(
+            &file,
+            "version",
+            format!("this build reads version {VERSION}, got {}", map.version),
+        ));
+    }
+    if map.name.trim().is_empty() {
+        return Err(field_err(&file, "name", "must not be empty"));
+    }
+    crate::case::check_contact_load(&map.contact, &map.load, map.end_time, &file)?;
+    let dir = map_path.parent().unwrap_or(Path::new("."));
+    let k_path = dir.join(&map.stiffness);
+    let m_path = dir.join(&map.mass);
+    let (nk, k_trip) = read_mtx(&k_path)?;
+    let (nm, m_trip) = read_mtx(&m_path)?;
+    if nk != nm {
+        return Err(field_err(
+            &file,
+            "mass",
+            format!("M is {nm} × {nm} but K is {nk} × {nk}"),
+        ));
+    }
+    let rows = nk;
+
+    // Nodes and rows.
+    let mut index_of: HashMap<u64, usize> = HashMap::with_capacity(map.nodes.len());
+    let mut owner: Vec<Option<(usize, usize)>> = vec![None; rows];
+    let mut fixed = vec![false; rows];
+    for (k, &r) in map.fixed_rows.iter().enumerate() {
+        if r == 0 || r > rows {
+            return Err(field_err(
+                &file,
+                format!("fixed_rows[{k}]"),
+                format!("row {r} is outside 1..={rows}"),
+            ));
+        }
+        if std::mem::replace(&mut fixed[r - 1], true) {
+            return Err(field_err(
+                &file,
+                format!("fixed_rows[{k}]"),
+                format!("row {r} is listed twice"),
+            ));
+        }
+    }
+    for (i, node) in map.nodes.iter().enumerate() {
+        if index_of.insert(node.id, i).is_some() {
+            return Err(field_err(
+                &file,
+                format!("nodes[{i}].id"),
+                format!("node id {} is used twice", node.id),
+            ));
+        }
+        if node.xyz.iter().any(|x| !x.is_finite()) {
+            return Err(field_err(
+                &file,
+                format!("nodes[{i}].xyz"),
+                "coordinates must be finite numbers",
+            ));
+        }
+        for (c, r) in node.rows.iter().enumerate() {
+            let Some(r) = *r else { continue };
+            let path = format!("nodes[{i}].rows[{c}]");
+            if r == 0 || r > rows {
+                return Err(field_err(
+                    &file,
+                    path,
+                    format!("row {r} is outside 1..={rows} (K and M are {rows} × {rows})"),
+                ));
+            }
+            if fixed[r - 1] {
+                return Err(field_err(
+                    &file,
+                    path,
+                    format!("row {r} is also in fixed_rows"),
+                ));
+            }
+            if let Some((j, d)) = owner[r - 1] {
+                return Err(field_err(
+                    &file,
+                    path,
+                    format!("row {r} is already nodes[{j}].rows[{d}]"),
+                ));
+            }
+            owner[r - 1] = Some((i, c));
+        }
+    }
+    let node = |id: u64, path: &str| -> Result<usize, Error> {
+        index_of
+            .get(&id)
+            .copied()
+            .ok_or_else(|| field_err(&file, path, format!("no node has id {id}")))
+    };
+    let master_node = node(map.master_node, "master_node")?;
+    let mut master_rows = [0usize; 6];
+    for (c, r) in map.nodes[master_node].rows.iter().enumerate() {
+        master_rows[c] = r.ok_or_else(|| {
+            field_err(
+                &file,
+                "master_node",
+                format!(
+                    "node {} has no row for {}; the master node needs all six DOF \
+                     (ux, uy, uz, rx, ry, rz) in the matrices",
+                    map.master_node,
+                    ["ux", "uy", "uz", "rx", "ry", "rz"][c]
+                ),
+            )
+        })? - 1;
+    }
+
+    // Renumbering: kept rows ascending, the master's six last.
+    let mut is_master = vec![false; rows];
+    for &r in &master_rows {
+        is_master[r] = true;
+    }
+    let mut new_index: Vec<Option<usize>> = vec![None; rows];
+    let mut next = 0;
+    for r in 0..rows {
+        if !fixed[r] && !is_master[r] {
+            new_index[r] = Some(next);
+            next += 1;
+        }
+    }
+    let n = next + 6;
+    for (c, &r) in master_rows.iter().enumerate() {
+        new_index[r] = Some(next + c);
+    }
+    if n <= 6 {
+        return Err(field_err(
+            &file,
+            "nodes",
+            format!("the model has {n} DOF; it needs DOF besides the master node's six"),
+        ));
+    }
+    let master = [0, 1, 2, 3, 4, 5].map(|c| next + c);
+    let (stiffness, mass) = union_pattern(n, &new_index, &k_trip, &m_trip);
+    for (name, a, path) in [("K", &stiffness, &k_path), ("M", &mass, &m_path)] {
+        for (r, idx) in new_index.iter().enumerate() {
+            let Some(j) = *idx else { continue };
+            let d = a.get(j, j);
+            if d.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+                return Err(field_err(
+                    &path.display().to_string(),
+                    format!("entry ({0}, {0})", r + 1),
+                    format!(
+                        "{name} has diagonal {d:e} at row {}: every kept DOF needs positive \
+                         stiffness and mass (unsupported DOF? put it in fixed_rows)",
+                        r + 1
+                    ),
+                ));
+            }
+        }
+    }
+
+    // DOF map: own rows, rigid followers, fixed.
+    let mut nodes_dep: Vec<[DofDep; 6]> = map
+        .nodes
+        .iter()
+        .map(|nd| {
+            nd.rows.map(|r| match r {
+                Some(r) => DofDep::single(new_index[r - 1].expect("named rows are kept")),
+                None => DofDep::FIXED,
+            })
+        })
+        .collect();
+    let mut followers = Vec::with_capacity(map.rigid_followers.len());
+    let xm = map.nodes[master_node].xyz;
+    for (k, &id) in map.rigid_followers.iter().enumerate() {
+        let path = format!("rigid_followers[{k}]");
+        let i = node(id, &path)?;
+        if i == master_node || map.nodes[i].rows.iter().any(Option::is_some) {
+            return Err(field_err(
+                &file,
+                path,
+                format!(
+                    "node {id} has rows of its own (or is the master); a rigid follower has none"
+                ),
+            ));
+        }
+        let xs = map.nodes[i].xyz;
+        nodes_dep[i] =
+            DofDep::rigid_follower(master, [xs[0] - xm[0], xs[1] - xm[1], xs[2] - xm[2]]);
+        followers.push(i);
+    }
+    let dof_map = DofMap {
+        nodes: nodes_dep,
+        n,
+        master,
+    };
+
+    // Pairs.
+    if map.pairs.is_empty() {
+        return Err(field_err(
+            &file,
+            "pairs",
+            "no joint pairs: the model needs at least one",
+        ));
+    }
+    if let Some(f) = &map.pair_frame {
+        frame_check(&file, "pair_frame", f)?;
+    }
+    let mut pairs = Vec::with_capacity(map.pairs.len());
+    for (k, p) in map.pairs.iter().enumerate() {
+        let path = format!("pairs[{k}]");
+        let lower = node(p.lower, &format!("{path}.lower"))?;
+        let upper = node(p.upper, &format!("{path}.upper"))?;
+        if lower == upper {
+            return Err(field_err(&file, path, "lower and upper are the same node"));
+        }
+        let default = map.pair_frame;
+        let pick = |own: Option<[f64; 3]>, d: Option<[f64; 3]>, name: &str| {
+            own.or(d).ok_or_else(|| {
+                field_err(
+                    &file,
+                    format!("{path}.{name}"),
+                    "missing, and the map has no `pair_frame` default",
+                )
+            })
+        };
+        let frame = FrameSpec {
+            normal: pick(p.normal, default.map(|f| f.normal), "normal")?,
+            t1: pick(p.t1, default.map(|f| f.t1), "t1")?,
+            t2: pick(p.t2, default.map(|f| f.t2), "t2")?,
+        };
+        if p.normal.is_some() || p.t1.is_some() || p.t2.is_some() {
+            frame_check(&file, &path, &frame)?;
+        }
+        for (which, i, id) in [("lower", lower, p.lower), ("upper", upper, p.upper)] {
+            for (axis, _) in [frame.normal, frame.t1, frame.t2]
+                .iter()
+                .flat_map(|d| d.iter().enumerate())
+                .filter(|(_, w)| **w != 0.0)
+            {
+                if dof_map.nodes[i][axis].terms().next().is_none() {
+                    return Err(field_err(
+                        &file,
+                        format!("{path}.{which}"),
+                        format!(
+                            "node {id} has no row for u{}; a joint node must move along its \
+                             pair frame",
+                            ["x", "y", "z"][axis]
+                        ),
+                    ));
+                }
+            }
+        }
+        pairs.push(PairFrame {
+            lower,
+            upper,
+            normal: frame.normal,
+            t1: frame.t1,
+            t2: frame.t2,
+        });
+    }
+    let joint = JointOperator::new(&pairs, &dof_map)?;
+
+    // Display cells.
+    let mut cells = Vec::with_capacity(map.cells.len());
+    for (k, c) in map.cells.iter().enumerate() {
+        let path = format!("cells[{k}].nodes");
+        let want = match c.kind {
+            MapCellKind::Quad4 => 4,
+            MapCellKind::Line2 => 2,
+        };
+        if c.nodes.len() != want {
+            return Err(field_err(
+                &file,
+                path,
+                format!(
+                    "a {:?} cell has {want} nodes, got {}",
+                    c.kind,
+                    c.nodes.len()
+                ),
+            ));
+        }
+        let idx: Vec<usize> = c
+            .nodes
+            .iter()
+            .map(|&id| node(id, &path))
+            .collect::<Result<_, _>>()?;
+        if !c.size.is_finite() || c.size < 0.0 {
+            return Err(field_err(
+                &file,
+                format!("cells[{k}].size"),
+                format!("must be finite and ≥ 0 mm, got {}", c.size),
+            ));
+        }
+        cells.push(Cell {
+            nodes: match c.kind {
+                MapCellKind::Quad4 => CellNodes::Quad4([idx[0], idx[1], idx[2], idx[3]]),
+                MapCellKind::Line2 => CellNodes::Line2([idx[0], idx[1]]),
+            },
+            group: c.group,
+            size: c.size,
+        });
+    }
+    let geometry = Geometry {
+        nodes: map.nodes.iter().map(|nd| nd.xyz).collect(),
+        node_ids: map.nodes.iter().map(|nd| nd.id).collect(),
+        cells,
+        followers,
+    };
+    Ok(Model {
+        name: map.name,
+        source: file,
+        origin: Origin::Matrices {
+            map: map_path.to_path_buf(),
+            stiffness: k_path,
+            mass: m_path,
+        },
+        geometry,
+        pairs,
+        dof_map,
+        stiffness,
+        mass,
+        joint,
+        load: map.load,
+        contact: map.contact,
+        end_time: map.end_time,
+    })
+}
+
+/// K and M renumbered by `new_index` (dropped rows: `None`) on the union of their patterns
+/// (both triangles, rows sorted), so both share one symbolic structure.
+fn union_pattern(
+    n: usize,
+    new_index: &[Option<usize>],
+    k: &[Triplet],
+    m: &[Triplet],
+) -> (SymCsc, SymCsc) {
+    // Per new column: (new row, K value, M value).
+    let mut cols: Vec<Vec<(usize, f64, f64)>> = vec![Vec::new(); n];
+    for (trip, is_k) in [(k, true), (m, false)] {
+        for &(i, j, v) in trip {
+            if let (Some(ni), Some(nj)) = (new_index[i], new_index[j]) {
+                cols[nj].push(if is_k { (ni, v, 0.0) } else { (ni, 0.0, v) });
+            }
+        }
+    }
+    let mut col_ptr = Vec::with_capacity(n + 1);
+    col_ptr.push(0);
+    let mut row_idx = Vec::new();
+    let mut kv = Vec::new();
+    let mut mv = Vec::new();
+    for c in &mut cols {
+        c.sort_by_key(|e| e.0);
+        let mut last = usize::MAX;
+        for &(r, a, b) in c.iter() {
+            if r == last {
+                *kv.last_mut().expect("an entry") += a;
+                *mv.last_mut().expect("an entry") += b;
+            } else {
+                row_idx.push(r);
+                kv.push(a);
+                mv.push(b);
+                last = r;
+            }
+        }
+        col_ptr.push(row_idx.len());
+    }
+    (
+        SymCsc {
+            n,
+            col_ptr: col_ptr.clone(),
+            row_idx: row_idx.clone(),
+            values: kv,
+        },
+        SymCsc {
+            n,
+            col_ptr,
+            row_idx,
+            values: mv,
+        },
+    )
+}
+
+/// Writes any model as `K.mtx`, `M.mtx` and `model.json` in `dir` (created if missing): node
+/// ids and coordinates, the rows of each node DOF, master node, rigid followers, pairs with
+/// their frames, cells, load, contact law and end time. Returns the three paths.
+pub fn write(model: &Model, dir: &Path) -> Result<Vec<PathBuf>, Error> {
+    let io = |file: &Path| {
+        let file = file.to_path_buf();
+        move |source| Error::Io { file, source }
+    };
+    std::fs::create_dir_all(dir).map_err(io(dir))?;
+    let k_path = dir.join("K.mtx");
+    let m_path = dir.join("M.mtx");
+    let map_path = dir.join("model.json");
+    for (a, path) in [(&model.stiffness, &k_path), (&model.mass, &m_path)] {
+        sprs::io::write_matrix_market_sym(path, &a.to_sprs(), sprs::io::SymmetryMode::Symmetric)
+            .map_err(io(path))?;
+    }
+    let geo = &model.geometry;
+    let mut follower = vec![false; geo.nodes.len()];
+    for &f in &geo.followers {
+        follower[f] = true;
+    }
+    let mut nodes = Vec::with_capacity(geo.nodes.len());
+    for (i, x) in geo.nodes.iter().enumerate() {
+        let mut rows = [None; 6];
+        if !follower[i] {
+            for (c, dep) in model.dof_map.nodes[i].iter().enumerate() {
+                rows[c] = match (dep.as_free(), dep.terms().count()) {
+                    (Some(r), _) => Some(r + 1),
+                    (None, 0) => None,
+                    (None, _) => {
+                        return Err(Error::Invalid(format!(
+                            "export-matrices: node {} DOF {c} depends on several DOF but is not \
+                             a rigid follower of the master node; the map cannot express it",
+                            geo.node_ids[i]
+                        )))
+                    }
+                };
+            }
+        }
+        nodes.push(MapNode {
+            id: geo.node_ids[i],
+            xyz: *x,
+            rows,
+        });
+    }
+    let master = model.master_dofs();
+    let master_node = (0..geo.nodes.len())
+        .find(|&i| {
+            !follower[i] && (0..6).all(|c| model.dof_map.nodes[i][c].as_free() == Some(master[c]))
+        })
+        .ok_or_else(|| {
+            Error::Invalid("export-matrices: no node owns the six master DOF".to_string())
+        })?;
+    let cells = geo
+        .cells
+        .iter()
+        .map(|c| MapCell {
+            kind: match c.nodes {
+                CellNodes::Quad4(_) => MapCellKind::Quad4,
+                CellNodes::Line2(_) => MapCellKind::Line2,
+            },
+            nodes: c
+                .nodes
+                .as_slice()
+                .iter()
+                .map(|&i| geo.node_ids[i])
+                .collect(),
+            group: c.group,
+            size: c.size,
+        })
+        .collect();
+    let map = MatrixMap {
+        schema: SCHEMA.to_string(),
+        version: VERSION,
+        name: model.name.clone(),
+        description: Some(format!(
+            "exported by jointrom {} from {}",
+            env!("CARGO_PKG_VERSION"),
+            model.source
+        )),
+        stiffness: "K.mtx".to_string(),
+        mass: "M.mtx".to_string(),
+        nodes,
+        master_node: geo.node_ids[master_node],
+        rigid_followers: geo.followers.iter().map(|&i| geo.node_ids[i]).collect(),
+        fixed_rows: Vec::new(),
+        pair_frame: None,
+        pairs: model
+            .pairs
+            .iter()
+            .map(|p| MapPair {
+                lower: geo.node_ids[p.lower],
+                upper: geo.node_ids[p.upper],
+                normal: Some(p.normal),
+                t1: Some(p.t1),
+                t2: Some(p.t2),
+            })
+            .collect(),
+        cells,
+        load: model.load,
+        contact: model.contact,
+        end_time: model.end_time,
+    };
+    std::fs::write(&map_path, map_text(&map)).map_err(io(&map_path))?;
+    Ok(vec![k_path, m_path, map_path])
+}
+
+/// The map as JSON text a person can read: the scalar fields first, then one node, pair or
+/// cell per line.
+fn map_text(map: &MatrixMap) -> String {
+    const ORDER: [&str; 16] = [
+        "schema",
+        "version",
+        "name",
+        "description",
+        "stiffness",
+        "mass",
+        "master_node",
+        "rigid_followers",
+        "fixed_rows",
+        "pair_frame",
+        "load",
+        "contact",
+        "end_time",
+        "nodes",
+        "pairs",
+        "cells",
+    ];
+    let value = serde_json::to_value(map).expect("the map serialises");
+    let compact = |v: &serde_json::Value| serde_json::to_string(v).expect("JSON serialises");
+    let obj = value.as_object().expect("the map is an object");
+    let mut keys: Vec<&str> = ORDER
+        .iter()
+        .copied()
+        .filter(|k| obj.contains_key(*k))
+        .collect();
+    keys.extend(
+        obj.keys()
+            .map(String::as_str)
+            .filter(|k| !ORDER.contains(k)),
+    );
+    let mut out = String::from("{\n");
+    for (i, key) in keys.iter().enumerate() {
+        let v = &obj[*key];
+        out += &format!("  \"{key}\": ");
+        match v.as_array() {
+            Some(items) if !items.is_empty() && items[0].is_object() => {
+                out += "[\n";
+                for (j, item) in items.iter().enumerate() {
+                    out += "    ";
+                    out += &compact(item);
+                    out += if j + 1 < items.len() { ",\n" } else { "\n" };
+                }
+                out += "  ]";
+            }
+            _ => out += &compact(v),
+        }
+        out += if i + 1 < keys.len() { ",\n" } else { "\n" };
+    }
+    out += "}\n";
+    out
+}

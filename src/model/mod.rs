@@ -1,0 +1,287 @@
+//! The full finite-element model: K and M on the independent DOF, the joint operator B, the
+//! master node, the load and the contact law — from a case (mesh generated and assembled here)
+//! or from a user's own matrices ([`crate::model::matrices`]: MatrixMarket K, M plus a JSON map).
+//!
+//! Everything downstream (bases, statics, transient runs, reports) sees only this type, so one
+//! pipeline serves both origins. Conventions every model satisfies (checked where it is built):
+//!
+//! - the master (Craig–Bampton boundary) DOF are the **last six** independent DOF, in the order
+//!   `[ux, uy, uz, rx, ry, rz]` of one master node, which carries the load (eq. 1's `f(t)`);
+//! - each joint pair has three rows in B (eq. 2): `n · (u_upper − u_lower)` (normal gap, contact
+//!   when negative, zero initial clearance), `t1 · (…)` and `t2 · (…)` (slips), with `n, t1, t2`
+//!   orthonormal;
+//! - K is symmetric positive definite (the structure is supported), M symmetric positive
+//!   definite, both stored on one sparsity pattern.
+
+mod contact;
+mod load;
+pub mod matrices;
+
+pub use contact::contact_static_full;
+
+use std::path::PathBuf;
+
+use crate::assembly::{assemble_structure, DofMap, Structure};
+use crate::case::{Case, ContactSpec, LoadSpec};
+use crate::error::Error;
+use crate::joint::{JointOperator, PairFrame};
+use crate::linalg::cholesky as statics;
+use crate::linalg::eigen::{self as modes, Modes};
+use crate::linalg::SymCsc;
+use crate::mesh::Mesh;
+
+/// Which boundary the master node has in an eigenproblem.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Interface {
+    /// Master node free: the cantilever's own modes.
+    Free,
+    /// Master node clamped: Craig–Bampton fixed-interface normal modes.
+    Fixed,
+}
+
+/// What a cell of the display geometry is.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum CellNodes {
+    /// A 4-node shell (VTK quad).
+    Quad4([usize; 4]),
+    /// A 2-node beam (VTK line).
+    Line2([usize; 2]),
+}
+
+impl CellNodes {
+    /// The node indices, in cell order.
+    pub fn as_slice(&self) -> &[usize] {
+        match self {
+            CellNodes::Quad4(n) => n,
+            CellNodes::Line2(n) => n,
+        }
+    }
+}
+
+/// A cell of the display geometry (VTU output, pictures; not used by the mechanics).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Cell {
+    /// Node indices into [`Geometry::nodes`].
+    pub nodes: CellNodes,
+    /// Group (sheet index of a generated case; the map's `group`; −1 for none).
+    pub group: i32,
+    /// Shell thickness or beam diameter, mm (0 where unknown).
+    pub size: f64,
+}
+
+/// Node positions, node ids and cells: what output needs to show a displacement field.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Geometry {
+    /// Node coordinates (x, y, z), mm.
+    pub nodes: Vec<[f64; 3]>,
+    /// The user's node ids (1-based node numbers for a generated case).
+    pub node_ids: Vec<u64>,
+    /// Cells for display.
+    pub cells: Vec<Cell>,
+    /// Nodes tied rigidly to the master node (RBE2): no DOF of their own.
+    pub followers: Vec<usize>,
+}
+
+/// Where a model came from.
+#[derive(Clone, Debug)]
+pub enum Origin {
+    /// Generated and assembled from a case.
+    Case {
+        /// The validated case.
+        case: Box<Case>,
+        /// Its discretisation.
+        mesh: Box<Mesh>,
+    },
+    /// Read from a user's MatrixMarket K and M plus a JSON map ([`crate::model::matrices`]).
+    Matrices {
+        /// The map file.
+        map: PathBuf,
+        /// The stiffness file.
+        stiffness: PathBuf,
+        /// The mass file.
+        mass: PathBuf,
+    },
+}
+
+/// A static solution.
+#[derive(Clone, Debug, PartialEq)]
+pub struct StaticSolution {
+    /// All independent DOF, mm and rad.
+    pub displacement: Vec<f64>,
+    /// The master node `[ux, uy, uz (mm), rx, ry, rz (rad)]`.
+    pub master_displacement: [f64; 6],
+}
+
+/// The full FE model (see the module docs for its conventions).
+#[derive(Clone, Debug)]
+pub struct Model {
+    /// Name (used in reports and output folders).
+    pub name: String,
+    /// Where it came from, for errors: a file path or `builtin:<name>`.
+    pub source: String,
+    /// Case and mesh, or the matrix files.
+    pub origin: Origin,
+    /// Nodes and cells for output.
+    pub geometry: Geometry,
+    /// The joint pairs with their frames, in the row order of [`Model::joint`].
+    pub pairs: Vec<PairFrame>,
+    /// Node DOF → independent DOF.
+    pub dof_map: DofMap,
+    /// Stiffness on the independent DOF, N/mm (N, N·mm/rad for rotations).
+    pub stiffness: SymCsc,
+    /// Mass on the independent DOF, t (t·mm² for rotations).
+    pub mass: SymCsc,
+    /// The joint operator B (3 rows per pair: normal, t1, t2).
+    pub joint: JointOperator,
+    /// The master-node load and its ramp.
+    pub load: LoadSpec,
+    /// Contact and friction law of all pairs.
+    pub contact: ContactSpec,
+    /// End of the simulated time span, s.
+    pub end_time: f64,
+}
+
+impl Model {
+    /// Builds the mesh and assembles K and M.
+    pub fn from_case(case: Case) -> Result<Model, Error> {
+        let mesh = Mesh::from_case(&case)?;
+        let Structure {
+            dof_map,
+            stiffness,
+            mass,
+        } = assemble_structure(&mesh)?;
+        let (normal, t1, t2) = PairFrame::SHEET_AXES;
+        let pairs: Vec<PairFrame> = mesh
+            .pairs
+            .iter()
+            .map(|p| PairFrame {
+                lower: p.lower,
+                upper: p.upper,
+                normal,
+                t1,
+                t2,
+            })
+            .collect();
+        let joint = JointOperator::new(&pairs, &dof_map)?;
+        let mut cells: Vec<Cell> = mesh
+            .shells
+            .iter()
+            .map(|e| Cell {
+                nodes: CellNodes::Quad4(e.nodes),
+                group: e.sheet as i32,
+                size: e.thickness,
+            })
+            .collect();
+        cells.extend(mesh.beams.iter().map(|b| Cell {
+            nodes: CellNodes::Line2(b.nodes),
+            group: -1,
+            size: b.diameter,
+        }));
+        let geometry = Geometry {
+            nodes: mesh.nodes.clone(),
+            node_ids: (1..=mesh.nodes.len() as u64).collect(),
+            cells,
+            followers: mesh.tie.slaves.clone(),
+        };
+        Ok(Model {
+            name: case.name.clone(),
+            source: case.source.clone(),
+            load: case.load,
+            contact: case.contact,
+            end_time: case.end_time,
+            origin: Origin::Case {
+                case: Box::new(case),
+                mesh: Box::new(mesh),
+            },
+            geometry,
+            pairs,
+            dof_map,
+            stiffness,
+            mass,
+            joint,
+        })
+    }
+
+    /// The case, for a model generated from one.
+    pub fn case(&self) -> Option<&Case> {
+        match &self.origin {
+            Origin::Case { case, .. } => Some(case),
+            Origin::Matrices { .. } => None,
+        }
+    }
+
+    /// The mesh, for a model generated from a case.
+    pub fn mesh(&self) -> Option<&Mesh> {
+        match &self.origin {
+            Origin::Case { mesh, .. } => Some(mesh),
+            Origin::Matrices { .. } => None,
+        }
+    }
+
+    /// The final master load `[Fx, Fy, Fz (N), Mx, My, Mz (N·mm)]`, before the ramp.
+    pub fn master_load(&self) -> [f64; 6] {
+        self.load.master.to_array()
+    }
+
+    /// Number of independent DOF (after eliminating clamp and rigid tie).
+    pub fn dofs(&self) -> usize {
+        self.dof_map.n
+    }
+
+    /// Number of joint pairs.
+    pub fn pair_count(&self) -> usize {
+        self.pairs.len()
+    }
+
+    /// Number of distinct independent DOF on nodes of joint pairs.
+    pub fn joint_dofs(&self) -> usize {
+        let mut nodes: Vec<usize> = self.pairs.iter().flat_map(|p| [p.lower, p.upper]).collect();
+        nodes.sort_unstable();
+        nodes.dedup();
+        nodes
+            .iter()
+            .filter_map(|&n| self.dof_map.free_dofs(n))
+            .count()
+            * 6
+    }
+
+    /// The master node's independent DOF `[ux, uy, uz, rx, ry, rz]`.
+    pub fn master_dofs(&self) -> [usize; 6] {
+        self.dof_map.master
+    }
+
+    /// The lowest `count` eigenmodes with the master node free or clamped.
+    pub fn modes(&self, count: usize, interface: Interface) -> Result<Modes, Error> {
+        match interface {
+            Interface::Free => modes::lowest_modes(&self.stiffness, &self.mass, count),
+            Interface::Fixed => {
+                let m = self.dofs() - 6;
+                modes::lowest_modes(&self.stiffness.leading(m), &self.mass.leading(m), count)
+            }
+        }
+    }
+
+    /// Linear static response (no contact) to master loads `[Fx, Fy, Fz, Mx, My, Mz]`
+    /// (N, N·mm), each column of `loads` one load case.
+    pub fn static_linear(&self, loads: &[[f64; 6]]) -> Result<Vec<StaticSolution>, Error> {
+        let master = self.master_dofs();
+        let rhs: Vec<Vec<f64>> = loads
+            .iter()
+            .map(|l| {
+                let mut f = vec![0.0; self.dofs()];
+                for k in 0..6 {
+                    f[master[k]] = l[k];
+                }
+                f
+            })
+            .collect();
+        let sols = statics::solve_spd(&self.stiffness, &rhs)?;
+        Ok(sols
+            .into_iter()
+            .map(|q| StaticSolution {
+                master_displacement: master.map(|k| q[k]),
+                displacement: q,
+            })
+            .collect())
+    }
+}

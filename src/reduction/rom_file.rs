@@ -1,0 +1,254 @@
+//! The reduced model as a product: a documented, versioned JSON file that other tools (system
+//! simulation, an engineer's own scripts) read, and that jointrom re-integrates itself.
+//!
+//! ## Schema `jointrom-rom`, version 1
+//!
+//! Matrices are arrays of rows (row-major), numbers in SI-mm units (mm, N, t, s, rad). With r
+//! the number of reduced coordinates q and w the number of joint pairs, the reduced equations
+//! of motion (paper eq. 7) are
+//!
+//! ```text
+//! M̃ q̈ + K̃ q = Σ_d f_d(t) φ_d − (BΦ)ᵀ p(BΦ q, s),     u_master = Φ_m q
+//! ```
+//!
+//! | field | shape / type | meaning |
+//! |---|---|---|
+//! | `schema`, `version` | `"jointrom-rom"`, `1` | this format |
+//! | `case`, `basis` | string, object | where it came from: basis kind, g, ν, w(g) threshold, w |
+//! | `dimension` | r | reduced coordinates |
+//! | `pairs` | w | joint node pairs |
+//! | `mass` | r × r | `M̃ = ΦᵀMΦ` (t; the identity for jointrom's M-orthonormal bases) |
+//! | `stiffness` | r × r | `K̃ = ΦᵀKΦ` (N/mm; diagonal ω² for the modal rotation) |
+//! | `joint_operator` | 3w × r | `BΦ`: per pair the rows normal gap, slip t1 (x), slip t2 (z), mm per unit q |
+//! | `master_rows` | 6 × r | `Φ_m`: rows of Φ at the master DOF ux, uy, uz (mm), rx, ry, rz (rad) |
+//! | `reduced_loads` | 6 × r | `φ_d = Φᵀ e_d` for a unit master load along DOF d (= `master_rows`) |
+//! | `master_load` | object | final master load `fx, fy, fz` (N), `mx, my, mz` (N·mm) |
+//! | `load_ramp` | object | its time function (the case file's `load.ramp`) |
+//! | `contact` | object | `normal_stiffness` k_n, `stick_stiffness` k_t (N/mm), `friction_coefficient` μ |
+//! | `friction_relaxation_time` | s | τ of jointrom's viscoplastic slip memory (see `crate::joint::law`) |
+//! | `coordinate_size` | r | max |Φ| per column (mm or rad per unit q): jointrom's tolerance scale |
+//! | `end_time` | s | the case's simulated span |
+//!
+//! The pair law: gap `g = (BΦq)_normal`, normal force `p_n = k_n·min(g, 0)`; Coulomb friction
+//! with elastic stick `k_t (u_t − s)` capped at `μ|p_n|` (see `crate::joint::law`).
+//!
+//! [`RomFile::read`] checks the schema, the version, every dimension and that every number is
+//! finite, naming the file and the field at fault; [`RomFile::system`] turns it into a
+//! [`ReducedSystem`] that `crate::integrate::mechanical::run` integrates — the same curves as the model it
+//! was exported from (bit for bit: JSON numbers round-trip exactly).
+
+use std::path::Path;
+
+use faer::Mat;
+use serde::{Deserialize, Serialize};
+
+use crate::case::{ContactSpec, MasterLoadSpec, RampSpec};
+use crate::error::Error;
+use crate::joint::law::DEFAULT_TAU;
+use crate::model::Model;
+use crate::reduction::ReducedModel;
+use crate::system::{ReducedParts, ReducedSystem};
+
+/// Schema name of the file.
+pub const SCHEMA: &str = "jointrom-rom";
+/// Schema version written (and the only one read).
+pub const VERSION: u32 = 1;
+
+/// Where the basis came from.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BasisInfo {
+    /// Basis kind (`tvd`, `tvd-plain`, `modes`, `jim`, `alldof`).
+    pub kind: String,
+    /// Added vectors g.
+    pub g: usize,
+    /// Fixed-interface modes ν.
+    pub nu: usize,
+    /// w(g) threshold of the a-priori choice.
+    pub threshold: f64,
+    /// POD energy ratios w(1), w(2), ... (empty for bases without POD).
+    pub w: Vec<f64>,
+}
+
+/// The exported reduced model (see the module docs for every field).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RomFile {
+    /// `"jointrom-rom"`.
+    pub schema: String,
+    /// 1.
+    pub version: u32,
+    /// Case name.
+    pub case: String,
+    /// Basis description.
+    pub basis: BasisInfo,
+    /// r.
+    pub dimension: usize,
+    /// w.
+    pub pairs: usize,
+    /// M̃ (r × r), t.
+    pub mass: Vec<Vec<f64>>,
+    /// K̃ (r × r), N/mm.
+    pub stiffness: Vec<Vec<f64>>,
+    /// BΦ (3w × r), mm per unit coordinate.
+    pub joint_operator: Vec<Vec<f64>>,
+    /// Φ at the master DOF (6 × r).
+    pub master_rows: Vec<Vec<f64>>,
+    /// Φᵀ e_d for unit master loads (6 × r).
+    pub reduced_loads: Vec<Vec<f64>>,
+    /// Final master load.
+    pub master_load: MasterLoadSpec,
+    /// Its time function.
+    pub load_ramp: RampSpec,
+    /// Pair law parameters.
+    pub contact: ContactSpec,
+    /// τ of the slip memory, s.
+    pub friction_relaxation_time: f64,
+    /// max |Φ| per column (r).
+    pub coordinate_size: Vec<f64>,
+    /// Simulated span, s.
+    pub end_time: f64,
+}
+
+fn rows(a: &Mat<f64>) -> Vec<Vec<f64>> {
+    (0..a.nrows())
+        .map(|i| (0..a.ncols()).map(|j| a[(i, j)]).collect())
+        .collect()
+}
+
+impl RomFile {
+    /// The file of a reduced model of `model`.
+    pub fn new(model: &Model, rom: &ReducedModel, basis: BasisInfo) -> Result<RomFile, Error> {
+        let r = rom.dim();
+        let master = model.master_dofs();
+        let phi_master = Mat::from_fn(6, r, |d, c| rom.phi[(master[d], c)]);
+        let column_size = (0..r)
+            .map(|c| rom.phi.col(c).iter().fold(0.0f64, |m, x| m.max(x.abs())))
+            .collect();
+        Ok(RomFile {
+            schema: SCHEMA.into(),
+            version: VERSION,
+            case: model.name.clone(),
+            basis,
+            dimension: r,
+            pairs: model.joint.pairs(),
+            mass: rows(&rom.m),
+            stiffness: rows(&rom.k),
+            joint_operator: rows(&rom.b_phi),
+            master_rows: rows(&phi_master),
+            reduced_loads: rows(&phi_master),
+            master_load: model.load.master,
+            load_ramp: model.load.ramp,
+            contact: model.contact,
+            friction_relaxation_time: DEFAULT_TAU,
+            coordinate_size: column_size,
+            end_time: model.end_time,
+        })
+    }
+
+    /// Writes the file (pretty JSON).
+    pub fn write(&self, path: &Path) -> Result<(), Error> {
+        let text = serde_json::to_string_pretty(self).expect("the reduced model serialises");
+        std::fs::write(path, text).map_err(|e| Error::Io {
+            file: path.to_path_buf(),
+            source: e,
+        })
+    }
+
+    /// Reads and checks a file (errors name the file and the field).
+    pub fn read(path: &Path) -> Result<RomFile, Error> {
+        let text = std::fs::read_to_string(path).map_err(|e| Error::Io {
+            file: path.to_path_buf(),
+            source: e,
+        })?;
+        let bad = |field: &str, msg: String| {
+            Error::Invalid(format!("{}: at `{field}`: {msg}", path.display()))
+        };
+        let de = &mut serde_json::Deserializer::from_str(&text);
+        let f: RomFile = serde_path_to_error::deserialize(de)
+            .map_err(|e| bad(&e.path().to_string(), e.inner().to_string()))?;
+        if f.schema != SCHEMA {
+            return Err(bad(
+                "schema",
+                format!("expected \"{SCHEMA}\", got \"{}\"", f.schema),
+            ));
+        }
+        if f.version != VERSION {
+            return Err(bad(
+                "version",
+                format!("this jointrom reads version {VERSION}, got {}", f.version),
+            ));
+        }
+        let (r, w) = (f.dimension, f.pairs);
+        let check = |field: &str, m: &[Vec<f64>], nr: usize| -> Result<(), Error> {
+            if m.len() != nr {
+                return Err(bad(field, format!("expected {nr} rows, got {}", m.len())));
+            }
+            for (i, row) in m.iter().enumerate() {
+                if row.len() != r {
+                    return Err(bad(
+                        &format!("{field}[{i}]"),
+                        format!("expected {r} columns, got {}", row.len()),
+                    ));
+                }
+                if let Some(j) = row.iter().position(|v| !v.is_finite()) {
+                    return Err(bad(&format!("{field}[{i}][{j}]"), "not finite".into()));
+                }
+            }
+            Ok(())
+        };
+        check("mass", &f.mass, r)?;
+        check("stiffness", &f.stiffness, r)?;
+        check("joint_operator", &f.joint_operator, 3 * w)?;
+        check("master_rows", &f.master_rows, 6)?;
+        check("reduced_loads", &f.reduced_loads, 6)?;
+        if f.coordinate_size.len() != r {
+            return Err(bad(
+                "coordinate_size",
+                format!("expected {r} entries, got {}", f.coordinate_size.len()),
+            ));
+        }
+        let positive = |field: &str, v: f64| {
+            if v.is_finite() && v > 0.0 {
+                Ok(())
+            } else {
+                Err(bad(field, format!("must be finite and positive, got {v}")))
+            }
+        };
+        positive("contact.normal_stiffness", f.contact.normal_stiffness)?;
+        positive("contact.stick_stiffness", f.contact.stick_stiffness)?;
+        positive("friction_relaxation_time", f.friction_relaxation_time)?;
+        positive("end_time", f.end_time)?;
+        if !(f.contact.friction_coefficient.is_finite() && f.contact.friction_coefficient >= 0.0) {
+            return Err(bad(
+                "contact.friction_coefficient",
+                format!("must be ≥ 0, got {}", f.contact.friction_coefficient),
+            ));
+        }
+        for (i, s) in f.coordinate_size.iter().enumerate() {
+            positive(&format!("coordinate_size[{i}]"), *s)?;
+        }
+        Ok(f)
+    }
+
+    /// The reduced system jointrom integrates.
+    pub fn system(&self) -> Result<ReducedSystem, Error> {
+        let mat = |m: &[Vec<f64>]| {
+            let nc = m.first().map_or(self.dimension, Vec::len);
+            Mat::from_fn(m.len(), nc, |i, j| m[i][j])
+        };
+        ReducedSystem::from_parts(ReducedParts {
+            k: mat(&self.stiffness),
+            m: mat(&self.mass),
+            b_phi: mat(&self.joint_operator),
+            phi_master: mat(&self.master_rows),
+            column_size: self.coordinate_size.clone(),
+            load: crate::case::LoadSpec {
+                master: self.master_load,
+                ramp: self.load_ramp,
+            },
+            contact: self.contact,
+            end_time: self.end_time,
+        })
+    }
+}

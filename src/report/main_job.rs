@@ -1,0 +1,862 @@
+//! The main job, `jointrom run`: build the model, choose the reduced model's size a priori, run
+//! it against the full FE model and write a report a structural-dynamics engineer reads.
+//!
+//! One call of [`run_report`] measures everything it shows, in the same process on the same
+//! machine:
+//!
+//! 1. the static convergence study ([`crate::studies::convergence`]: ‖f_c‖ of every basis kind against the
+//!    number g of added vectors, and the POD energy ratios w(g) of eq. (26) — the paper's Figs.
+//!    7, 8, 15, 16, 19);
+//! 2. the full FE transient with friction (BDF + Newton with the structured sparse solve), the
+//!    reference of every error below;
+//! 3. reduced transients: TVD with g = 0, the paper's sizes (friction bar 10, 25; multilayer
+//!    sheet 20, 60) and the a-priori g (smallest g with w(g) ≥ the threshold, eq. 26), plus the
+//!    competitors (plain POD, modes only, Joint Interface Modes, all joint DOF) and functional
+//!    (fixed-point) iteration next to Newton; every run under a wall-clock budget, so a method
+//!    that does not finish is a measured failure, not a hang;
+//! 4. charts: ‖f_c‖(t), ‖f_R‖(t), master u_y(t) (Figs. 9, 11, 12, 17, 18), and speed against
+//!    accuracy — integration CPU time (log) against the relative L2 error of ‖f_c‖(t)
+//!
+//!    ```text
+//!    e = sqrt( Σ_k (‖f_c‖_ROM(t_k) − ‖f_c‖_full(t_k))² / Σ_k ‖f_c‖_full(t_k)² )
+//!    ```
+//!
+//!    over the output times t_k — with the full run's CPU time and the paper's CPU ratios (Sections
+//!    4.1.5, 4.2.4) as vertical anchors and the Pareto front (points no other point beats in both
+//!    time and error) drawn through;
+//! 5. the first joint modes as VTU files and a picture (`shapes/`, [`crate::report::shapes`]);
+//!    the stored stability map of the case (`results/stability/CASE`, made by
+//!    `jointrom stability CASE`; 17 min, too long to repeat here), copied in when present;
+//! 6. `report.md` (the charts as PNG, SVG alongside) and `results.json` with every number.
+//!
+//! `quick` shortens the transient window to 0.02 s and the study to g ≤ 20 (< 20 s in all).
+
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use serde::Serialize;
+
+use crate::error::Error;
+use crate::integrate::mechanical::{ProblemOptions, TransientOptions};
+use crate::integrate::problem::{Iteration, OdeOptions, OdeStats};
+use crate::model::Model;
+use crate::reduction::{build_basis, BasisKind, BasisOptions, ReducedModel};
+use crate::report::chart::{LegendPosition, LineChart, Reference, Series};
+use crate::studies::convergence::{self as study, StudyOptions};
+use crate::studies::stability::{integrate_budgeted, relative_l2, Outcome};
+use crate::system::{FullSystem, ReducedSystem};
+
+/// Options of [`run_report`]. Defaults: the full job (case end time, study g ≤ 60, functional
+/// iteration runs included), budgets 60 s per reduced run and 600 s for the full run, progress
+/// on a terminal only, the stored stability maps under `results/stability`.
+#[derive(Clone, Debug)]
+pub struct ReportOptions {
+    /// Short variant: 0.02 s window, study g ≤ 20, fewer runs.
+    pub quick: bool,
+    /// Wall-clock budget of one reduced run, s.
+    pub rom_budget_s: f64,
+    /// Wall-clock budget of the full FE Newton run, s.
+    pub full_budget_s: f64,
+    /// Wall-clock budget of the full FE run with functional iteration, s (it is expected to fail:
+    /// the budget bounds what that failure costs; at most 2 s when `quick`).
+    pub full_functional_budget_s: f64,
+    /// Show a progress bar (only drawn when stderr is a terminal).
+    pub progress: bool,
+    /// Folder holding stored stability maps (`<dir>/<case>/stability_status.png`).
+    pub stability_dir: PathBuf,
+}
+
+impl Default for ReportOptions {
+    fn default() -> Self {
+        ReportOptions {
+            quick: false,
+            rom_budget_s: 60.0,
+            full_budget_s: 600.0,
+            full_functional_budget_s: 5.0,
+            progress: true,
+            stability_dir: PathBuf::from("results/stability"),
+        }
+    }
+}
+
+/// One transient run of the report.
+#[derive(Clone, Debug, Serialize)]
+pub struct RunRecord {
+    /// `full` or a basis kind name (`tvd`, `tvd-plain`, `modes`, `jim`, `alldof`).
+    pub model: String,
+    /// Added vectors g (reduced models).
+    pub g: Option<usize>,
+    /// Coordinates (full: DOF; reduced: basis size r).
+    pub size: usize,
+    /// `newton` or `functional`.
+    pub iteration: String,
+    /// `ok`, `budget` or the CVODE flag.
+    pub status: String,
+    /// Failure message.
+    pub message: Option<String>,
+    /// Time reached, s.
+    pub t_reached: f64,
+    /// Basis (or model) construction time, s.
+    pub build_s: f64,
+    /// Integration wall time, s.
+    pub wall_s: f64,
+    /// Integration CPU time, s.
+    pub cpu_s: f64,
+    /// Solver statistics.
+    pub stats: OdeStats,
+    /// Relative L2 error of ‖f_c‖(t) against the full run (`None`: not comparable).
+    pub error_fc: Option<f64>,
+    /// Relative L2 error of master u_y(t).
+    pub error_uy: Option<f64>,
+    /// Relative L2 error of ‖f_R‖(t).
+    pub error_fr: Option<f64>,
+    /// Full-run integration CPU time over this run's (speed-up).
+    pub speedup: Option<f64>,
+    /// This run's CPU time in % of the full run's (the paper's measure).
+    pub cpu_percent: Option<f64>,
+    /// On the Pareto front of (CPU time, error of ‖f_c‖).
+    pub pareto: bool,
+    /// Output times, s.
+    #[serde(skip)]
+    pub t: Vec<f64>,
+    /// ‖f_c‖(t), N.
+    #[serde(skip)]
+    pub fc: Vec<f64>,
+    /// ‖f_R‖(t), N.
+    #[serde(skip)]
+    pub fr: Vec<f64>,
+    /// Master u_y(t), mm.
+    #[serde(skip)]
+    pub uy: Vec<f64>,
+}
+
+/// The paper's CPU-time ratio of a reduced run to the full run.
+#[derive(Clone, Debug, Serialize)]
+pub struct PaperAnchor {
+    /// g.
+    pub g: usize,
+    /// CPU time in % of the full FE model.
+    pub cpu_percent: f64,
+}
+
+/// Everything [`run_report`] measured (written as `results.json`).
+#[derive(Clone, Debug, Serialize)]
+pub struct Report {
+    /// Case name.
+    pub case: String,
+    /// The CASE argument that reproduces the model: a built-in name, a case file or a matrix map.
+    pub source: String,
+    /// The command line.
+    pub command_line: Vec<String>,
+    /// Quick variant.
+    pub quick: bool,
+    /// Model DOF.
+    pub dofs: usize,
+    /// Joint pairs.
+    pub pairs: usize,
+    /// Transient window, s.
+    pub end_time: f64,
+    /// w threshold of the a-priori choice.
+    pub threshold: f64,
+    /// The a-priori g (TVD, K-weighted POD).
+    pub g_chosen: usize,
+    /// w(g) of the K-weighted POD, g = 1, 2, ...
+    pub w: Vec<f64>,
+    /// w(g) of the plain POD.
+    pub w_plain: Vec<f64>,
+    /// The static study (summary per basis kind is in `study.json` as well).
+    pub study: study::Study,
+    /// The transient runs, full first.
+    pub runs: Vec<RunRecord>,
+    /// The paper's CPU ratios for this case (empty for other cases).
+    pub paper_anchors: Vec<PaperAnchor>,
+    /// Files written (relative to the report folder).
+    pub files: Vec<String>,
+    /// Whole job, s.
+    pub total_s: f64,
+    /// Further fields given by the caller (model summary, modes, linear statics).
+    #[serde(flatten)]
+    pub extra: serde_json::Map<String, serde_json::Value>,
+}
+
+/// The paper's g values and CPU ratios (Sections 4.1.5 and 4.2.4).
+fn paper_anchors(case: &str) -> Vec<PaperAnchor> {
+    let a = |g, p| PaperAnchor { g, cpu_percent: p };
+    match case {
+        "friction_bar" => vec![a(0, 0.07), a(10, 0.12), a(25, 0.25)],
+        "multilayer_sheet" => vec![a(0, 0.42), a(20, 0.44), a(60, 0.49)],
+        _ => Vec::new(),
+    }
+}
+
+/// One planned reduced run.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Plan {
+    kind: BasisKind,
+    g: usize,
+    functional: bool,
+}
+
+fn plans(case: &str, g_chosen: usize, pairs: usize, quick: bool) -> Vec<Plan> {
+    let paper: Vec<usize> = match case {
+        "multilayer_sheet" => vec![20, 60],
+        _ => vec![10, 25],
+    };
+    let mut tvd_g = vec![0, g_chosen];
+    tvd_g.extend(&paper);
+    if !quick {
+        tvd_g.extend([5, 40, pairs.saturating_sub(6)]);
+    }
+    tvd_g.retain(|&g| g <= pairs);
+    tvd_g.sort_unstable();
+    tvd_g.dedup();
+    let mut out: Vec<Plan> = tvd_g
+        .iter()
+        .map(|&g| Plan {
+            kind: BasisKind::Tvd,
+            g,
+            functional: false,
+        })
+        .collect();
+    let competitor_g: Vec<usize> = if quick { vec![paper[0]] } else { paper.clone() };
+    for kind in [BasisKind::TvdPlain, BasisKind::Modes, BasisKind::Jim] {
+        for &g in &competitor_g {
+            // Modes only: the Lanczos solver is trusted up to ~40 modes (ν + g).
+            if kind == BasisKind::Modes && g > 30 {
+                continue;
+            }
+            out.push(Plan {
+                kind,
+                g,
+                functional: false,
+            });
+        }
+    }
+    out.push(Plan {
+        kind: BasisKind::AllDof,
+        g: pairs,
+        functional: false,
+    });
+    let functional_g: Vec<usize> = if quick {
+        vec![g_chosen]
+    } else {
+        vec![0, g_chosen]
+    };
+    for g in functional_g {
+        out.push(Plan {
+            kind: BasisKind::Tvd,
+            g,
+            functional: true,
+        });
+    }
+    out
+}
+
+fn record(
+    model: &str,
+    g: Option<usize>,
+    size: usize,
+    functional: bool,
+    build_s: f64,
+    o: Outcome,
+) -> RunRecord {
+    RunRecord {
+        model: model.into(),
+        g,
+        size,
+        iteration: if functional { "functional" } else { "newton" }.into(),
+        status: o.status,
+        message: o.message,
+        t_reached: o.t_reached,
+        build_s,
+        wall_s: o.wall_s,
+        cpu_s: o.cpu_s,
+        stats: o.stats,
+        error_fc: None,
+        error_uy: None,
+        error_fr: None,
+        speedup: None,
+        cpu_percent: None,
+        pareto: false,
+        t: o.t,
+        fc: o.fc,
+        fr: o.fr,
+        uy: o.uy,
+    }
+}
+
+fn ode_options(functional: bool) -> OdeOptions {
+    let mut ode = TransientOptions::default().ode;
+    if functional {
+        ode.iteration = Iteration::Functional { anderson: 0 };
+    }
+    ode
+}
+
+/// Runs the main job on `model` and writes the report into `dir` (created if missing);
+/// `extra` fields are added to `results.json`.
+///
+/// # Errors
+/// Building the model's bases or the full reference run failing, charts or files that cannot be
+/// written. Reduced runs that fail are recorded with their status, not errors.
+pub fn run_report(
+    model: &Model,
+    dir: &Path,
+    opts: &ReportOptions,
+    extra: serde_json::Map<String, serde_json::Value>,
+) -> Result<Report, Error> {
+    let t_all = Instant::now();
+    std::fs::create_dir_all(dir).map_err(|e| Error::Io {
+        file: dir.to_path_buf(),
+        source: e,
+    })?;
+    let case = model.name.clone();
+    let end_time = if opts.quick {
+        model.end_time.min(0.02)
+    } else {
+        model.end_time
+    };
+    let output_step = 1e-4;
+    let problem = ProblemOptions::default();
+
+    let bar = if opts.progress && std::io::stderr().is_terminal() {
+        let b = indicatif::ProgressBar::new(1);
+        b.set_style(
+            indicatif::ProgressStyle::with_template(
+                "{elapsed_precise} [{bar:30}] {pos}/{len} {msg}",
+            )
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar())
+            .progress_chars("=> "),
+        );
+        b
+    } else {
+        indicatif::ProgressBar::hidden()
+    };
+
+    // 1. Static study and the a-priori g.
+    bar.set_message("static convergence study");
+    let study_opts = StudyOptions {
+        max_g: if opts.quick { 20 } else { 60 },
+        ..StudyOptions::default()
+    };
+    let st = study::run_study(model, &study_opts)?;
+    let energy = |name: &str| st.energy.iter().find(|e| e.name == name);
+    let tvd_energy = energy("tvd")
+        .ok_or_else(|| Error::Invalid("the study has no K-weighted TVD energy curve".into()))?;
+    let g_chosen = tvd_energy.g_threshold;
+    let w = tvd_energy.w.clone();
+    let w_plain = energy("tvd-plain").map(|e| e.w.clone()).unwrap_or_default();
+    let mut files = Vec::new();
+    let study_dir = dir.join("study");
+    std::fs::create_dir_all(&study_dir).map_err(|e| Error::Io {
+        file: study_dir.clone(),
+        source: e,
+    })?;
+    for f in study::write_charts(&st, &study_dir)? {
+        files.push(relative(dir, &f));
+    }
+
+    let pairs = model.joint.pairs();
+    let plan = plans(&case, g_chosen, pairs, opts.quick);
+    bar.set_length(plan.len() as u64 + 3);
+    bar.inc(1);
+
+    // 2. The full reference.
+    bar.set_message("full FE model, Newton");
+    let t0 = Instant::now();
+    let full_sys = FullSystem::new(model);
+    let build_full = t0.elapsed().as_secs_f64();
+    let full = integrate_budgeted(
+        full_sys,
+        &problem,
+        &ode_options(false),
+        end_time,
+        output_step,
+        opts.full_budget_s,
+    );
+    if !full.ok() {
+        return Err(Error::Invalid(format!(
+            "the full FE reference run failed at t = {} s ({}): {}",
+            full.t_reached,
+            full.status,
+            full.message.clone().unwrap_or_default()
+        )));
+    }
+    let mut runs = vec![record("full", None, model.dofs(), false, build_full, full)];
+    bar.inc(1);
+    bar.set_message("full FE model, functional iteration");
+    let full_fun = integrate_budgeted(
+        FullSystem::new(model),
+        &problem,
+        &ode_options(true),
+        end_time,
+        output_step,
+        if opts.quick {
+            opts.full_functional_budget_s.min(2.0)
+        } else {
+            opts.full_functional_budget_s
+        },
+    );
+    runs.push(record(
+        "full",
+        None,
+        model.dofs(),
+        true,
+        build_full,
+        full_fun,
+    ));
+    bar.inc(1);
+
+    // 3. Reduced runs.
+    for p in &plan {
+        bar.set_message(format!(
+            "{} g = {} ({})",
+            p.kind.name(),
+            p.g,
+            if p.functional { "functional" } else { "Newton" }
+        ));
+        let t0 = Instant::now();
+        let basis = build_basis(
+            model,
+            p.kind,
+            &BasisOptions {
+                g: Some(p.g),
+                ..BasisOptions::default()
+            },
+        )?;
+        let g_used = basis.g;
+        let rm = ReducedModel::new(model, basis.phi)?;
+        let build_s = t0.elapsed().as_secs_f64();
+        let o = integrate_budgeted(
+            ReducedSystem::new(model, &rm),
+            &problem,
+            &ode_options(p.functional),
+            end_time,
+            output_step,
+            opts.rom_budget_s,
+        );
+        runs.push(record(
+            p.kind.name(),
+            Some(g_used),
+            rm.dim(),
+            p.functional,
+            build_s,
+            o,
+        ));
+        bar.inc(1);
+    }
+    bar.finish_and_clear();
+
+    // Errors, speed-ups, Pareto front.
+    let (t_ref, fc_ref, fr_ref, uy_ref, cpu_ref) = {
+        let f = &runs[0];
+        (
+            f.t.clone(),
+            f.fc.clone(),
+            f.fr.clone(),
+            f.uy.clone(),
+            f.cpu_s,
+        )
+    };
+    for r in runs.iter_mut().skip(1) {
+        if r.status != "ok" {
+            continue;
+        }
+        r.error_fc = relative_l2(&r.t, &r.fc, &t_ref, &fc_ref);
+        r.error_uy = relative_l2(&r.t, &r.uy, &t_ref, &uy_ref);
+        r.error_fr = relative_l2(&r.t, &r.fr, &t_ref, &fr_ref);
+        if r.cpu_s > 0.0 && cpu_ref.is_finite() {
+            r.speedup = Some(cpu_ref / r.cpu_s);
+            r.cpu_percent = Some(100.0 * r.cpu_s / cpu_ref);
+        }
+    }
+    mark_pareto(&mut runs);
+
+    let anchors = paper_anchors(&case);
+    let mut report = Report {
+        case: case.clone(),
+        source: model
+            .source
+            .strip_prefix("builtin:")
+            .unwrap_or(&model.source)
+            .to_string(),
+        command_line: std::env::args().collect(),
+        quick: opts.quick,
+        dofs: model.dofs(),
+        pairs,
+        end_time,
+        threshold: st.threshold,
+        g_chosen,
+        w,
+        w_plain,
+        study: st,
+        runs,
+        paper_anchors: anchors,
+        files,
+        total_s: 0.0,
+        extra,
+    };
+
+    // 4. Charts.
+    for f in time_charts(&report, dir)? {
+        report.files.push(relative(dir, &f));
+    }
+    for f in speed_chart(&report, dir)? {
+        report.files.push(relative(dir, &f));
+    }
+    // Joint modes: VTU for ParaView and the picture of the first four.
+    let shape_dir = dir.join("shapes");
+    let sh = crate::report::shapes::shapes(model, BasisOptions::default().nu, 12)?;
+    for f in crate::report::shapes::write_shapes(model, &sh, &shape_dir)? {
+        report.files.push(relative(dir, &f));
+    }
+    // 5. The stored stability map.
+    let stab = opts.stability_dir.join(&case);
+    let mut stability_files = Vec::new();
+    for name in ["stability_status", "stability_error", "stability_wall"] {
+        for ext in ["png", "svg"] {
+            let src = stab.join(format!("{name}.{ext}"));
+            if src.is_file() {
+                let dst = dir.join(format!("{name}.{ext}"));
+                std::fs::copy(&src, &dst).map_err(|e| Error::Io {
+                    file: dst.clone(),
+                    source: e,
+                })?;
+                stability_files.push(relative(dir, &dst));
+            }
+        }
+    }
+    report.files.extend(stability_files.iter().cloned());
+    report.total_s = t_all.elapsed().as_secs_f64();
+
+    // 6. Files.
+    let json = dir.join("results.json");
+    write(
+        &json,
+        &serde_json::to_string_pretty(&report).expect("the report serialises"),
+    )?;
+    let md = dir.join("report.md");
+    write(&md, &markdown(&report, &stab, !stability_files.is_empty()))?;
+    report.files.push("results.json".into());
+    report.files.push("report.md".into());
+    Ok(report)
+}
+
+fn write(path: &Path, text: &str) -> Result<(), Error> {
+    std::fs::write(path, text).map_err(|e| Error::Io {
+        file: path.to_path_buf(),
+        source: e,
+    })
+}
+
+fn relative(dir: &Path, f: &Path) -> String {
+    f.strip_prefix(dir).unwrap_or(f).display().to_string()
+}
+
+/// Marks the runs no other run beats in both CPU time and ‖f_c‖ error (finished runs with an
+/// error only).
+fn mark_pareto(runs: &mut [RunRecord]) {
+    let pts: Vec<Option<(f64, f64)>> = runs
+        .iter()
+        .map(|r| match (r.status.as_str(), r.error_fc) {
+            ("ok", Some(e)) if r.cpu_s.is_finite() && e.is_finite() => Some((r.cpu_s, e)),
+            _ => None,
+        })
+        .collect();
+    for i in 0..runs.len() {
+        let Some((ci, ei)) = pts[i] else { continue };
+        let dominated = pts.iter().enumerate().any(|(j, p)| {
+            j != i && p.is_some_and(|(cj, ej)| cj <= ci && ej <= ei && (cj < ci || ej < ei))
+        });
+        runs[i].pareto = !dominated;
+    }
+}
+
+/// Selects one output curve of a run.
+type Curve = fn(&RunRecord) -> &[f64];
+
+/// ‖f_c‖(t), ‖f_R‖(t), u_y(t): full against TVD with g = 0, the paper's sizes and the a-priori g.
+fn time_charts(rep: &Report, dir: &Path) -> Result<Vec<PathBuf>, Error> {
+    let mut shown: Vec<&RunRecord> = vec![&rep.runs[0]];
+    let mut wanted: Vec<usize> = vec![0];
+    wanted.extend(rep.paper_anchors.iter().map(|a| a.g).filter(|&g| g > 0));
+    if rep.paper_anchors.is_empty() {
+        wanted.extend([10, 25]);
+    }
+    wanted.push(rep.g_chosen);
+    wanted.sort_unstable();
+    wanted.dedup();
+    for g in wanted {
+        if let Some(r) = rep.runs.iter().find(|r| {
+            r.model == "tvd" && r.g == Some(g) && r.iteration == "newton" && !r.t.is_empty()
+        }) {
+            shown.push(r);
+        }
+    }
+    let mut files = Vec::new();
+    let quantities: [(&str, &str, &str, Curve); 3] = [
+        ("fc_t", "contact force norm ‖f_c‖", "‖f_c‖ (N)", |r| &r.fc),
+        ("fr_t", "friction force norm ‖f_R‖", "‖f_R‖ (N)", |r| &r.fr),
+        ("uy_t", "master displacement u_y", "u_y (mm)", |r| &r.uy),
+    ];
+    for (stem, what, unit, get) in quantities {
+        let mut c = LineChart::new(
+            format!("{}: {what}, full FE vs TVD ROMs", rep.case),
+            "t (s)",
+            unit,
+        );
+        c.legend = LegendPosition::UpperRight;
+        for r in &shown {
+            let mut s = Series::new(
+                if r.model == "full" {
+                    format!("full FE ({} DOF)", r.size)
+                } else if r.g == Some(rep.g_chosen) {
+                    format!("TVD g = {} (a priori, w ≥ {})", rep.g_chosen, rep.threshold)
+                } else {
+                    format!("TVD g = {}", r.g.unwrap_or(0))
+                },
+                r.t.iter().copied().zip(get(r).iter().copied()).collect(),
+            );
+            s.markers = false;
+            c.series.push(s);
+        }
+        files.extend(c.write(&dir.join(stem))?);
+    }
+    Ok(files)
+}
+
+/// CPU time against the ‖f_c‖ error, one scatter series per (basis kind, iteration), the Pareto
+/// front, the full run's CPU time and the paper's ratios as vertical lines.
+fn speed_chart(rep: &Report, dir: &Path) -> Result<Vec<PathBuf>, Error> {
+    let mut c = LineChart::new(
+        format!(
+            "{}: speed against accuracy ({} s window)",
+            rep.case, rep.end_time
+        ),
+        "integration CPU time (s)",
+        "relative L2 error of ‖f_c‖(t) vs full FE",
+    );
+    c.x_log = true;
+    c.y_log = true;
+    c.legend = LegendPosition::LowerLeft;
+    c.size = (1100, 700);
+    let mut groups: Vec<(String, String)> = Vec::new();
+    for r in rep.runs.iter().skip(1) {
+        let key = (r.model.clone(), r.iteration.clone());
+        if !groups.contains(&key) {
+            groups.push(key);
+        }
+    }
+    for (model, it) in &groups {
+        let pts: Vec<(f64, f64)> = rep
+            .runs
+            .iter()
+            .filter(|r| &r.model == model && &r.iteration == it)
+            .filter_map(|r| r.error_fc.map(|e| (r.cpu_s, e.max(study::ERROR_FLOOR))))
+            .collect();
+        if !pts.is_empty() {
+            c.series
+                .push(Series::scatter(format!("{model} ({it})"), pts));
+        }
+    }
+    let mut front: Vec<(f64, f64)> = rep
+        .runs
+        .iter()
+        .filter(|r| r.pareto)
+        .filter_map(|r| r.error_fc.map(|e| (r.cpu_s, e.max(study::ERROR_FLOOR))))
+        .collect();
+    front.sort_by(|a, b| a.0.total_cmp(&b.0));
+    if !front.is_empty() {
+        let mut s = Series::new("Pareto front", front);
+        s.markers = false;
+        c.series.push(s);
+    }
+    let full_cpu = rep.runs[0].cpu_s;
+    if full_cpu.is_finite() && full_cpu > 0.0 {
+        c.x_references.push(Reference {
+            label: format!("full FE, Newton: {full_cpu:.2} s"),
+            value: full_cpu,
+            color: None,
+        });
+        for a in &rep.paper_anchors {
+            c.x_references.push(Reference {
+                label: format!("paper: g = {} at {} % of full", a.g, a.cpu_percent),
+                value: full_cpu * a.cpu_percent / 100.0,
+                color: Some([150, 150, 150]),
+            });
+        }
+    }
+    c.references.push(Reference {
+        label: "2 % (issue target)".into(),
+        value: 0.02,
+        color: Some([200, 0, 0]),
+    });
+    if c.series.is_empty() {
+        return Ok(Vec::new());
+    }
+    Ok(c.write(&dir.join("speed_accuracy"))?.to_vec())
+}
+
+fn fmt_opt(v: Option<f64>, prec: usize) -> String {
+    v.map_or("–".into(), |x| format!("{x:.prec$e}"))
+}
+
+fn markdown(rep: &Report, stab: &Path, stability: bool) -> String {
+    use std::fmt::Write;
+    let mut s = String::new();
+    let full = &rep.runs[0];
+    let _ = writeln!(s, "# jointrom report: {}\n", rep.case);
+    let _ = writeln!(
+        s,
+        "Command: `{}` — {} DOF, {} joint pairs, transient window {} s{}, whole job {:.1} s. \
+         Every figure below was measured in this run on this machine.\n",
+        rep.command_line.join(" "),
+        rep.dofs,
+        rep.pairs,
+        rep.end_time,
+        if rep.quick { " (quick)" } else { "" },
+        rep.total_s
+    );
+    let _ = writeln!(s, "## Summary\n");
+    let _ = writeln!(
+        s,
+        "A-priori size: g = {} joint modes (smallest g with w(g) ≥ {}, eq. 26). Full FE \
+         reference: BDF + Newton, {} steps, {:.2} s CPU.\n",
+        rep.g_chosen, rep.threshold, full.stats.steps, full.cpu_s
+    );
+    let _ = writeln!(
+        s,
+        "| model | g | size | iteration | status | err ‖f_c‖ | err u_y | err ‖f_R‖ | CPU s | % of full | speed-up | steps | RHS | Newton its | setups | Pareto |"
+    );
+    let _ = writeln!(
+        s,
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+    );
+    for r in &rep.runs {
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} | {} | {} | {} | {} | {} | {:.3} | {} | {} | {} | {} | {} | {} | {} |",
+            r.model,
+            r.g.map_or("–".into(), |g| g.to_string()),
+            r.size,
+            r.iteration,
+            if r.status == "ok" {
+                "ok".to_string()
+            } else {
+                format!("{} at t = {:.3e} s", r.status, r.t_reached)
+            },
+            fmt_opt(r.error_fc, 2),
+            fmt_opt(r.error_uy, 2),
+            fmt_opt(r.error_fr, 2),
+            r.cpu_s,
+            r.cpu_percent.map_or("–".into(), |p| format!("{p:.2}")),
+            r.speedup.map_or("–".into(), |p| format!("{p:.0}×")),
+            r.stats.steps,
+            r.stats.rhs_evals,
+            r.stats.nonlinear_iterations,
+            r.stats.linear_setups,
+            if r.pareto { "●" } else { "" }
+        );
+    }
+    let _ = writeln!(
+        s,
+        "\nErrors are relative L2 over the output times (every 1e-4 s) against the full FE run. \
+         CPU is the integration's process CPU time (10 ms resolution); basis construction is \
+         extra (`build_s` in `results.json`). A run that does not finish within its wall-clock \
+         budget is recorded as `budget` with the time it reached.\n"
+    );
+    if !rep.paper_anchors.is_empty() {
+        let _ = writeln!(s, "Paper (Sections 4.1.5, 4.2.4), CPU time of the reduced integration in % of the full FE model:");
+        for a in &rep.paper_anchors {
+            let ours = rep
+                .runs
+                .iter()
+                .find(|r| r.model == "tvd" && r.g == Some(a.g) && r.iteration == "newton")
+                .and_then(|r| r.cpu_percent);
+            let _ = writeln!(
+                s,
+                "- g = {}: paper {} %, here {}",
+                a.g,
+                a.cpu_percent,
+                ours.map_or("not run".into(), |p| format!("{p:.2} %"))
+            );
+        }
+        let _ = writeln!(s);
+    }
+    let _ = writeln!(
+        s,
+        "## Transient: full FE against TVD reduced models (Figs. 9, 11, 12, 17, 18)\n"
+    );
+    for (stem, what) in [
+        ("fc_t", "contact force norm"),
+        ("fr_t", "friction force norm"),
+        ("uy_t", "master displacement"),
+    ] {
+        let _ = writeln!(s, "![{what}]({stem}.png)\n");
+    }
+    let _ = writeln!(s, "## Speed against accuracy\n");
+    let _ = writeln!(
+        s,
+        "One point per (basis, size, iteration); the line joins the Pareto front; vertical lines: \
+         the full run's CPU time and the paper's CPU ratios applied to it.\n\n![speed against accuracy](speed_accuracy.png)\n"
+    );
+    let _ = writeln!(s, "## Joint modes (Figs. 3–6, 14)\n");
+    let _ = writeln!(
+        s,
+        "The first joint modes Φ̃_T (K-weighted POD of the TVD) as the normal gap they give each \
+         joint pair (blue closes, red opens; the sign of a mode is arbitrary). ParaView files of \
+         the Craig–Bampton vectors, the first TVD and joint modes: `shapes/*.vtu`.\n\n\
+         ![joint modes](shapes/joint_modes.png)\n"
+    );
+    let _ = writeln!(
+        s,
+        "## Static convergence and w(g) (Figs. 7, 8, 15, 16, 19)\n"
+    );
+    let _ = writeln!(
+        s,
+        "Full FE: ‖f_c‖ = {:.9} N, {} pairs in contact.\n",
+        rep.study.full.contact_force_norm, rep.study.full.pairs_in_contact
+    );
+    let _ = writeln!(
+        s,
+        "| basis | error g = 0 | error at max g | first g within 1e-2 | first g within 1e-4 |"
+    );
+    let _ = writeln!(s, "|---|---|---|---|---|");
+    for x in &rep.study.series {
+        let show = |o: Option<usize>| o.map_or("–".to_string(), |g| g.to_string());
+        let _ = writeln!(
+            s,
+            "| {} | {:.2e} | {:.2e} | {} | {} |",
+            x.label,
+            x.relative_error.first().copied().unwrap_or(f64::NAN),
+            x.relative_error.last().copied().unwrap_or(f64::NAN),
+            show(x.within.first().and_then(|w| w.first)),
+            show(x.within.get(1).and_then(|w| w.first)),
+        );
+    }
+    let _ = writeln!(
+        s,
+        "\n![error](study/fc_error.png)\n\n![norm](study/fc_norm.png)\n\n![w(g)](study/w.png)\n"
+    );
+    let _ = writeln!(s, "## Stability map\n");
+    if stability {
+        let _ = writeln!(
+            s,
+            "Stored map from `{}` (made by `jointrom stability {} --out {}`; see its \
+             `stability.md` and SOURCE.md for the command and the failures explained).\n\n\
+             ![status](stability_status.png)\n\n![error](stability_error.png)\n\n![wall](stability_wall.png)\n",
+            stab.display(),
+            rep.case,
+            stab.parent().map_or(".".into(), |p| p.display().to_string())
+        );
+    } else {
+        let _ = writeln!(
+            s,
+            "No stored map under `{}`: run `jointrom stability {}` (about 17 min on 2 cores).\n",
+            stab.display(),
+            rep.source
+        );
+    }
+    s
+}

@@ -1,0 +1,1116 @@
+//! The static convergence study of the paper (Witteveen & Pichler 2014, Sections 4.1.2, 4.2.2
+//! and 5; Figs. 7, 15, 19 and 8, 16) and the reduced contact statics behind `jointrom basis`,
+//! `jointrom static --basis` and `jointrom study`.
+//!
+//! ## What is compared
+//!
+//! The case's master load (times a scale) is applied with frictionless penalty contact in the
+//! joint ([`crate::joint::statics`]). The measure is the paper's: `‖f_c‖₂`, the Euclidean norm of all
+//! pair contact forces (N). The full-FE value is the reference; each reduction basis is
+//! `Φ = [Φ_S Φ_V | first g enrichment vectors]`, M-orthonormalized by
+//! [`final_basis`] (drop tolerance [`DEFAULT_DROP_TOL`]), and solved exactly by the
+//! active-set Newton method on the reduced model (eq. 7). The relative error is
+//! `|‖f_c‖_red − ‖f_c‖_full| / ‖f_c‖_full`; the relative error of the whole pair force vector,
+//! `‖p_red − p_full‖ / ‖p_full‖`, is recorded too (it bounds the former).
+//!
+//! The enrichments, g = 0 ..= `max_g` vectors each (g = 0 is plain Craig–Bampton with ν modes for
+//! every kind, so all curves start at the same point):
+//!
+//! - `tvd`: the leading POMs of the K-weighted POD (eqs. 24–25) of the TVD (Algorithm 2, eq. 16,
+//!   normal stiffness `k_n` only) — the paper's method;
+//! - `tvd-plain`: the plain POD (eqs. 20–22) of the same TVD;
+//! - `tvd-kt`: K-weighted POD of the TVD with `k_n` and `k_t` (Algorithm 2, line 10);
+//! - `modes`: ν + g fixed-interface normal modes instead of joint modes (the paper's Fig. 7
+//!   comparison).
+//!
+//! A series ends early when its kind has fewer than `max_g` vectors (the TVD of `k_n` alone span
+//! at most one direction per pair, so their POD has at most w modes); `available` says how many.
+//! The energy ratios `w(g)` (eq. 26) of each POD are recorded for g = 1 ..= `max_g`.
+//!
+//! ## Cost
+//!
+//! The expensive parts run once: the full solution, Craig–Bampton, each TVD variant and its POD,
+//! and the ν + `max_g` fixed-interface modes of `modes`. Per g and kind only the
+//! M-orthonormalization of `6 + ν + g` columns, the projection (`ReducedModel`) and the dense
+//! reduced contact solve remain.
+//!
+//! Two references without a g axis are recorded too: `tvd_spans`, the basis with *all* nonzero
+//! TVD of a variant and no POD (the limit of its POD series) plus `alldof` (Craig–Bampton + the
+//! normal constraint mode of every pair, paper Section 5.1: exact by construction), and the
+//! full-FE value. `jim` (paper Section 5.3) is a series: the first g Joint Interface Modes of
+//! the normal and in-plane sets, by frequency.
+//!
+//! ## Reduced contact solves
+//!
+//! The active-set Newton method of [`crate::joint::statics`] can cycle on a coarse basis (measured on
+//! the friction bar: CB + 2 … 14 extra modes, TVD with 4 … 6 joint modes). The contact energy is
+//! convex, so [`reduced_contact_static_damped`] (the same Newton step with an Armijo line search)
+//! takes over when it fails; every such g is listed in `restarts`, and a g where both fail is
+//! NaN and listed in `failures` (none measured).
+//!
+//! ## Measured (ν = 10, load × 1; this crate's meshes; `results/study/`)
+//!
+//! | case | full ‖f_c‖ | g = 0 error | tvd (K-weighted) | tvd-plain | tvd-inertia (eq. 15) | tvd-kt | modes | jim |
+//! |---|---|---|---|---|---|---|---|---|
+//! | friction_bar (54 pairs) | 2.0630588 N | 33 | 1 % from g = 49, 1e-4 from 52, 4.8e-10 at 54 | same g, 4.7e-10 | 2.1e-2 at 60 | 0.17 at 60 | 3.2e-2 at 60 | 3.0e-2 at 60 |
+//! | multilayer_sheet (92 pairs) | 0.04133989 N | 34 | 1 % from 53, 1e-4 from 73, 2.9e-7 at 80 | same g | 2.5e-4 at 80 | 0.36 at 80 | 3.5e-2 at 80 | 0.15 at 80 |
+//!
+//! The weighted POD of the TVD is computed without forming `YᵀKY` ([`crate::reduction::pod_tvd`]):
+//! the POMs that carry the last per cent of the contact force have POD eigenvalues of
+//! 1e-12 … 1e-16 λ_max, below the round-off floor of the Gram route. The TVD series converge to
+//! the full value, but late: w(g) ≥ 0.999 already at g = 12 (friction bar) and 21 (multilayer),
+//! far before the contact force converges, so the paper's "25 joint modes converge the friction
+//! bar (w = 0.9994)" is not reproduced for the static contact force on this mesh. k_n + k_t TVD
+//! span a three times larger space and converge more slowly per added vector; without POD they
+//! stop at 4.7e-4 / 2.9e-3 (the combined normal-tangential pseudoforces do not contain the pure
+//! normal flexibility directions).
+//!
+//! Timings (2 shared cores, loaded): a whole study ≈ 2.5–6 s per scene (each sweep ≈ 0.3–1.5 s;
+//! the all-TVD references ≈ 0.3–0.6 s each), charts ≈ 0.05 s.
+//!
+//! ## Basis names
+//!
+//! [`BASIS_KINDS`] is the one list of the names `--basis` accepts; [`parse_basis`] maps a name to
+//! its [`BasisKind`] or fails listing the valid ones.
+
+use std::time::Instant;
+
+use faer::linalg::triangular_solve::{
+    solve_lower_triangular_in_place, solve_upper_triangular_in_place,
+};
+use faer::{Mat, MatRef, Par, Side};
+use serde::Serialize;
+
+use crate::error::Error;
+use crate::joint::statics::{contact_static_reduced, ContactOptions, ContactState};
+use crate::joint::NORMAL;
+use crate::model::contact_static_full;
+use crate::model::Model;
+use crate::reduction::{
+    alldof_vectors, build_basis, craig_bampton, final_basis, jim_vectors, trial_vector_derivatives,
+    BasisKind, BasisOptions, JimSet, ReducedModel, TvdOptions, DEFAULT_DROP_TOL, DEFAULT_THRESHOLD,
+};
+
+/// The basis kinds of `jointrom static --basis`, by name (the one list; see [`parse_basis`]).
+pub const BASIS_KINDS: &[(&str, BasisKind)] = &[
+    ("tvd", BasisKind::Tvd),
+    ("tvd-plain", BasisKind::TvdPlain),
+    ("modes", BasisKind::Modes),
+    ("jim", BasisKind::Jim),
+    ("alldof", BasisKind::AllDof),
+];
+
+/// The [`BasisKind`] called `name` (one of [`BASIS_KINDS`]); the error lists the valid names.
+pub fn parse_basis(name: &str) -> Result<BasisKind, Error> {
+    BASIS_KINDS
+        .iter()
+        .find(|(n, _)| *n == name)
+        .map(|&(_, k)| k)
+        .ok_or_else(|| {
+            Error::Invalid(format!(
+                "--basis {name:?}: unknown basis kind; valid: {}",
+                basis_names().join(", ")
+            ))
+        })
+}
+
+/// The name of a kind in [`BASIS_KINDS`] (`"?"` for a kind not listed there).
+pub fn basis_name(kind: BasisKind) -> &'static str {
+    BASIS_KINDS
+        .iter()
+        .find(|(_, k)| *k == kind)
+        .map(|&(n, _)| n)
+        .unwrap_or("?")
+}
+
+/// All names of [`BASIS_KINDS`], in order.
+pub fn basis_names() -> Vec<&'static str> {
+    BASIS_KINDS.iter().map(|&(n, _)| n).collect()
+}
+
+/// The case's master load `[Fx, Fy, Fz (N), Mx, My, Mz (N·mm)]` times `scale`.
+pub fn scaled_load(model: &Model, scale: f64) -> Result<[f64; 6], Error> {
+    if !scale.is_finite() {
+        return Err(Error::Invalid(format!(
+            "--scale must be finite, got {scale}"
+        )));
+    }
+    Ok(model.master_load().map(|v| v * scale))
+}
+
+/// A reduced contact static solution.
+#[derive(Clone, Debug)]
+pub struct ReducedStatic {
+    /// Reduced coordinates η (r); the displacement is `Φ η`.
+    pub eta: Vec<f64>,
+    /// The master node `[ux, uy, uz (mm), rx, ry, rz (rad)]` of `Φ η`.
+    pub master_displacement: [f64; 6],
+    /// Gaps (mm), pair forces (N), active set, `‖f_c‖` (N).
+    pub state: ContactState,
+}
+
+/// Frictionless contact statics of a reduced model under its load `Φᵀ f` times `scale`
+/// ([`contact_static_reduced`] on `K̃` and the normal rows of `B Φ`).
+pub fn reduced_contact_static(
+    model: &Model,
+    rm: &ReducedModel,
+    scale: f64,
+    opts: &ContactOptions,
+) -> Result<ReducedStatic, Error> {
+    let w = model.joint.pairs();
+    let r = rm.dim();
+    let b_n = Mat::from_fn(w, r, |i, j| rm.b_phi[(3 * i + NORMAL, j)]);
+    let f: Vec<f64> = rm.load.iter().map(|v| v * scale).collect();
+    let (eta, state) = contact_static_reduced(
+        rm.k.as_ref(),
+        b_n.as_ref(),
+        &f,
+        model.contact.normal_stiffness,
+        opts,
+    )?;
+    let master = model.master_dofs();
+    let master_displacement = master.map(|d| (0..r).map(|c| rm.phi[(d, c)] * eta[c]).sum::<f64>());
+    Ok(ReducedStatic {
+        eta,
+        master_displacement,
+        state,
+    })
+}
+
+/// [`reduced_contact_static`] (the active-set Newton method of [`crate::joint::statics`]) from
+/// `opts.start`; if that fails — it can cycle on a coarse basis, whose contact problem is still
+/// convex but poorly resolved — [`reduced_contact_static_damped`], which converges for any
+/// basis. Returns the solution and the first attempt's error if the fallback was needed.
+pub fn reduced_contact_static_restarting(
+    model: &Model,
+    rm: &ReducedModel,
+    scale: f64,
+    opts: &ContactOptions,
+) -> Result<(ReducedStatic, Option<Error>), Error> {
+    match reduced_contact_static(model, rm, scale, opts) {
+        Ok(sol) => Ok((sol, None)),
+        Err(first) => match reduced_contact_static_damped(model, rm, scale, opts) {
+            Ok(sol) => Ok((sol, Some(first))),
+            Err(second) => Err(Error::LinearAlgebra(format!(
+                "reduced contact statics failed: {first}; then, damped: {second}"
+            ))),
+        },
+    }
+}
+
+/// Frictionless contact statics of a reduced model by semismooth Newton with a backtracking
+/// (Armijo) line search on the contact energy
+///
+/// ```text
+/// E(η) = ½ ηᵀ K̃ η − f̃ᵀ η + ½ k_n Σ_i min(b_i η, 0)²     (b_i: row i of B_n Φ)
+/// ```
+///
+/// which is convex and continuously differentiable with `∇E = H_A η − f̃`,
+/// `H_A = K̃ + k_n Σ_{i∈A(η)} b_iᵀ b_i`, `A(η) = {i : b_i η < 0}`. The Newton direction
+/// `d = H_A⁻¹ f̃ − η` is the undamped active-set step of [`crate::joint::statics`]; it is a descent
+/// direction (`∇E·d = −dᵀ H_A d < 0`), and backtracking until
+/// `E(η + t d) ≤ E(η) + 10⁻⁴ t ∇E·d` makes the iteration converge from any start, where the
+/// undamped one can cycle. It stops exactly as the undamped one: when the full step's active set
+/// equals the set it was computed with, the step solves the piecewise linear equilibrium
+/// exactly. Starts from η = 0 (all pairs open); at most `20 · opts.max_iterations` steps.
+pub fn reduced_contact_static_damped(
+    model: &Model,
+    rm: &ReducedModel,
+    scale: f64,
+    opts: &ContactOptions,
+) -> Result<ReducedStatic, Error> {
+    let w = model.joint.pairs();
+    let r = rm.dim();
+    let k_n = model.contact.normal_stiffness;
+    let b = Mat::from_fn(w, r, |i, j| rm.b_phi[(3 * i + NORMAL, j)]);
+    let f: Vec<f64> = rm.load.iter().map(|v| v * scale).collect();
+    let gaps_of = |eta: &[f64]| -> Vec<f64> {
+        (0..w)
+            .map(|i| (0..r).map(|j| b[(i, j)] * eta[j]).sum())
+            .collect()
+    };
+    let energy = |eta: &[f64]| -> f64 {
+        let mut e = 0.0;
+        for i in 0..r {
+            let ki: f64 = (0..r).map(|j| rm.k[(i, j)] * eta[j]).sum();
+            e += eta[i] * (0.5 * ki - f[i]);
+        }
+        e + 0.5 * k_n * gaps_of(eta).iter().map(|g| g.min(0.0).powi(2)).sum::<f64>()
+    };
+    let max_steps = 20 * opts.max_iterations.max(1);
+    let mut eta = vec![0.0; r];
+    let mut active_counts = Vec::new();
+    for it in 1..=max_steps {
+        let active: Vec<bool> = gaps_of(&eta).iter().map(|&g| g < 0.0).collect();
+        active_counts.push(active.iter().filter(|&&a| a).count());
+        let mut h = rm.k.to_owned();
+        for i in (0..w).filter(|&i| active[i]) {
+            for c in 0..r {
+                let bc = k_n * b[(i, c)];
+                if bc != 0.0 {
+                    for rr in 0..r {
+                        h[(rr, c)] += b[(i, rr)] * bc;
+                    }
+                }
+            }
+        }
+        let llt = h.llt(Side::Lower).map_err(|e| {
+            Error::LinearAlgebra(format!(
+                "damped reduced contact, step {it}: K̃ + K_c is not positive definite: {e:?}"
+            ))
+        })?;
+        let rhs = Mat::from_fn(r, 1, |i, _| f[i]);
+        let x = faer::linalg::solvers::Solve::solve(&llt, &rhs);
+        let full: Vec<f64> = (0..r).map(|i| x[(i, 0)]).collect();
+        if full.iter().any(|v| !v.is_finite()) {
+            return Err(Error::LinearAlgebra(format!(
+                "damped reduced contact, step {it}: solution is not finite"
+            )));
+        }
+        let gaps = gaps_of(&full);
+        let next: Vec<bool> = gaps.iter().map(|&g| g < 0.0).collect();
+        if next == active {
+            let forces: Vec<f64> = gaps
+                .iter()
+                .zip(&active)
+                .map(|(&g, &a)| if a { k_n * g } else { 0.0 })
+                .collect();
+            let master = model.master_dofs();
+            let master_displacement =
+                master.map(|dof| (0..r).map(|c| rm.phi[(dof, c)] * full[c]).sum::<f64>());
+            let state = ContactState {
+                contact_force_norm: forces.iter().map(|p| p * p).sum::<f64>().sqrt(),
+                pairs_in_contact: active.iter().filter(|&&a| a).count(),
+                gaps,
+                forces,
+                active,
+                iterations: it,
+                active_counts,
+            };
+            return Ok(ReducedStatic {
+                eta: full,
+                master_displacement,
+                state,
+            });
+        }
+        // Armijo backtracking along d = full − η; ∇E·d = −dᵀ H_A d.
+        let d: Vec<f64> = full.iter().zip(&eta).map(|(a, b)| a - b).collect();
+        let mut hd = vec![0.0; r];
+        for c in 0..r {
+            for rr in 0..r {
+                hd[rr] += h[(rr, c)] * d[c];
+            }
+        }
+        let slope = -d.iter().zip(&hd).map(|(a, b)| a * b).sum::<f64>();
+        let e0 = energy(&eta);
+        let mut t = 1.0;
+        loop {
+            let trial: Vec<f64> = eta.iter().zip(&d).map(|(e, dd)| e + t * dd).collect();
+            if energy(&trial) <= e0 + 1e-4 * t * slope {
+                eta = trial;
+                break;
+            }
+            t *= 0.5;
+            if t < 1e-12 {
+                return Err(Error::LinearAlgebra(format!(
+                    "damped reduced contact, step {it}: line search failed (no decrease of the \
+                     contact energy along the Newton direction)"
+                )));
+            }
+        }
+    }
+    Err(Error::LinearAlgebra(format!(
+        "damped reduced contact did not converge in {max_steps} steps"
+    )))
+}
+
+/// What `jointrom static --basis` reports.
+#[derive(Clone, Debug)]
+pub struct BasisStatic {
+    /// The kind's name ([`BASIS_KINDS`]).
+    pub basis: &'static str,
+    /// Enrichment vectors used (joint modes; extra modes for `modes`).
+    pub g: usize,
+    /// Columns of the final basis r.
+    pub basis_size: usize,
+    /// The reduced solution.
+    pub solution: ReducedStatic,
+    /// Whether the active-set iteration failed and the damped one solved it (see
+    /// [`reduced_contact_static_restarting`]).
+    pub restarted: bool,
+    /// Basis build time (s).
+    pub build_s: f64,
+    /// Projection and contact solve time (s).
+    pub solve_s: f64,
+}
+
+/// Builds the basis `kind` with `opts` ([`build_basis`]) and solves the reduced contact statics
+/// under the case load times `scale`. An explicit `opts.g` larger than the kind has vectors is
+/// an error naming `--g` (never clamped).
+pub fn basis_static(
+    model: &Model,
+    kind: BasisKind,
+    opts: &BasisOptions,
+    scale: f64,
+) -> Result<BasisStatic, Error> {
+    scaled_load(model, scale)?;
+    let t0 = Instant::now();
+    let basis = build_basis(model, kind, opts)?;
+    let build_s = t0.elapsed().as_secs_f64();
+    if let Some(g) = opts.g {
+        if basis.g < g {
+            return Err(Error::Invalid(format!(
+                "--g {g}: basis `{}` has only {} enrichment vectors on {}",
+                basis_name(kind),
+                basis.g,
+                model.name
+            )));
+        }
+    }
+    let t1 = Instant::now();
+    let basis_size = basis.phi.ncols();
+    let rm = ReducedModel::new(model, basis.phi)?;
+    let (solution, first) =
+        reduced_contact_static_restarting(model, &rm, scale, &ContactOptions::default())?;
+    Ok(BasisStatic {
+        restarted: first.is_some(),
+        basis: basis_name(kind),
+        g: basis.g,
+        basis_size,
+        solution,
+        build_s,
+        solve_s: t1.elapsed().as_secs_f64(),
+    })
+}
+
+/// What `jointrom basis` reports.
+#[derive(Clone, Debug, Serialize)]
+pub struct BasisSummary {
+    /// Case name.
+    pub case: String,
+    /// `tvd` or `tvd-plain`.
+    pub kind: &'static str,
+    /// Fixed-interface modes ν.
+    pub nu: usize,
+    /// K-weighted POD energy ratio `w[g − 1] = w(g)` (eq. 26), g = 1 ..= p.
+    pub w: Vec<f64>,
+    /// Plain POD energy ratio (eq. 26 with eqs. 20–22), g = 1 ..= p.
+    pub w_plain: Vec<f64>,
+    /// g used: the given one, or the smallest with `w(g) ≥ threshold` (of the kind's POD).
+    pub g_chosen: usize,
+    /// The threshold.
+    pub threshold: f64,
+    /// TVD candidates `2 (v + s)²`.
+    pub tvd_count: usize,
+    /// Kept (nonzero) TVD.
+    pub tvd_nonzero: usize,
+    /// Columns of the final basis.
+    pub basis_size: usize,
+    /// Directions dropped by the M-orthonormalization.
+    pub dropped: usize,
+    /// Time of the basis build ([`build_basis`]) (s).
+    pub build_s: f64,
+}
+
+/// The TVD basis of `kind` (`Tvd` or `TvdPlain`) with both POD energy curves.
+pub fn basis_summary(
+    model: &Model,
+    kind: BasisKind,
+    opts: &BasisOptions,
+) -> Result<BasisSummary, Error> {
+    if !matches!(kind, BasisKind::Tvd | BasisKind::TvdPlain) {
+        return Err(Error::Invalid(format!(
+            "--kind {}: must be tvd or tvd-plain",
+            basis_name(kind)
+        )));
+    }
+    if !(opts.threshold > 0.0 && opts.threshold <= 1.0) {
+        return Err(Error::Invalid(format!(
+            "--threshold must be in (0, 1], got {}",
+            opts.threshold
+        )));
+    }
+    let t0 = Instant::now();
+    let basis = build_basis(model, kind, opts)?;
+    let build_s = t0.elapsed().as_secs_f64();
+    if let Some(g) = opts.g {
+        if basis.g < g {
+            return Err(Error::Invalid(format!(
+                "--g {g}: the POD of the TVD has only {} modes on {}",
+                basis.g, model.name
+            )));
+        }
+    }
+    // The other POD's energy curve (the basis builder returns the kind's own only).
+    let other = if kind == BasisKind::Tvd {
+        BasisKind::TvdPlain
+    } else {
+        BasisKind::Tvd
+    };
+    let w_other = build_basis(
+        model,
+        other,
+        &BasisOptions {
+            g: Some(0),
+            ..*opts
+        },
+    )?
+    .w;
+    let (w, w_plain) = if kind == BasisKind::Tvd {
+        (basis.w, w_other)
+    } else {
+        (w_other, basis.w)
+    };
+    Ok(BasisSummary {
+        case: model.name.clone(),
+        kind: basis_name(kind),
+        nu: opts.nu,
+        w,
+        w_plain,
+        g_chosen: basis.g,
+        threshold: opts.threshold,
+        tvd_count: basis.tvd_total,
+        tvd_nonzero: basis.tvd_nonzero,
+        basis_size: basis.phi.ncols(),
+        dropped: basis.dropped,
+        build_s,
+    })
+}
+
+/// Options of [`run_study`]. Defaults: `nu = 10`, `max_g = 60`, `scale = 1`,
+/// `threshold =` [`DEFAULT_THRESHOLD`], `drop_tol =` [`DEFAULT_DROP_TOL`], default contact
+/// options.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StudyOptions {
+    /// Fixed-interface modes ν of the Craig–Bampton part.
+    pub nu: usize,
+    /// Largest number of enrichment vectors g.
+    pub max_g: usize,
+    /// Factor on the case's master load.
+    pub scale: f64,
+    /// Threshold on w(g) reported as the a-priori choice of g (eq. 26).
+    pub threshold: f64,
+    /// Drop tolerance of [`final_basis`].
+    pub drop_tol: f64,
+    /// Active-set Newton options (full and reduced).
+    pub contact: ContactOptions,
+}
+
+impl Default for StudyOptions {
+    fn default() -> Self {
+        StudyOptions {
+            nu: 10,
+            max_g: 60,
+            scale: 1.0,
+            threshold: DEFAULT_THRESHOLD,
+            drop_tol: DEFAULT_DROP_TOL,
+            contact: ContactOptions::default(),
+        }
+    }
+}
+
+/// The full-FE reference of the study.
+#[derive(Clone, Debug, Serialize)]
+pub struct FullReference {
+    /// `‖f_c‖` (N).
+    pub contact_force_norm: f64,
+    /// Pairs in contact.
+    pub pairs_in_contact: usize,
+    /// Master displacement (mm, rad).
+    pub master_displacement: [f64; 6],
+    /// Solve time (s).
+    pub solve_s: f64,
+}
+
+/// First g at which a series is within a relative tolerance of the full value.
+#[derive(Clone, Debug, Serialize)]
+pub struct Within {
+    /// The relative tolerance on `‖f_c‖`.
+    pub tol: f64,
+    /// The first g with error ≤ tol (`None`: never within `max_g`).
+    pub first: Option<usize>,
+    /// The smallest g from which every later g of the series is within tol.
+    pub stays: Option<usize>,
+}
+
+/// A reduced contact solve that failed at one g.
+#[derive(Clone, Debug, Serialize)]
+pub struct Failure {
+    /// The g.
+    pub g: usize,
+    /// The error.
+    pub error: String,
+}
+
+/// One basis kind's convergence curve.
+#[derive(Clone, Debug, Serialize)]
+pub struct ConvergenceSeries {
+    /// Short name (`tvd`, `tvd-plain`, `tvd-kt`, `modes`, ...).
+    pub name: String,
+    /// Legend text.
+    pub label: String,
+    /// Enrichment vectors available (the series stops at `min(available, max_g)`).
+    pub available: usize,
+    /// g = 0, 1, ...
+    pub g: Vec<usize>,
+    /// Final basis size r at each g.
+    pub basis_size: Vec<usize>,
+    /// `‖f_c‖` (N) at each g.
+    pub contact_force_norm: Vec<f64>,
+    /// `|‖f_c‖ − ‖f_c‖_full| / ‖f_c‖_full`.
+    pub relative_error: Vec<f64>,
+    /// `‖p − p_full‖ / ‖p_full‖` (pair force vectors).
+    pub force_vector_error: Vec<f64>,
+    /// Pairs in contact at each g.
+    pub pairs_in_contact: Vec<usize>,
+    /// Where the series gets within 1e-2 and 1e-4.
+    pub within: Vec<Within>,
+    /// g where the active-set Newton method failed (cycled) and the damped one
+    /// ([`reduced_contact_static_damped`]) solved it.
+    pub restarts: Vec<Failure>,
+    /// g where both failed: the values are NaN (`null` in JSON) there.
+    pub failures: Vec<Failure>,
+    /// Time to prepare the enrichment vectors (TVD + POD, or modes) (s).
+    pub prepare_s: f64,
+    /// Time of the sweep over g (orthonormalization, projection, contact solves) (s).
+    pub sweep_s: f64,
+}
+
+/// A POD energy-ratio curve.
+#[derive(Clone, Debug, Serialize)]
+pub struct EnergyCurve {
+    /// Short name (`tvd`, `tvd-plain`, `tvd-kt`).
+    pub name: String,
+    /// Legend text.
+    pub label: String,
+    /// `w[g − 1] = w(g)`, g = 1 ..= max_g (or p if fewer).
+    pub w: Vec<f64>,
+    /// Smallest g with `w(g) ≥ threshold`.
+    pub g_threshold: usize,
+    /// Nonzero TVD columns p.
+    pub tvd_nonzero: usize,
+    /// Kept POD modes (eigenvalues above the zero threshold).
+    pub pod_modes: usize,
+}
+
+/// The reduced solution on `[Φ_S Φ_V | all nonzero TVD]` (no POD): the limit the POD series
+/// of this TVD variant can reach, up to the POD's numerical-zero cut and
+/// the basis drop tolerance.
+#[derive(Clone, Debug, Serialize)]
+pub struct SpanReference {
+    /// TVD variant (`tvd`: k_n only; `tvd-kt`: k_n and k_t).
+    pub name: String,
+    /// Columns kept by the M-orthonormalization.
+    pub basis_size: usize,
+    /// Columns dropped as dependent.
+    pub dropped: usize,
+    /// `‖f_c‖` (N); NaN if the solve failed.
+    pub contact_force_norm: f64,
+    /// Relative error of `‖f_c‖`.
+    pub relative_error: f64,
+    /// Time (s).
+    pub solve_s: f64,
+}
+
+/// See [`SpanReference`].
+fn span_reference(
+    model: &Model,
+    full: &ContactState,
+    cb: MatRef<'_, f64>,
+    tvd: MatRef<'_, f64>,
+    opts: &StudyOptions,
+    name: &str,
+) -> Result<SpanReference, Error> {
+    let t0 = Instant::now();
+    let (phi, dropped) = final_basis(&[cb, tvd], &model.mass, opts.drop_tol)?;
+    let basis_size = phi.ncols();
+    let rm = ReducedModel::new(model, phi)?;
+    let norm = reduced_contact_static_restarting(model, &rm, opts.scale, &opts.contact)
+        .map(|(s, _)| s.state.contact_force_norm)
+        .unwrap_or(f64::NAN);
+    Ok(SpanReference {
+        name: name.into(),
+        basis_size,
+        dropped,
+        contact_force_norm: norm,
+        relative_error: (norm - full.contact_force_norm).abs() / full.contact_force_norm,
+        solve_s: t0.elapsed().as_secs_f64(),
+    })
+}
+
+/// The whole study of one case.
+#[derive(Clone, Debug, Serialize)]
+pub struct Study {
+    /// Case name.
+    pub case: String,
+    /// Model DOF.
+    pub dofs: usize,
+    /// Joint pairs.
+    pub pairs: usize,
+    /// ν.
+    pub nu: usize,
+    /// Largest g.
+    pub max_g: usize,
+    /// Load factor.
+    pub scale: f64,
+    /// The w threshold of `g_threshold`.
+    pub threshold: f64,
+    /// The full-FE value.
+    pub full: FullReference,
+    /// Convergence curves, one per basis kind.
+    pub series: Vec<ConvergenceSeries>,
+    /// POD energy curves.
+    pub energy: Vec<EnergyCurve>,
+    /// The limit of each TVD variant without POD truncation, `[Φ_S Φ_V | all TVD]`, and
+    /// `alldof`, `[Φ_S Φ_V | K⁻¹ b_nᵀ of every pair]`.
+    pub tvd_spans: Vec<SpanReference>,
+    /// Craig–Bampton time (s).
+    pub craig_bampton_s: f64,
+    /// Whole study time (s), charts excluded.
+    pub total_s: f64,
+}
+
+/// One TVD variant of the study: name, legend, TVD options, K-weighted POD?
+struct TvdVariant {
+    name: &'static str,
+    label: &'static str,
+    tvd: TvdOptions,
+    weighted: bool,
+}
+
+/// The TVD variants of the study (the one list; POD variants of one TVD share its computation).
+fn tvd_variants() -> Vec<TvdVariant> {
+    let kn = TvdOptions::default();
+    let knkt = TvdOptions {
+        tangential: true,
+        ..kn
+    };
+    vec![
+        TvdVariant {
+            name: "tvd",
+            label: "TVD, K-weighted POD (eq. 16)",
+            tvd: kn,
+            weighted: true,
+        },
+        TvdVariant {
+            name: "tvd-plain",
+            label: "TVD, plain POD",
+            tvd: kn,
+            weighted: false,
+        },
+        TvdVariant {
+            name: "tvd-inertia",
+            label: "TVD with inertia (eq. 15), K-weighted POD",
+            tvd: TvdOptions {
+                inertia: true,
+                ..kn
+            },
+            weighted: true,
+        },
+        TvdVariant {
+            name: "tvd-kt",
+            label: "TVD with k_n + k_t, K-weighted POD",
+            tvd: knkt,
+            weighted: true,
+        },
+    ]
+}
+
+/// Runs the study (see the module docs).
+pub fn run_study(model: &Model, opts: &StudyOptions) -> Result<Study, Error> {
+    let t_all = Instant::now();
+    let load = scaled_load(model, opts.scale)?;
+    if !(opts.threshold > 0.0 && opts.threshold <= 1.0) {
+        return Err(Error::Invalid(format!(
+            "threshold must be in (0, 1], got {}",
+            opts.threshold
+        )));
+    }
+    let t0 = Instant::now();
+    let full = contact_static_full(model, load, &opts.contact)?;
+    let full_ref = FullReference {
+        contact_force_norm: full.state.contact_force_norm,
+        pairs_in_contact: full.state.pairs_in_contact,
+        master_displacement: full.master_displacement,
+        solve_s: t0.elapsed().as_secs_f64(),
+    };
+    if full_ref.contact_force_norm.is_nan() || full_ref.contact_force_norm <= 0.0 {
+        return Err(Error::Invalid(format!(
+            "{}: the full model has no pair in contact under this load (‖f_c‖ = 0), so there is \
+             no contact force to converge to; try --scale -1",
+            model.name
+        )));
+    }
+
+    let t0 = Instant::now();
+    let cb = craig_bampton(model, opts.nu)?;
+    let craig_bampton_s = t0.elapsed().as_secs_f64();
+
+    let mut series = Vec::new();
+    let mut energy = Vec::new();
+    // TVD variants: each distinct TvdOptions computed once.
+    let mut tvd_cache: Vec<(TvdOptions, crate::reduction::Tvd, f64)> = Vec::new();
+    let mut spans = Vec::new();
+    for v in tvd_variants() {
+        let t0 = Instant::now();
+        let idx = match tvd_cache.iter().position(|(o, _, _)| *o == v.tvd) {
+            Some(i) => i,
+            None => {
+                let tvd = trial_vector_derivatives(model, cb.as_ref(), &v.tvd)?;
+                tvd_cache.push((v.tvd, tvd, t0.elapsed().as_secs_f64()));
+                tvd_cache.len() - 1
+            }
+        };
+        let (_, tvd, tvd_s) = &tvd_cache[idx];
+        if v.weighted && !spans.iter().any(|x: &SpanReference| x.name == v.name) {
+            spans.push(span_reference(
+                model,
+                &full.state,
+                cb.as_ref(),
+                tvd.vectors.as_ref(),
+                opts,
+                v.name,
+            )?);
+        }
+        let p = crate::reduction::pod_tvd(model, tvd, v.weighted)?;
+        let prepare_s = tvd_s + t0.elapsed().as_secs_f64();
+        energy.push(EnergyCurve {
+            name: v.name.into(),
+            label: v.label.into(),
+            w: p.w.iter().copied().take(opts.max_g).collect(),
+            g_threshold: p.choose_g(opts.threshold),
+            tvd_nonzero: tvd.nonzero(),
+            pod_modes: p.lambda.len(),
+        });
+        let s = sweep(
+            model,
+            &full.state,
+            cb.as_ref(),
+            p.poms.as_ref(),
+            opts,
+            (v.name, v.label),
+        )?;
+        series.push(ConvergenceSeries { prepare_s, ..s });
+    }
+
+    // Modes only: modes ν+1 ..= ν+max_g once (dense, see `dense_fixed_interface_modes`);
+    // g extra modes = their leading columns.
+    {
+        let t0 = Instant::now();
+        let extra = dense_fixed_interface_modes(model, opts.nu, opts.max_g)?;
+        let prepare_s = t0.elapsed().as_secs_f64();
+        let s = sweep(
+            model,
+            &full.state,
+            cb.as_ref(),
+            extra.as_ref(),
+            opts,
+            ("modes", "Craig–Bampton, ν + g modes"),
+        )?;
+        series.push(ConvergenceSeries { prepare_s, ..s });
+    }
+
+    // Joint Interface Modes (paper Section 5.3): max_g of them once, g = leading columns.
+    {
+        let t0 = Instant::now();
+        let jim = jim_vectors(model, opts.max_g, JimSet::Both)?;
+        let prepare_s = t0.elapsed().as_secs_f64();
+        let s = sweep(
+            model,
+            &full.state,
+            cb.as_ref(),
+            jim.as_ref(),
+            opts,
+            ("jim", "Craig–Bampton + g Joint Interface Modes"),
+        )?;
+        series.push(ConvergenceSeries { prepare_s, ..s });
+    }
+    // All joint DOF (paper Section 5.1): the exact limit, one column per pair.
+    spans.push(span_reference(
+        model,
+        &full.state,
+        cb.as_ref(),
+        alldof_vectors(model)?.as_ref(),
+        opts,
+        "alldof",
+    )?);
+
+    Ok(Study {
+        case: model.name.clone(),
+        dofs: model.dofs(),
+        pairs: model.joint.pairs(),
+        nu: opts.nu,
+        max_g: opts.max_g,
+        scale: opts.scale,
+        threshold: opts.threshold,
+        full: full_ref,
+        series,
+        energy,
+        tvd_spans: spans,
+        craig_bampton_s,
+        total_s: t_all.elapsed().as_secs_f64(),
+    })
+}
+
+/// The convergence tolerances reported in [`ConvergenceSeries::within`].
+pub const WITHIN_TOLS: [f64; 2] = [1e-2, 1e-4];
+
+/// `‖f_c‖` of `[base | extra[:, ..g]]` for g = 0 ..= min(max_g, extra.ncols()).
+fn sweep(
+    model: &Model,
+    full: &ContactState,
+    base: MatRef<'_, f64>,
+    extra: MatRef<'_, f64>,
+    opts: &StudyOptions,
+    (name, label): (&str, &str),
+) -> Result<ConvergenceSeries, Error> {
+    let t0 = Instant::now();
+    let available = extra.ncols();
+    let top = opts.max_g.min(available);
+    let fnorm = full.contact_force_norm;
+    let mut s = ConvergenceSeries {
+        name: name.into(),
+        label: label.into(),
+        available,
+        g: Vec::new(),
+        basis_size: Vec::new(),
+        contact_force_norm: Vec::new(),
+        relative_error: Vec::new(),
+        force_vector_error: Vec::new(),
+        pairs_in_contact: Vec::new(),
+        within: Vec::new(),
+        restarts: Vec::new(),
+        failures: Vec::new(),
+        prepare_s: 0.0,
+        sweep_s: 0.0,
+    };
+    for g in 0..=top {
+        let (phi, _) = final_basis(&[base, extra.subcols(0, g)], &model.mass, opts.drop_tol)?;
+        let r = phi.ncols();
+        let rm = ReducedModel::new(model, phi)?;
+        let sol = match reduced_contact_static_restarting(model, &rm, opts.scale, &opts.contact) {
+            Ok((sol, None)) => sol,
+            Ok((sol, Some(first))) => {
+                s.restarts.push(Failure {
+                    g,
+                    error: first.to_string(),
+                });
+                sol
+            }
+            Err(e) => {
+                s.failures.push(Failure {
+                    g,
+                    error: e.to_string(),
+                });
+                s.g.push(g);
+                s.basis_size.push(r);
+                s.contact_force_norm.push(f64::NAN);
+                s.relative_error.push(f64::NAN);
+                s.force_vector_error.push(f64::NAN);
+                s.pairs_in_contact.push(0);
+                continue;
+            }
+        };
+        let st = &sol.state;
+        let dp: f64 = st
+            .forces
+            .iter()
+            .zip(&full.forces)
+            .map(|(a, b)| (a - b) * (a - b))
+            .sum::<f64>()
+            .sqrt();
+        s.g.push(g);
+        s.basis_size.push(r);
+        s.contact_force_norm.push(st.contact_force_norm);
+        s.relative_error
+            .push((st.contact_force_norm - fnorm).abs() / fnorm);
+        s.force_vector_error.push(dp / fnorm);
+        s.pairs_in_contact.push(st.pairs_in_contact);
+    }
+    s.within = WITHIN_TOLS
+        .iter()
+        .map(|&tol| within(&s.g, &s.relative_error, tol))
+        .collect();
+    s.sweep_s = t0.elapsed().as_secs_f64();
+    Ok(s)
+}
+
+/// First g, and the g from which all later ones are, with `err ≤ tol`.
+pub fn within(g: &[usize], err: &[f64], tol: f64) -> Within {
+    let first = err.iter().position(|&e| e <= tol).map(|i| g[i]);
+    let stays = match err.iter().rposition(|&e| e.is_nan() || e > tol) {
+        None => g.first().copied(),
+        Some(i) if i + 1 < g.len() => Some(g[i + 1]),
+        Some(_) => None,
+    };
+    Within { tol, first, stays }
+}
+
+/// Floor for drawing a zero relative error on a log axis.
+pub const ERROR_FLOOR: f64 = 1e-16;
+
+/// Writes the study's charts into `dir` as SVG and PNG; returns the files written.
+///
+/// - `fc_error`: relative error of `‖f_c‖` against g, log axis (errors below [`ERROR_FLOOR`]
+///   drawn at the floor; failed solves, NaN, leave a gap), with the 1e-2 and 1e-4 levels as
+///   reference lines;
+/// - `fc_norm`: `‖f_c‖` against g with the full-FE value (paper Figs. 7, 15, 19);
+/// - `w`: the POD energy ratios w(g) with the threshold (paper Figs. 8, 16).
+pub fn write_charts(
+    study: &Study,
+    dir: &std::path::Path,
+) -> Result<Vec<std::path::PathBuf>, Error> {
+    use crate::report::chart::{LegendPosition, LineChart, Reference, Series};
+    let mut files = Vec::new();
+    let case = &study.case;
+
+    let mut err = LineChart::new(
+        format!(
+            "{case}: static contact force convergence (ν = {})",
+            study.nu
+        ),
+        "added vectors g",
+        "relative error of ‖f_c‖",
+    );
+    err.y_log = true;
+    err.legend = LegendPosition::LowerLeft;
+    for s in &study.series {
+        err.series.push(Series::new(
+            s.label.clone(),
+            s.g.iter()
+                .zip(&s.relative_error)
+                .map(|(&g, &e)| (g as f64, if e.is_nan() { e } else { e.max(ERROR_FLOOR) }))
+                .collect(),
+        ));
+    }
+    for tol in WITHIN_TOLS {
+        err.references
+            .push(Reference::new(format!("{tol:.0e}"), tol));
+    }
+    for t in &study.tvd_spans {
+        // In the colour of the series it limits (alldof: the next free colour).
+        let k = study
+            .series
+            .iter()
+            .position(|s| s.name == t.name)
+            .unwrap_or(study.series.len());
+        let label = if t.name == "alldof" {
+            format!(
+                "alldof: CB + all pair constraint modes ({} columns)",
+                t.basis_size
+            )
+        } else {
+            format!("all {} TVD, no POD ({} columns)", t.name, t.basis_size)
+        };
+        err.references.push(Reference {
+            label,
+            value: t.relative_error.max(ERROR_FLOOR),
+            color: Some(crate::report::chart::series_color(k)),
+        });
+    }
+    files.extend(err.write(&dir.join("fc_error"))?);
+
+    let mut norm = LineChart::new(
+        format!("{case}: ‖f_c‖ of the reduced models (ν = {})", study.nu),
+        "added vectors g",
+        "‖f_c‖ (N)",
+    );
+    for s in &study.series {
+        norm.series.push(Series::new(
+            s.label.clone(),
+            s.g.iter()
+                .zip(&s.contact_force_norm)
+                .map(|(&g, &f)| (g as f64, f))
+                .collect(),
+        ));
+    }
+    norm.references.push(Reference::new(
+        format!("full FE, {:.6} N", study.full.contact_force_norm),
+        study.full.contact_force_norm,
+    ));
+    files.extend(norm.write(&dir.join("fc_norm"))?);
+
+    let mut w = LineChart::new(
+        format!("{case}: POD energy ratio w(g) of the TVD (eq. 26)"),
+        "POD modes g",
+        "w(g)",
+    );
+    for e in &study.energy {
+        w.series.push(Series::new(
+            e.label.clone(),
+            e.w.iter()
+                .enumerate()
+                .map(|(i, &v)| ((i + 1) as f64, v))
+                .collect(),
+        ));
+    }
+    w.legend = LegendPosition::LowerRight;
+    w.references.push(Reference::new(
+        format!("threshold {}", study.threshold),
+        study.threshold,
+    ));
+    files.extend(w.write(&dir.join("w"))?);
+    Ok(files)
+}
+
+/// Fixed-interface normal modes `skip + 1 ..= skip + count` (`K_ii φ = ω² M_ii φ`, master
+/// clamped, M-orthonormal, zero on the master DOF), n × count, by a dense solve: `K_ii = L Lᵀ`,
+/// the symmetric eigenproblem `L⁻¹ M_ii L⁻ᵀ y = μ y` with `μ = 1/ω²` (largest μ = lowest
+/// modes), `φ = L⁻ᵀ y / sqrt(μ)`.
+///
+/// Used for the `modes` series because it needs ν + 60 modes and the sparse Lanczos solver
+/// ([`Model::modes`]) fails its backward-error check beyond ~40 modes on the built-in cases.
+/// O(n³): fine for the built-in meshes (≈ 900 DOF, well under a second).
+pub fn dense_fixed_interface_modes(
+    model: &Model,
+    skip: usize,
+    count: usize,
+) -> Result<Mat<f64>, Error> {
+    let n = model.dofs();
+    let m = n.saturating_sub(6);
+    if skip + count > m {
+        return Err(Error::Invalid(format!(
+            "{} fixed-interface modes requested, the model has {m} interior DOF",
+            skip + count
+        )));
+    }
+    let k = model.stiffness.leading(m).to_dense();
+    let mut x = model.mass.leading(m).to_dense();
+    let llt = k.llt(Side::Lower).map_err(|e| {
+        Error::LinearAlgebra(format!("dense K_ii (fixed interface) Cholesky: {e:?}"))
+    })?;
+    let l = llt.L();
+    solve_lower_triangular_in_place(l, x.as_mut(), Par::Seq); // L⁻¹ M
+    let mut c = x.transpose().to_owned(); // M L⁻ᵀ
+    solve_lower_triangular_in_place(l, c.as_mut(), Par::Seq); // L⁻¹ M L⁻ᵀ
+    let c = Mat::from_fn(m, m, |i, j| 0.5 * (c[(i, j)] + c[(j, i)]));
+    let evd = c
+        .self_adjoint_eigen(Side::Lower)
+        .map_err(|e| Error::LinearAlgebra(format!("dense fixed-interface modes: {e:?}")))?;
+    let mu = evd.S().column_vector();
+    let u = evd.U();
+    let mut y = Mat::<f64>::zeros(m, count);
+    let mut scale = vec![0.0; count];
+    for c in 0..count {
+        let i = m - 1 - (skip + c); // ascending order: largest μ last
+        if !(mu[i] > 0.0 && mu[i].is_finite()) {
+            return Err(Error::LinearAlgebra(format!(
+                "dense fixed-interface mode {}: μ = 1/ω² = {:e} is not positive",
+                skip + c + 1,
+                mu[i]
+            )));
+        }
+        scale[c] = 1.0 / mu[i].sqrt();
+        for r in 0..m {
+            y[(r, c)] = u[(r, i)];
+        }
+    }
+    solve_upper_triangular_in_place(l.transpose(), y.as_mut(), Par::Seq); // L⁻ᵀ y
+    Ok(Mat::from_fn(n, count, |r, c| {
+        if r < m {
+            y[(r, c)] * scale[c]
+        } else {
+            0.0
+        }
+    }))
+}

@@ -1,0 +1,1373 @@
+//! The stability map of issue 4: where the integrator's methods fail on the jointed structures.
+//!
+//! ## The sweep
+//!
+//! Every combination of
+//!
+//! - model: the full FE model (eq. 6), the ROM with g = 0 (Craig–Bampton only) and the ROM with
+//!   the g chosen by the POD energy ratio `w(g) ≥ 0.9994` (eq. 26), both `BasisKind::Tvd` bases of
+//!   [`build_basis`] (eq. 7);
+//! - nonlinear iteration: functional (fixed point, no Anderson acceleration) or modified Newton
+//!   with the structured solve of `M + γ²(K + BᵀK_cB)` ([`NewtonLinear::Problem`]);
+//! - penalty stiffness k_n ∈ {1e2, 1e4, 1e6} N/mm (the case's `contact.normal_stiffness` is
+//!   overridden before the model is built, so the TVD see it too);
+//! - friction off / on, events (root finding on gaps and stick/slip switches with
+//!   re-initialisation) off / on, BDF max order 2 / 5,
+//!
+//! is integrated from rest over a short window ([`SweepOptions::end_time`], 0.01 s of the friction
+//! bar by default; the full model over [`SweepOptions::full_end_time`]) at the paper's Table 1
+//! tolerances, and each cell records its status (`ok`, the CVODE flag such as
+//! `CV_TOO_MUCH_WORK`, `budget`, `chatter` or `error`) with the time reached, the solver
+//! statistics, the wall time and the relative L2 error over the output times of `‖f_c‖(t)`
+//!
+//! ```text
+//! e = ‖fc_cell − fc_ref‖₂ / ‖fc_ref‖₂      (over the cell's output times)
+//! ```
+//!
+//! against the *reference* of its model, k_n and friction: Newton, max order 5, events off, at
+//! tolerances [`SweepOptions::reference_factor`] (100) times tighter. ROM cells also get
+//! `error_vs_full`, the same measure against the full model's reference over the full model's
+//! (shorter) window when that reference ran — the model error rather than the integration error.
+//!
+//! ## Bounded cost
+//!
+//! A cell cannot run away: CVODE's `max_steps` caps the steps per output interval (a cell over it
+//! fails with `CV_TOO_MUCH_WORK`), and a wall-clock budget per cell is enforced from inside the
+//! right-hand side (a wrapper problem returns a fatal callback error once the budget is spent, so
+//! CVODE stops at once; the cell is reported as `budget` with the time reached).
+//!
+//! ## Measured (friction bar, 2 shared cores, budget 8 s per cell, ROM window 0.01 s, full 1e-3 s)
+//!
+//! Run with `STABILITY_OUT=DIR STABILITY_BUDGET=8 STABILITY_FULL_END=1e-3 cargo test --release
+//! --test stability -- --ignored full_map --nocapture` (≈ 17 min for the 144 cells and 18
+//! references). The ROMs: g = 0 → r = 16, w(g)-chosen g = 12 → r = 28.
+//!
+//! - **ROMs, k_n ≤ 1e4**: every cell ok, functional and Newton alike (0.03–5.6 s); the
+//!   steps are bounded by accuracy, not stability, so functional iteration needs about as many
+//!   steps as Newton (friction on: ~2× more, the slip relaxation 1/τ enters ‖J‖ for sliding
+//!   pairs). Errors against the 100× tighter reference: g = 0 1e-5…8e-5; the w(g) ROM 1e-4…4e-4
+//!   at k_n = 1e2 but **~2 % at k_n = 1e4** in every cell, i.e. the paper's tolerances do not
+//!   resolve ‖f_c‖(t) of the richer basis over the first 0.01 s (the reference needs 2.5× the
+//!   steps).
+//! - **ROMs, k_n = 1e6**: g = 0 still ok (65 000–130 000 steps, errors 1–5 %); the w(g) ROM
+//!   exhausts the budget with Newton and with events (steps ≈ 4e-8 s): the penalty frequency
+//!   `√(k_n/m)` of the lightly loaded pairs sets an *accuracy* limit that Newton cannot lift;
+//!   functional cells that finish are 14–22 % off.
+//! - **Full model, functional iteration**: every cell `budget` (steps ≈ 2e-8 s, 0.1–0.6 ms
+//!   reached): `γ‖J‖ < 1` with the shells' membrane/drilling modes and the weld beams far above
+//!   the contact frequencies.
+//! - **Full model, Newton, events off**: k_n = 1e2 ok in 187 steps (error 1.5e-3 against the
+//!   tight reference); k_n = 1e4 ok at max order 2 (~2 000 steps, 1–2 s) but `budget` at max
+//!   order 5 (10 000 steps for 0.7–0.8 ms): BDF orders 3–5 are not A-stable on the undamped
+//!   high-frequency modes, so the controller keeps rejecting and shrinking high-order steps;
+//!   k_n = 1e6 `budget` except max order 2 with friction (9 052 steps, 5.4 s).
+//! - **Events on, full model**: every cell `budget` before 1e-5 s: from rest, gaps and
+//!   stick/slip switches of many pairs sit at zero and cross it at every step, and each root
+//!   restarts CVODE at order 1 with a tiny step.
+//! - No cell failed with a CVODE flag with `max_steps` = 20 000 per 1e-4 s output interval:
+//!   the wall budget binds first. With a small cap (tests/stability.rs: 100) functional
+//!   iteration at k_n = 1e6 fails with `CV_TOO_MUCH_WORK`.
+//! - The full-model references (rtol 1e-10, atol 1e-8) finished only for k_n = 1e2, friction
+//!   off (57 000 steps, 36 s); elsewhere they hit their 60 s budget, so full-model cells have
+//!   no error and ROM cells no `error_vs_full` except there: over that first millisecond
+//!   (‖f_c‖ still small) the ROM with g = 0 is off by a factor ~5 (4.77), the w(g) ROM by 24 %,
+//!   whatever the iteration, order or events.
+//!
+//! ## Failure kinds
+//!
+//! - `budget` with **functional iteration** (full model): the fixed point converges only while
+//!   `γ‖J‖ < 1` (γ = h β₀), so the step is bounded by the stiffest retained mode — the shells'
+//!   in-plane and drilling modes in the full model, the closed pairs' penalty frequency
+//!   `√(k_n/m)` in a ROM, and with friction the slip relaxation `1/τ` (τ = 1e-6 s) of sliding
+//!   pairs — whatever the accuracy needs.
+//! - `budget` with **BDF max order 5** where order 2 finishes (full model, k_n = 1e4): orders
+//!   3–5 are not A-stable near the imaginary axis, where an undamped structure's eigenvalues
+//!   ±iω lie; high-order steps over the fast modes fail the error test and the step shrinks.
+//! - `budget` with **events**: gaps of nearly closed pairs and stick/slip switches change sign
+//!   at nearly every step (penalty oscillation), each root restarts the integrator at order 1;
+//!   a switch that fires repeatedly at the same time would end the cell as `chatter`.
+//! - `budget` with **Newton at k_n = 1e6** (w(g) ROM, full model): the contact oscillation at
+//!   `√(k_n/m)` must be resolved to the tolerance, an accuracy limit that a stable implicit
+//!   method does not remove.
+//! - `CV_TOO_MUCH_WORK`: more than `max_steps` steps within one output interval, the same step
+//!   bounds as above met with a small cap.
+
+//! ## Outputs
+//!
+//! [`write_outputs`]: `stability.json` (every cell, the options and the references),
+//! `stability.md` (a markdown table) and three heat maps (SVG + PNG) — rows model × iteration ×
+//! max order, columns k_n × friction × events — coloured by status, by log10 of the wall time and
+//! by log10 of the error, the failure flag (and, on the status map, the time reached, s)
+//! written in failed cells.
+
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use serde::Serialize;
+
+use crate::case::Case;
+use crate::error::Error;
+use crate::integrate::mechanical::{EnergySample, MechanicalOde, ProblemOptions};
+use crate::integrate::problem::{
+    CallbackError, Iteration, NewtonLinear, OdeOptions, OdeProblem, OdeStats, Stop,
+};
+use crate::integrate::sundials::Cvode;
+use crate::model::Model;
+use crate::reduction::{build_basis, BasisKind, BasisOptions, ReducedModel};
+use crate::report::heatmap::{sequential, HeatCell, HeatMap};
+use crate::system::{FullSystem, ReducedSystem, SecondOrderSystem};
+
+/// The model of a cell.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+pub enum ModelKind {
+    /// The full FE model.
+    #[serde(rename = "full")]
+    Full,
+    /// ROM, TVD basis with g = 0 (Craig–Bampton).
+    #[serde(rename = "rom-g0")]
+    RomG0,
+    /// ROM, TVD basis with g chosen by w(g).
+    #[serde(rename = "rom")]
+    Rom,
+}
+
+impl ModelKind {
+    /// Every kind, in map order.
+    pub const ALL: [ModelKind; 3] = [ModelKind::Full, ModelKind::RomG0, ModelKind::Rom];
+
+    /// The CLI / JSON name.
+    pub fn name(self) -> &'static str {
+        match self {
+            ModelKind::Full => "full",
+            ModelKind::RomG0 => "rom-g0",
+            ModelKind::Rom => "rom",
+        }
+    }
+
+    /// Parses a CLI name.
+    pub fn parse(s: &str) -> Result<ModelKind, Error> {
+        ModelKind::ALL
+            .into_iter()
+            .find(|k| k.name() == s)
+            .ok_or_else(|| {
+                Error::Invalid(format!(
+                    "--models: unknown model {s:?}; valid: full, rom-g0, rom"
+                ))
+            })
+    }
+}
+
+/// The nonlinear iteration of a cell.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum IterKind {
+    /// Fixed point, no acceleration.
+    Functional,
+    /// Modified Newton with the structured solve.
+    Newton,
+}
+
+impl IterKind {
+    /// The CLI / JSON name.
+    pub fn name(self) -> &'static str {
+        match self {
+            IterKind::Functional => "functional",
+            IterKind::Newton => "newton",
+        }
+    }
+
+    /// Parses a CLI name.
+    pub fn parse(s: &str) -> Result<IterKind, Error> {
+        match s {
+            "functional" => Ok(IterKind::Functional),
+            "newton" => Ok(IterKind::Newton),
+            _ => Err(Error::Invalid(format!(
+                "--iterations: unknown iteration {s:?}; valid: functional, newton"
+            ))),
+        }
+    }
+
+    fn iteration(self) -> Iteration {
+        match self {
+            IterKind::Functional => Iteration::Functional { anderson: 0 },
+            IterKind::Newton => Iteration::Newton {
+                linear: NewtonLinear::Problem,
+            },
+        }
+    }
+}
+
+/// Options of [`run_sweep`]. Defaults: the whole map of the module docs, ROM window 0.01 s,
+/// full window 2e-4 s, outputs every 1e-4 s (ROM) / 1e-5 s (full), paper tolerances
+/// (rtol 1e-8, atol 1e-6), 20 000 steps per output interval, 20 s per cell, references 100×
+/// tighter with 3× the budget.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct SweepOptions {
+    /// Models.
+    pub models: Vec<ModelKind>,
+    /// Nonlinear iterations.
+    pub iterations: Vec<IterKind>,
+    /// Penalty stiffnesses k_n, N/mm.
+    pub normal_stiffness: Vec<f64>,
+    /// Friction off/on values.
+    pub friction: Vec<bool>,
+    /// Events off/on values.
+    pub events: Vec<bool>,
+    /// BDF maximum orders.
+    pub max_orders: Vec<usize>,
+    /// ROM window, s.
+    pub end_time: f64,
+    /// Full-model window, s.
+    pub full_end_time: f64,
+    /// ROM output spacing, s.
+    pub output_step: f64,
+    /// Full-model (and reference) output spacing, s.
+    pub full_output_step: f64,
+    /// Relative tolerance.
+    pub rtol: f64,
+    /// Absolute tolerance (mm of the physical field; see [`crate::integrate::mechanical`]).
+    pub atol: f64,
+    /// Velocity tolerance per displacement tolerance, 1/s
+    /// ([`crate::integrate::mechanical::ProblemOptions::velocity_scale`]).
+    pub velocity_scale: f64,
+    /// CVODE's maximum steps per output interval.
+    pub max_steps: usize,
+    /// Wall-clock budget per cell, s.
+    pub budget_s: f64,
+    /// Tolerance factor of the references (> 1).
+    pub reference_factor: f64,
+    /// Budget of a reference run, s.
+    pub reference_budget_s: f64,
+    /// Run the references (errors are `None` without).
+    pub references: bool,
+    /// Basis options of the ROMs (g is set to 0 for `rom-g0`).
+    #[serde(skip)]
+    pub basis: BasisOptions,
+    /// Print one line per cell to stderr.
+    pub progress: bool,
+}
+
+impl Default for SweepOptions {
+    fn default() -> Self {
+        SweepOptions {
+            models: ModelKind::ALL.to_vec(),
+            iterations: vec![IterKind::Functional, IterKind::Newton],
+            normal_stiffness: vec![1e2, 1e4, 1e6],
+            friction: vec![false, true],
+            events: vec![false, true],
+            max_orders: vec![2, 5],
+            end_time: 0.01,
+            full_end_time: 2e-4,
+            output_step: 1e-4,
+            full_output_step: 1e-5,
+            rtol: 1e-8,
+            atol: 1e-6,
+            velocity_scale: crate::integrate::mechanical::DEFAULT_VELOCITY_SCALE,
+            max_steps: 20_000,
+            budget_s: 20.0,
+            reference_factor: 100.0,
+            reference_budget_s: 60.0,
+            references: true,
+            basis: BasisOptions::default(),
+            progress: false,
+        }
+    }
+}
+
+/// One cell of the map.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Cell {
+    /// Model.
+    pub model: ModelKind,
+    /// Number of reduced coordinates (full: DOF).
+    pub dim: usize,
+    /// Nonlinear iteration.
+    pub iteration: IterKind,
+    /// k_n, N/mm.
+    pub normal_stiffness: f64,
+    /// Friction on.
+    pub friction: bool,
+    /// Events on.
+    pub events: bool,
+    /// BDF max order.
+    pub max_order: usize,
+    /// Window, s.
+    pub end_time: f64,
+    /// Outcome of the integration (see [`Outcome`]).
+    #[serde(flatten)]
+    pub outcome: Outcome,
+    /// Relative L2 error of ‖f_c‖(t) against the same model's reference (`None`: the cell or
+    /// the reference failed).
+    pub error: Option<f64>,
+    /// The same against the full model's reference over its window (ROM cells).
+    pub error_vs_full: Option<f64>,
+}
+
+/// Status, statistics and wall time of one integration.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Outcome {
+    /// `ok`, the CVODE flag (`CV_TOO_MUCH_WORK`, `CV_CONV_FAILURE`, `CV_ERR_FAILURE`, ...),
+    /// `budget`, `chatter` or `error`.
+    pub status: String,
+    /// The failure's message (`None` when ok).
+    pub message: Option<String>,
+    /// Time reached, s.
+    pub t_reached: f64,
+    /// Solver statistics.
+    pub stats: OdeStats,
+    /// Events located (re-initialisations).
+    pub events_found: u64,
+    /// Wall time of the integration (excluding building the system), s.
+    pub wall_s: f64,
+    /// Process CPU time of the integration, s (10 ms resolution; NaN where unavailable).
+    pub cpu_s: f64,
+    /// Output times, s.
+    #[serde(skip)]
+    pub t: Vec<f64>,
+    /// ‖f_c‖ at the output times, N.
+    #[serde(skip)]
+    pub fc: Vec<f64>,
+    /// ‖f_R‖ at the output times, N.
+    #[serde(skip)]
+    pub fr: Vec<f64>,
+    /// Master u_y at the output times, mm.
+    #[serde(skip)]
+    pub uy: Vec<f64>,
+}
+
+impl Outcome {
+    /// Whether the integration reached its end.
+    pub fn ok(&self) -> bool {
+        self.status == "ok"
+    }
+
+    fn push(&mut self, s: EnergySample) {
+        self.t.push(s.t);
+        self.fc.push(s.contact_force_norm);
+        self.fr.push(s.friction_force_norm);
+        self.uy.push(s.master[1]);
+    }
+}
+
+/// Integrates `sys` from rest over `[0, end]` with outputs every `output_step` under a
+/// wall-clock budget (checked in every right-hand side). Never fails as a whole: a setup or
+/// integration failure, or the budget running out (`budget`), becomes the outcome's status, with
+/// the curves up to the time reached.
+pub fn integrate_budgeted<S: SecondOrderSystem>(
+    sys: Result<S, Error>,
+    problem: &ProblemOptions,
+    ode: &OdeOptions,
+    end: f64,
+    output_step: f64,
+    budget_s: f64,
+) -> Outcome {
+    integrate(
+        sys,
+        &RunSpec {
+            problem: *problem,
+            ode: ode.clone(),
+            end,
+            output_step,
+            budget_s,
+        },
+    )
+}
+
+/// A reference run.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Reference {
+    /// Model.
+    pub model: ModelKind,
+    /// k_n, N/mm.
+    pub normal_stiffness: f64,
+    /// Friction on.
+    pub friction: bool,
+    /// rtol used.
+    pub rtol: f64,
+    /// atol used.
+    pub atol: f64,
+    /// Outcome.
+    #[serde(flatten)]
+    pub outcome: Outcome,
+    /// Relative L2 error of this reference's ‖f_c‖ against the full model's reference over the
+    /// full window (ROM references).
+    pub error_vs_full: Option<f64>,
+}
+
+/// A built model kind of one k_n.
+#[derive(Clone, Debug, Serialize)]
+pub struct Built {
+    /// Model kind.
+    pub model: ModelKind,
+    /// k_n, N/mm.
+    pub normal_stiffness: f64,
+    /// Coordinates.
+    pub dim: usize,
+    /// Joint modes g (ROMs).
+    pub g: Option<usize>,
+    /// Largest reduced eigenfrequency ω_max/2π without contact, Hz (ROMs).
+    pub max_frequency_hz: Option<f64>,
+    /// Build time (model or basis), s.
+    pub build_s: f64,
+}
+
+/// The result of [`run_sweep`].
+#[derive(Clone, Debug, Serialize)]
+pub struct Sweep {
+    /// Case name.
+    pub case: String,
+    /// Options.
+    pub options: SweepOptions,
+    /// The models built.
+    pub models: Vec<Built>,
+    /// The references.
+    pub references: Vec<Reference>,
+    /// Every cell.
+    pub cells: Vec<Cell>,
+    /// Total wall time, s.
+    pub wall_s: f64,
+}
+
+/// Wraps a problem with a wall-clock deadline checked in every right-hand-side evaluation.
+struct Budgeted<P> {
+    inner: P,
+    deadline: Instant,
+    exceeded: bool,
+}
+
+impl<P: OdeProblem> OdeProblem for Budgeted<P> {
+    fn dim(&self) -> usize {
+        self.inner.dim()
+    }
+    fn rhs(&mut self, t: f64, y: &[f64], ydot: &mut [f64]) -> Result<(), CallbackError> {
+        if Instant::now() > self.deadline {
+            self.exceeded = true;
+            return Err(CallbackError::Fatal("wall-clock budget exceeded".into()));
+        }
+        self.inner.rhs(t, y, ydot)
+    }
+    fn num_roots(&self) -> usize {
+        self.inner.num_roots()
+    }
+    fn roots(&mut self, t: f64, y: &[f64], g: &mut [f64]) -> Result<(), CallbackError> {
+        self.inner.roots(t, y, g)
+    }
+    fn atol_scale(&self, scale: &mut [f64]) -> bool {
+        self.inner.atol_scale(scale)
+    }
+    fn has_newton_solver(&self) -> bool {
+        self.inner.has_newton_solver()
+    }
+    fn newton_setup(
+        &mut self,
+        t: f64,
+        y: &[f64],
+        fy: &[f64],
+        jok: bool,
+        gamma: f64,
+    ) -> Result<bool, CallbackError> {
+        self.inner.newton_setup(t, y, fy, jok, gamma)
+    }
+    fn newton_solve(
+        &mut self,
+        t: f64,
+        y: &[f64],
+        r: &[f64],
+        z: &mut [f64],
+        gamma: f64,
+    ) -> Result<(), CallbackError> {
+        self.inner.newton_solve(t, y, r, z, gamma)
+    }
+}
+
+/// Roots in a row without progress in time after which a cell is `chatter`.
+const MAX_STALLED_ROOTS: usize = 1000;
+
+/// What one integration needs besides the system.
+#[derive(Clone, Debug)]
+struct RunSpec {
+    problem: ProblemOptions,
+    ode: OdeOptions,
+    end: f64,
+    output_step: f64,
+    budget_s: f64,
+}
+
+/// The status name of an integration error: the CVODE flag where there is one.
+fn classify(e: &Error) -> String {
+    let flag_in = |s: &str| {
+        s.split(|c: char| !(c.is_ascii_alphanumeric() || c == '_'))
+            .find(|w| w.starts_with("CV_"))
+            .map(str::to_string)
+    };
+    match e {
+        Error::Sundials { flag, .. } => flag_in(flag).unwrap_or_else(|| "sundials".into()),
+        Error::Callback { flag, .. } => flag_in(flag).unwrap_or_else(|| "callback".into()),
+        Error::Invalid(m) if m.contains("chattering") => "chatter".into(),
+        _ => "error".into(),
+    }
+}
+
+/// Integrates `sys` from rest; never fails as a whole: setup and integration errors become the
+/// outcome's status.
+fn integrate<S: SecondOrderSystem>(sys: Result<S, Error>, spec: &RunSpec) -> Outcome {
+    let mut out = Outcome {
+        status: "ok".into(),
+        message: None,
+        t_reached: 0.0,
+        stats: OdeStats::default(),
+        events_found: 0,
+        wall_s: 0.0,
+        cpu_s: 0.0,
+        t: Vec::new(),
+        fc: Vec::new(),
+        fr: Vec::new(),
+        uy: Vec::new(),
+    };
+    let fail = |mut out: Outcome, e: Error| {
+        out.status = classify(&e);
+        out.message = Some(e.to_string());
+        out
+    };
+    let ode = match sys.and_then(|s| MechanicalOde::new(s, &spec.problem)) {
+        Ok(o) => o,
+        Err(e) => return fail(out, e),
+    };
+    let mut ode = ode;
+    let y0 = ode.initial_state();
+    out.push(ode.sample(0.0, &y0));
+    let wall = Instant::now();
+    let cpu = crate::integrate::mechanical::cpu_time();
+    let problem = Budgeted {
+        inner: ode,
+        deadline: wall + std::time::Duration::from_secs_f64(spec.budget_s),
+        exceeded: false,
+    };
+    let mut cv = match Cvode::new(problem, 0.0, &y0, &spec.ode) {
+        Ok(c) => c,
+        Err(e) => return fail(out, e),
+    };
+    let outputs = (spec.end / spec.output_step - 1e-9).ceil().max(1.0) as usize;
+    let mut last_root_t = f64::NEG_INFINITY;
+    let mut stalled = 0usize;
+    let mut result: Result<(), Error> = Ok(());
+    'outer: for k in 1..=outputs {
+        let tout = (k as f64 * spec.output_step).min(spec.end);
+        loop {
+            match cv.solve_to(tout) {
+                Ok(Stop::Reached(_)) => break,
+                Ok(Stop::Root { t, .. }) => {
+                    out.events_found += 1;
+                    if t - last_root_t <= 1e-13 * t.abs().max(1e-3) {
+                        stalled += 1;
+                        if stalled > MAX_STALLED_ROOTS {
+                            result = Err(Error::Invalid(format!(
+                                "events: {MAX_STALLED_ROOTS} roots without progress at \
+                                 t = {t} s (chattering switch)"
+                            )));
+                            break 'outer;
+                        }
+                    } else {
+                        stalled = 0;
+                    }
+                    last_root_t = t;
+                    let y = cv.y().to_vec();
+                    if let Err(e) = cv.reinit(t, &y) {
+                        result = Err(e);
+                        break 'outer;
+                    }
+                }
+                Err(e) => {
+                    result = Err(e);
+                    break 'outer;
+                }
+            }
+        }
+        let t = cv.t();
+        let y = cv.y().to_vec();
+        out.push(cv.problem_mut().inner.sample(t, &y));
+    }
+    out.wall_s = wall.elapsed().as_secs_f64();
+    out.cpu_s = crate::integrate::mechanical::cpu_time() - cpu;
+    out.stats = cv.stats();
+    out.t_reached = cv.t();
+    if let Err(e) = result {
+        let budget = cv.problem().exceeded;
+        out = fail(out, e);
+        if budget {
+            out.status = "budget".into();
+        }
+    }
+    out
+}
+
+/// Relative L2 difference of `a` against `reference` over the times of `a` that the reference
+/// has too (matched to 1e-6 of the smaller spacing); `None` with fewer than 2 matched nonzero
+/// points or a zero reference.
+pub fn relative_l2(t_a: &[f64], a: &[f64], t_ref: &[f64], reference: &[f64]) -> Option<f64> {
+    let spacing = |t: &[f64]| {
+        t.windows(2)
+            .map(|w| w[1] - w[0])
+            .filter(|d| *d > 0.0)
+            .fold(f64::INFINITY, f64::min)
+    };
+    let tol = 1e-6 * spacing(t_a).min(spacing(t_ref));
+    if !tol.is_finite() {
+        return None;
+    }
+    let (mut num, mut den, mut matched) = (0.0, 0.0, 0usize);
+    let mut j = 0;
+    for (i, &t) in t_a.iter().enumerate() {
+        while j < t_ref.len() && t_ref[j] < t - tol {
+            j += 1;
+        }
+        if j < t_ref.len() && (t_ref[j] - t).abs() <= tol {
+            num += (a[i] - reference[j]).powi(2);
+            den += reference[j].powi(2);
+            if reference[j] != 0.0 {
+                matched += 1;
+            }
+        }
+    }
+    (matched >= 2 && den > 0.0).then(|| (num / den).sqrt())
+}
+
+/// A model of one k_n, ready to build systems.
+enum Prepared {
+    Full,
+    Rom(Box<ReducedModel>),
+}
+
+fn system_run(model: &Model, prep: &Prepared, spec: &RunSpec) -> Outcome {
+    match prep {
+        Prepared::Full => integrate(FullSystem::new(model), spec),
+        Prepared::Rom(rm) => integrate(ReducedSystem::new(model, rm), spec),
+    }
+}
+
+fn check_options(o: &SweepOptions) -> Result<(), Error> {
+    let pos = |name: &str, v: f64| {
+        if v.is_finite() && v > 0.0 {
+            Ok(())
+        } else {
+            Err(Error::Invalid(format!(
+                "{name} must be finite and positive, got {v}"
+            )))
+        }
+    };
+    pos("end_time", o.end_time)?;
+    pos("full_end_time", o.full_end_time)?;
+    pos("output_step", o.output_step)?;
+    pos("full_output_step", o.full_output_step)?;
+    pos("rtol", o.rtol)?;
+    pos("atol", o.atol)?;
+    pos("budget_s", o.budget_s)?;
+    pos("reference_budget_s", o.reference_budget_s)?;
+    if !(o.reference_factor.is_finite() && o.reference_factor >= 1.0) {
+        return Err(Error::Invalid(format!(
+            "reference_factor must be ≥ 1, got {}",
+            o.reference_factor
+        )));
+    }
+    for &k in &o.normal_stiffness {
+        pos("normal_stiffness", k)?;
+    }
+    if let Some(m) = o.max_orders.iter().find(|m| !(1..=5).contains(*m)) {
+        return Err(Error::Invalid(format!(
+            "max_orders: BDF order must be 1–5, got {m}"
+        )));
+    }
+    if o.max_steps == 0 {
+        return Err(Error::Invalid("max_steps must be positive".into()));
+    }
+    if o.models.is_empty()
+        || o.iterations.is_empty()
+        || o.normal_stiffness.is_empty()
+        || o.friction.is_empty()
+        || o.events.is_empty()
+        || o.max_orders.is_empty()
+    {
+        return Err(Error::Invalid(
+            "every sweep axis needs at least one value".into(),
+        ));
+    }
+    Ok(())
+}
+
+/// Runs the map on a case (see the module docs). Only bad options and failures to build a
+/// model or basis are errors; every integration failure is a cell's status.
+pub fn run_sweep(case: &Case, opts: &SweepOptions) -> Result<Sweep, Error> {
+    check_options(opts)?;
+    let t0 = Instant::now();
+    let model = Model::from_case(case.clone())?;
+    let model_s = t0.elapsed().as_secs_f64();
+    run_sweep_model(&model, model_s, opts)
+}
+
+/// [`run_sweep`] on a built model (a case's or a user's matrices, [`crate::model::matrices`]);
+/// `model_s` is the time it took to build, reported with the full model's cells. Each k_n
+/// value only changes the contact law: K, M and B are shared.
+pub fn run_sweep_model(base: &Model, model_s: f64, opts: &SweepOptions) -> Result<Sweep, Error> {
+    check_options(opts)?;
+    let t_all = Instant::now();
+    let progress = |s: &str| {
+        if opts.progress {
+            eprintln!("{s}");
+        }
+    };
+    let mut built = Vec::new();
+    let mut references = Vec::new();
+    let mut cells = Vec::new();
+    for &kn in &opts.normal_stiffness {
+        let mut model = base.clone();
+        model.contact.normal_stiffness = kn;
+        // Prepared models, full first so that its reference is there for the ROMs.
+        let mut order = opts.models.clone();
+        order.sort_by_key(|m| ModelKind::ALL.iter().position(|k| k == m));
+        order.dedup();
+        let mut prepared = Vec::new();
+        for &kind in &order {
+            let t0 = Instant::now();
+            let (prep, dim, g, fmax) = match kind {
+                ModelKind::Full => (Prepared::Full, model.dofs(), None, None),
+                ModelKind::RomG0 | ModelKind::Rom => {
+                    let mut bo = opts.basis;
+                    if kind == ModelKind::RomG0 {
+                        bo.g = Some(0);
+                    }
+                    let basis = build_basis(&model, BasisKind::Tvd, &bo)?;
+                    let fmax = basis
+                        .eigenvalues
+                        .iter()
+                        .cloned()
+                        .fold(f64::NAN, f64::max)
+                        .sqrt()
+                        / (2.0 * std::f64::consts::PI);
+                    let rm = ReducedModel::new(&model, basis.phi)?;
+                    let dim = rm.dim();
+                    (Prepared::Rom(Box::new(rm)), dim, Some(basis.g), Some(fmax))
+                }
+            };
+            let build_s = t0.elapsed().as_secs_f64()
+                + if kind == ModelKind::Full {
+                    model_s
+                } else {
+                    0.0
+                };
+            progress(&format!(
+                "k_n = {kn:e}: {} built, {dim} coordinates ({build_s:.2} s)",
+                kind.name()
+            ));
+            built.push(Built {
+                model: kind,
+                normal_stiffness: kn,
+                dim,
+                g,
+                max_frequency_hz: fmax.filter(|f: &f64| f.is_finite()),
+                build_s,
+            });
+            prepared.push((kind, prep, dim));
+        }
+        for &friction in &opts.friction {
+            // References: Newton, order 5, events off, tighter tolerances.
+            let mut full_ref: Option<(Vec<f64>, Vec<f64>)> = None;
+            let mut refs_here: Vec<(ModelKind, Outcome)> = Vec::new();
+            if opts.references {
+                for (kind, prep, _) in &prepared {
+                    let end = if *kind == ModelKind::Full {
+                        opts.full_end_time
+                    } else {
+                        opts.end_time
+                    };
+                    let spec = RunSpec {
+                        problem: ProblemOptions {
+                            friction,
+                            events: false,
+                            velocity_scale: opts.velocity_scale,
+                            ..ProblemOptions::default()
+                        },
+                        ode: OdeOptions {
+                            iteration: IterKind::Newton.iteration(),
+                            rtol: opts.rtol / opts.reference_factor,
+                            atol: opts.atol / opts.reference_factor,
+                            max_order: 5,
+                            max_steps: opts.max_steps.max(100_000),
+                            ..OdeOptions::default()
+                        },
+                        end,
+                        output_step: opts.full_output_step.min(end),
+                        budget_s: opts.reference_budget_s,
+                    };
+                    let o = system_run(&model, prep, &spec);
+                    progress(&format!(
+                        "reference {} k_n = {kn:e} friction {}: {} t = {:.3e} s, {} steps, {:.2} s",
+                        kind.name(),
+                        on_off(friction),
+                        o.status,
+                        o.t_reached,
+                        o.stats.steps,
+                        o.wall_s
+                    ));
+                    let vs_full = match (&full_ref, *kind) {
+                        (Some((t, f)), ModelKind::RomG0 | ModelKind::Rom) if o.ok() => {
+                            relative_l2(&o.t, &o.fc, t, f)
+                        }
+                        _ => None,
+                    };
+                    if *kind == ModelKind::Full && o.ok() {
+                        full_ref = Some((o.t.clone(), o.fc.clone()));
+                    }
+                    references.push(Reference {
+                        model: *kind,
+                        normal_stiffness: kn,
+                        friction,
+                        rtol: spec.ode.rtol,
+                        atol: spec.ode.atol,
+                        outcome: o.clone(),
+                        error_vs_full: vs_full,
+                    });
+                    refs_here.push((*kind, o));
+                }
+            }
+            for (kind, prep, dim) in &prepared {
+                let (end, dt) = if *kind == ModelKind::Full {
+                    (opts.full_end_time, opts.full_output_step)
+                } else {
+                    (opts.end_time, opts.output_step)
+                };
+                for &iteration in &opts.iterations {
+                    for &max_order in &opts.max_orders {
+                        for &events in &opts.events {
+                            let spec = RunSpec {
+                                problem: ProblemOptions {
+                                    friction,
+                                    events,
+                                    velocity_scale: opts.velocity_scale,
+                                    ..ProblemOptions::default()
+                                },
+                                ode: OdeOptions {
+                                    iteration: iteration.iteration(),
+                                    rtol: opts.rtol,
+                                    atol: opts.atol,
+                                    max_order,
+                                    max_steps: opts.max_steps,
+                                    ..OdeOptions::default()
+                                },
+                                end,
+                                output_step: dt.min(end),
+                                budget_s: opts.budget_s,
+                            };
+                            let o = system_run(&model, prep, &spec);
+                            let reference = refs_here
+                                .iter()
+                                .find(|(k, r)| k == kind && r.ok())
+                                .map(|(_, r)| r);
+                            let error = match reference {
+                                Some(r) if o.ok() => relative_l2(&o.t, &o.fc, &r.t, &r.fc),
+                                _ => None,
+                            };
+                            // Against the full reference over its (shorter) window: the cell's
+                            // samples within that window, compared where the times match.
+                            let error_vs_full = match (&full_ref, *kind) {
+                                (Some((t, f)), ModelKind::RomG0 | ModelKind::Rom) if o.ok() => {
+                                    relative_l2(&o.t, &o.fc, t, f)
+                                }
+                                _ => None,
+                            };
+                            progress(&format!(
+                                "{:<6} {:<10} order {max_order} k_n {kn:7.0e} friction {:<3} \
+                                 events {:<3}: {:<18} t {:.3e} s steps {:>7} rhs {:>8} {:7.2} s \
+                                 error {}",
+                                kind.name(),
+                                iteration.name(),
+                                on_off(friction),
+                                on_off(events),
+                                o.status,
+                                o.t_reached,
+                                o.stats.steps,
+                                o.stats.rhs_evals,
+                                o.wall_s,
+                                error.map_or("-".into(), |e| format!("{e:.2e}"))
+                            ));
+                            cells.push(Cell {
+                                model: *kind,
+                                dim: *dim,
+                                iteration,
+                                normal_stiffness: kn,
+                                friction,
+                                events,
+                                max_order,
+                                end_time: end,
+                                outcome: o,
+                                error,
+                                error_vs_full,
+                            });
+                        }
+                    }
+                }
+            }
+        }
+    }
+    Ok(Sweep {
+        case: base.name.clone(),
+        options: opts.clone(),
+        models: built,
+        references,
+        cells,
+        wall_s: t_all.elapsed().as_secs_f64(),
+    })
+}
+
+fn on_off(b: bool) -> &'static str {
+    if b {
+        "on"
+    } else {
+        "off"
+    }
+}
+
+/// The status with `CV_` stripped (short enough for a heat-map cell).
+fn short_status(s: &str) -> &str {
+    s.strip_prefix("CV_").unwrap_or(s)
+}
+
+fn status_color(s: &str) -> [u8; 3] {
+    match s {
+        "ok" => [120, 190, 120],
+        "budget" => [245, 170, 60],
+        "CV_TOO_MUCH_WORK" => [215, 80, 70],
+        "CV_CONV_FAILURE" => [150, 90, 190],
+        "CV_ERR_FAILURE" => [70, 110, 200],
+        "chatter" => [140, 90, 60],
+        _ => [110, 110, 110],
+    }
+}
+
+/// The markdown table of every cell.
+pub fn markdown_table(sweep: &Sweep) -> String {
+    let mut s = String::new();
+    s.push_str(&format!(
+        "# Stability map: {} (rtol {:e}, atol {:e}, window {} s ROM / {} s full, budget {} s/cell)\n\n",
+        sweep.case,
+        sweep.options.rtol,
+        sweep.options.atol,
+        sweep.options.end_time,
+        sweep.options.full_end_time,
+        sweep.options.budget_s
+    ));
+    s.push_str("| model | dim | iteration | max order | k_n (N/mm) | friction | events | status | t reached (s) | steps | RHS evals | nonlin iters | nonlin fails | err-test fails | events found | wall (s) | error | error vs full |\n");
+    s.push_str("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+    let opt = |e: Option<f64>| e.map_or("–".into(), |e| format!("{e:.2e}"));
+    for c in &sweep.cells {
+        let o = &c.outcome;
+        s.push_str(&format!(
+            "| {} | {} | {} | {} | {:.0e} | {} | {} | {} | {:.4e} | {} | {} | {} | {} | {} | {} | {:.3} | {} | {} |\n",
+            c.model.name(),
+            c.dim,
+            c.iteration.name(),
+            c.max_order,
+            c.normal_stiffness,
+            on_off(c.friction),
+            on_off(c.events),
+            o.status,
+            o.t_reached,
+            o.stats.steps,
+            o.stats.rhs_evals,
+            o.stats.nonlinear_iterations,
+            o.stats.nonlinear_conv_failures,
+            o.stats.error_test_failures,
+            o.events_found,
+            o.wall_s,
+            opt(c.error),
+            opt(c.error_vs_full)
+        ));
+    }
+    s.push_str(
+        "\nReferences (Newton, max order 5, events off, tolerances ÷ reference_factor):\n\n",
+    );
+    s.push_str("| model | k_n (N/mm) | friction | status | t reached (s) | steps | wall (s) | error vs full |\n|---|---|---|---|---|---|---|---|\n");
+    for r in &sweep.references {
+        s.push_str(&format!(
+            "| {} | {:.0e} | {} | {} | {:.4e} | {} | {:.3} | {} |\n",
+            r.model.name(),
+            r.normal_stiffness,
+            on_off(r.friction),
+            r.outcome.status,
+            r.outcome.t_reached,
+            r.outcome.stats.steps,
+            r.outcome.wall_s,
+            opt(r.error_vs_full)
+        ));
+    }
+    s
+}
+
+/// What a heat map colours.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MapKind {
+    /// Status (categorical).
+    Status,
+    /// log10 of the wall time.
+    Wall,
+    /// log10 of the error against the reference.
+    Error,
+}
+
+/// The heat map of a sweep: rows model × iteration × max order, columns k_n × friction ×
+/// events, in the order of the options; a combination that was not run is blank.
+pub fn heat_map(sweep: &Sweep, kind: MapKind) -> HeatMap {
+    let o = &sweep.options;
+    let mut rows = Vec::new();
+    for &m in &o.models {
+        for &it in &o.iterations {
+            for &mo in &o.max_orders {
+                rows.push((m, it, mo));
+            }
+        }
+    }
+    let mut cols = Vec::new();
+    for &kn in &o.normal_stiffness {
+        for &fr in &o.friction {
+            for &ev in &o.events {
+                cols.push((kn, fr, ev));
+            }
+        }
+    }
+    let find = |r: &(ModelKind, IterKind, usize), c: &(f64, bool, bool)| {
+        sweep.cells.iter().find(|x| {
+            x.model == r.0
+                && x.iteration == r.1
+                && x.max_order == r.2
+                && x.normal_stiffness == c.0
+                && x.friction == c.1
+                && x.events == c.2
+        })
+    };
+    let walls: Vec<f64> = sweep
+        .cells
+        .iter()
+        .map(|c| c.outcome.wall_s.max(1e-4).log10())
+        .collect();
+    let (wlo, whi) = bounds(&walls);
+    let errs: Vec<f64> = sweep
+        .cells
+        .iter()
+        .filter_map(|c| c.error)
+        .map(|e| e.max(1e-12).log10())
+        .collect();
+    let (elo, ehi) = bounds(&errs);
+    let scaled = |v: f64, lo: f64, hi: f64| {
+        if hi > lo {
+            (v - lo) / (hi - lo)
+        } else {
+            0.5
+        }
+    };
+    let cells: Vec<Vec<HeatCell>> = rows
+        .iter()
+        .map(|r| {
+            cols.iter()
+                .map(|c| match find(r, c) {
+                    None => HeatCell {
+                        color: [255, 255, 255],
+                        text: String::new(),
+                    },
+                    Some(x) => {
+                        let st = &x.outcome.status;
+                        let failed_text = short_status(st).to_string();
+                        match kind {
+                            MapKind::Status => HeatCell {
+                                color: status_color(st),
+                                text: if x.outcome.ok() {
+                                    "ok".into()
+                                } else {
+                                    format!("{failed_text} {:.1e}", x.outcome.t_reached)
+                                },
+                            },
+                            MapKind::Wall => {
+                                let v = x.outcome.wall_s.max(1e-4).log10();
+                                HeatCell {
+                                    color: sequential(scaled(v, wlo, whi)),
+                                    text: if x.outcome.ok() {
+                                        format!("{:.2} s", x.outcome.wall_s)
+                                    } else {
+                                        failed_text.clone()
+                                    },
+                                }
+                            }
+                            MapKind::Error => match x.error {
+                                Some(e) => {
+                                    let v = e.max(1e-12).log10();
+                                    HeatCell {
+                                        color: sequential(scaled(v, elo, ehi)),
+                                        text: format!("{e:.1e}"),
+                                    }
+                                }
+                                None => HeatCell {
+                                    color: if x.outcome.ok() {
+                                        [220, 220, 220]
+                                    } else {
+                                        status_color(st)
+                                    },
+                                    text: if x.outcome.ok() {
+                                        "no ref".into()
+                                    } else {
+                                        failed_text
+                                    },
+                                },
+                            },
+                        }
+                    }
+                })
+                .collect()
+        })
+        .collect();
+    let legend: Vec<(String, [u8; 3])> = match kind {
+        MapKind::Status => {
+            let mut seen: Vec<String> = Vec::new();
+            for c in &sweep.cells {
+                if !seen.contains(&c.outcome.status) {
+                    seen.push(c.outcome.status.clone());
+                }
+            }
+            seen.into_iter()
+                .map(|s| {
+                    let col = status_color(&s);
+                    (s, col)
+                })
+                .collect()
+        }
+        MapKind::Wall => ramp_legend(wlo, whi, "s"),
+        MapKind::Error => ramp_legend(elo, ehi, ""),
+    };
+    let what = match kind {
+        MapKind::Status => "status",
+        MapKind::Wall => "wall time (colour: log10)",
+        MapKind::Error => "relative L2 error of ‖f_c‖(t) vs reference (colour: log10)",
+    };
+    HeatMap {
+        title: format!("{}: {what}", sweep.case),
+        row_labels: rows
+            .iter()
+            .map(|(m, it, mo)| format!("{} {} order {mo}", m.name(), it.name()))
+            .collect(),
+        col_labels: cols
+            .iter()
+            .map(|(kn, fr, ev)| {
+                vec![
+                    format!("k_n {kn:.0e}"),
+                    format!("friction {}", on_off(*fr)),
+                    format!("events {}", on_off(*ev)),
+                ]
+            })
+            .collect(),
+        cells,
+        legend,
+        cell_size: (104, 30),
+        row_label_width: 230,
+    }
+}
+
+fn bounds(v: &[f64]) -> (f64, f64) {
+    v.iter()
+        .filter(|x| x.is_finite())
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| {
+            (a.min(x), b.max(x))
+        })
+}
+
+fn ramp_legend(lo: f64, hi: f64, unit: &str) -> Vec<(String, [u8; 3])> {
+    if !(lo.is_finite() && hi.is_finite()) {
+        return Vec::new();
+    }
+    (0..5)
+        .map(|k| {
+            let f = k as f64 / 4.0;
+            let v = lo + f * (hi - lo);
+            (format!("{:.1e} {unit}", 10f64.powf(v)), sequential(f))
+        })
+        .collect()
+}
+
+/// Writes `dir/stability.json`, `dir/stability.md` and the heat maps
+/// `dir/stability_{status,wall,error}.{svg,png}`; returns the files written.
+pub fn write_outputs(sweep: &Sweep, dir: &Path, charts: bool) -> Result<Vec<PathBuf>, Error> {
+    std::fs::create_dir_all(dir).map_err(|e| Error::Io {
+        file: dir.to_path_buf(),
+        source: e,
+    })?;
+    let write = |name: &str, text: String| -> Result<PathBuf, Error> {
+        let p = dir.join(name);
+        std::fs::write(&p, text).map_err(|e| Error::Io {
+            file: p.clone(),
+            source: e,
+        })?;
+        Ok(p)
+    };
+    let mut files = vec![
+        write("stability.json", sweep_json(sweep).to_string())?,
+        write("stability.md", markdown_table(sweep))?,
+    ];
+    if charts {
+        for (kind, name) in [
+            (MapKind::Status, "stability_status"),
+            (MapKind::Wall, "stability_wall"),
+            (MapKind::Error, "stability_error"),
+        ] {
+            files.extend(heat_map(sweep, kind).write(&dir.join(name))?);
+        }
+    }
+    Ok(files)
+}
+
+/// The JSON document of a sweep (what `stability.json` holds): the options, models,
+/// references and every cell, plus the ‖f_c‖ curves of the references.
+pub fn sweep_json(sweep: &Sweep) -> serde_json::Value {
+    let mut v = serde_json::to_value(sweep).unwrap_or(serde_json::Value::Null);
+    if let Some(refs) = v.get_mut("references").and_then(|r| r.as_array_mut()) {
+        for (j, r) in refs.iter_mut().zip(&sweep.references) {
+            j["t"] = serde_json::json!(r.outcome.t);
+            j["contact_force_norm"] = serde_json::json!(r.outcome.fc);
+        }
+    }
+    v
+}
+
+/// `jointrom stability CASE`: the stability map (see the module docs).
+#[derive(clap::Args, Debug, Clone)]
+pub struct StabilityArgs {
+    /// Case file, matrix map (`jointrom-matrices` JSON) or built-in name.
+    pub case: String,
+    /// Output folder (OUT/CASE/stability.json, .md and heat maps).
+    #[arg(long, default_value = "out")]
+    pub out: PathBuf,
+    /// Models: full, rom-g0, rom (comma-separated).
+    #[arg(long, value_delimiter = ',', default_value = "full,rom-g0,rom")]
+    pub models: Vec<String>,
+    /// Iterations: functional, newton.
+    #[arg(long, value_delimiter = ',', default_value = "functional,newton")]
+    pub iterations: Vec<String>,
+    /// Penalty stiffnesses k_n, N/mm.
+    #[arg(long, value_delimiter = ',', default_value = "1e2,1e4,1e6")]
+    pub kn: Vec<f64>,
+    /// Friction values: off, on.
+    #[arg(long, value_delimiter = ',', default_value = "off,on")]
+    pub friction: Vec<String>,
+    /// Events values: off, on.
+    #[arg(long, value_delimiter = ',', default_value = "off,on")]
+    pub events: Vec<String>,
+    /// BDF maximum orders.
+    #[arg(long, value_delimiter = ',', default_value = "2,5")]
+    pub max_order: Vec<usize>,
+    /// ROM window, s.
+    #[arg(long, default_value_t = 0.01)]
+    pub end_time: f64,
+    /// Full-model window, s.
+    #[arg(long, default_value_t = 2e-4)]
+    pub full_end_time: f64,
+    /// ROM output spacing, s.
+    #[arg(long, default_value_t = 1e-4)]
+    pub output_step: f64,
+    /// Full-model and reference output spacing, s.
+    #[arg(long, default_value_t = 1e-5)]
+    pub full_output_step: f64,
+    /// Relative tolerance.
+    #[arg(long, default_value_t = 1e-8)]
+    pub rtol: f64,
+    /// Absolute tolerance.
+    #[arg(long, default_value_t = 1e-6)]
+    pub atol: f64,
+    /// Velocity tolerance per displacement tolerance, 1/s (1: the paper's one number).
+    #[arg(long, default_value_t = crate::integrate::mechanical::DEFAULT_VELOCITY_SCALE)]
+    pub velocity_scale: f64,
+    /// CVODE maximum steps per output interval.
+    #[arg(long, default_value_t = 20_000)]
+    pub max_steps: usize,
+    /// Wall-clock budget per cell, s.
+    #[arg(long, default_value_t = 20.0)]
+    pub budget: f64,
+    /// Wall-clock budget per reference run, s.
+    #[arg(long, default_value_t = 60.0)]
+    pub reference_budget: f64,
+    /// Tolerance factor of the references.
+    #[arg(long, default_value_t = 100.0)]
+    pub reference_factor: f64,
+    /// Skip the reference runs (no errors).
+    #[arg(long)]
+    pub no_reference: bool,
+    /// Skip the heat maps.
+    #[arg(long)]
+    pub no_charts: bool,
+}
+
+fn parse_on_off(flag: &str, v: &[String]) -> Result<Vec<bool>, Error> {
+    v.iter()
+        .map(|s| match s.as_str() {
+            "on" => Ok(true),
+            "off" => Ok(false),
+            _ => Err(Error::Invalid(format!(
+                "--{flag}: expected on or off, got {s:?}"
+            ))),
+        })
+        .collect()
+}
+
+impl StabilityArgs {
+    /// The sweep options these arguments ask for.
+    pub fn options(&self) -> Result<SweepOptions, Error> {
+        Ok(SweepOptions {
+            models: self
+                .models
+                .iter()
+                .map(|s| ModelKind::parse(s))
+                .collect::<Result<_, _>>()?,
+            iterations: self
+                .iterations
+                .iter()
+                .map(|s| IterKind::parse(s))
+                .collect::<Result<_, _>>()?,
+            normal_stiffness: self.kn.clone(),
+            friction: parse_on_off("friction", &self.friction)?,
+            events: parse_on_off("events", &self.events)?,
+            max_orders: self.max_order.clone(),
+            end_time: self.end_time,
+            full_end_time: self.full_end_time,
+            output_step: self.output_step,
+            full_output_step: self.full_output_step,
+            rtol: self.rtol,
+            atol: self.atol,
+            velocity_scale: self.velocity_scale,
+            max_steps: self.max_steps,
+            budget_s: self.budget,
+            reference_factor: self.reference_factor,
+            reference_budget_s: self.reference_budget,
+            references: !self.no_reference,
+            basis: BasisOptions::default(),
+            progress: std::io::stderr().is_terminal(),
+        })
+    }
+}
+
+/// Runs `jointrom stability`: the sweep, then `OUT/CASE/stability.{json,md}` and the heat maps.
+/// Returns a summary: the output folder, files, number of cells, failed cells by status, the
+/// total wall time.
+pub fn stability_command(args: &StabilityArgs) -> Result<serde_json::Value, Error> {
+    let opts = args.options()?;
+    let t0 = Instant::now();
+    let model = Model::from_case_name(&args.case)?;
+    let sweep = run_sweep_model(&model, t0.elapsed().as_secs_f64(), &opts)?;
+    let dir = args.out.join(&sweep.case);
+    let files = write_outputs(&sweep, &dir, !args.no_charts)?;
+    let mut by_status = std::collections::BTreeMap::<String, usize>::new();
+    for c in &sweep.cells {
+        *by_status.entry(c.outcome.status.clone()).or_default() += 1;
+    }
+    Ok(serde_json::json!({
+        "dir": dir,
+        "files": files,
+        "cells": sweep.cells.len(),
+        "status_counts": by_status,
+        "wall_s": sweep.wall_s,
+    }))
+}
