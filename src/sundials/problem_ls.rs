@@ -32,7 +32,7 @@ use sundials_sys::{
 };
 
 use super::callbacks::ffi_guard;
-use super::owners::LinearSolver;
+use super::owners::{LinearSolver, Owned};
 use super::Context;
 use crate::Error;
 
@@ -45,11 +45,15 @@ struct Content {
 }
 
 /// Creates the solver in `context` (ops set, content allocated; `ops.free` releases both).
-pub(crate) fn new(context: &Context) -> Result<LinearSolver, Error> {
-    // SAFETY: SUNLinSolNewEmpty returns a solver with allocated, zeroed ops and null content,
-    // or null (turned into an error by LinearSolver::new).
-    let raw = unsafe { SUNLinSolNewEmpty(context.as_raw()) };
-    let solver = LinearSolver::new(raw, "SUNLinSolNewEmpty", context)?;
+pub(crate) fn new(context: &Context) -> Result<Owned<LinearSolver>, Error> {
+    // SAFETY: the context is live; SUNLinSolNewEmpty returns a new solver with allocated,
+    // zeroed ops and null content (freed by SUNLinSolFree through the ops' default path until
+    // `free` is installed below), or null (turned into an error by Owned::new). Only `solver`
+    // frees it.
+    let solver = unsafe {
+        let raw = SUNLinSolNewEmpty(context.as_raw());
+        Owned::<LinearSolver>::new(raw, "SUNLinSolNewEmpty", context)
+    }?;
     let content = Box::new(Content {
         p_data: std::ptr::null_mut(),
         pset: None,
