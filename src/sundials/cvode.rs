@@ -226,10 +226,11 @@ impl<P: OdeProblem> Cvode<P> {
         };
         let m = cvode.mem.as_raw();
         let user_data = cvode.shared.as_user_data();
-        // SAFETY (all calls below): `m` is live CVODE memory owned by `cvode`; `user_data`
-        // points to the boxed Shared<P> that `cvode` frees only after CVodeFree; vectors,
-        // matrices and solvers passed are owned by `cvode` and outlive the memory (field
-        // order). The trampolines' type parameter is this problem type.
+        // SAFETY: (also for the blocks below that say "see above") `m` is live CVODE memory
+        // owned by `cvode`; `user_data` points to the boxed Shared<P> that `cvode` frees only
+        // after CVodeFree; vectors, matrices and solvers passed are owned by `cvode` and
+        // outlive the memory (field order). The trampolines' type parameter is this problem
+        // type.
         unsafe {
             cvode.check_cv(
                 "CVodeSetErrHandlerFn",
