@@ -160,6 +160,10 @@ fn check_distinct(a: N_Vector, b: N_Vector) -> Result<(), CallbackError> {
 }
 
 /// `CVRhsFn`: `ydot = F(t, y)`, non-finite output → recoverable.
+///
+/// # Safety
+/// Called by CVODE only: `data` is the `Shared<P>` registered as user data (as for `run`), and
+/// `y`, `ydot` are live serial vectors of length `n`.
 pub(crate) unsafe extern "C" fn rhs<P: OdeProblem>(
     t: realtype,
     y: N_Vector,
@@ -179,6 +183,9 @@ pub(crate) unsafe extern "C" fn rhs<P: OdeProblem>(
 }
 
 /// `CVRootFn`: the event functions (any failure is fatal for CVODE).
+///
+/// # Safety
+/// As [`rhs`]; `gout` points to `nroots` writable doubles not aliasing `y`.
 pub(crate) unsafe extern "C" fn roots<P: OdeProblem>(
     t: realtype,
     y: N_Vector,
@@ -207,6 +214,9 @@ pub(crate) unsafe extern "C" fn roots<P: OdeProblem>(
 }
 
 /// `CVLsPrecSetupFn`: the problem's `newton_setup(t, y, fy, jok, γ)` → `jcur`.
+///
+/// # Safety
+/// As [`rhs`] for `data`, `y`, `fy`; `jcur` is null or CVLS's writable flag.
 pub(crate) unsafe extern "C" fn newton_setup<P: OdeProblem>(
     t: realtype,
     y: N_Vector,
@@ -231,6 +241,10 @@ pub(crate) unsafe extern "C" fn newton_setup<P: OdeProblem>(
 
 /// `CVLsPrecSolveFn`: the problem's `newton_solve`, `z ≈ (I − γJ)⁻¹ r`; non-finite `z` →
 /// recoverable.
+///
+/// # Safety
+/// As [`rhs`] for `data`, `y`, `r`, `z`; `z` is not written through any other pointer while
+/// the call runs.
 #[allow(clippy::too_many_arguments)]
 pub(crate) unsafe extern "C" fn newton_solve<P: OdeProblem>(
     t: realtype,
@@ -256,6 +270,11 @@ pub(crate) unsafe extern "C" fn newton_solve<P: OdeProblem>(
 
 /// `CVErrHandlerFn`: keeps CVODE's messages (errors for the `Error`, warnings counted) instead
 /// of printing them to stderr.
+///
+/// # Safety
+/// Called by CVODE only: `data` is null or the registered `Shared<P>`, not otherwise
+/// referenced during the call; `function` and `msg` are null or NUL-terminated strings valid
+/// for the call.
 pub(crate) unsafe extern "C" fn error_handler<P: OdeProblem>(
     error_code: c_int,
     _module: *const c_char,

@@ -69,7 +69,10 @@ impl Drop for RawContext {
         // Every SUNDIALS object created in it holds a `Context` clone and so has been destroyed
         // before the last `Rc<RawContext>` is dropped.
         let flag = unsafe { SUNContext_Free(&mut raw) };
-        // SUNContext_Free fails only for a null context, which NonNull rules out.
-        debug_assert_eq!(flag, 0, "SUNContext_Free returned {flag}");
+        // The flag is ignored on purpose: SUNContext_Free (6.4) returns nonzero only when a
+        // profiling build fails to free the context's profiler, and then there is nothing to
+        // recover or retry either; `drop` has no caller to report to (and a panic here would
+        // abort the process if the context is dropped while unwinding).
+        let _ = flag;
     }
 }

@@ -52,7 +52,7 @@ use sundials_sys::{
 };
 
 use super::callbacks::{self, Failure, Shared};
-use super::owners::{CvodeMem, LinearSolver, Matrix, NonlinearSolver};
+use super::owners::{CvodeMemory, LinearSolver, Matrix, NonlinearSolver, Owned};
 use super::{cvode_flag_name, cvode_ls_flag_name, problem_ls, Context, SerialVector};
 use crate::integrate::problem::{
     Iteration, Method, NewtonLinear, OdeOptions, OdeProblem, OdeStats, Stop,
@@ -142,10 +142,10 @@ impl<P> Drop for SharedBox<P> {
 pub struct Cvode<P: OdeProblem> {
     // Field order = drop order: CVodeFree, nonlinear solver, linear solver, matrix, vector,
     // problem, context.
-    mem: CvodeMem,
-    nls: Option<NonlinearSolver>,
-    ls: Option<LinearSolver>,
-    matrix: Option<Matrix>,
+    mem: Owned<CvodeMemory>,
+    nls: Option<Owned<NonlinearSolver>>,
+    ls: Option<Owned<LinearSolver>>,
+    matrix: Option<Owned<Matrix>>,
     y: SerialVector,
     shared: SharedBox<P>,
     _context: Context,
@@ -181,8 +181,10 @@ impl<P: OdeProblem> Cvode<P> {
             Method::Bdf => CV_BDF,
             Method::Adams => CV_ADAMS,
         };
-        // SAFETY: the context is live; CVodeCreate returns new memory or null.
-        let mem = CvodeMem::new(unsafe { CVodeCreate(lmm, context.as_raw()) }, &context)?;
+        // SAFETY: the context is live; CVodeCreate returns new memory created in it, or null,
+        // which only `mem` frees.
+        let mem =
+            unsafe { Owned::new(CVodeCreate(lmm, context.as_raw()), "CVodeCreate", &context) }?;
         let shared = SharedBox::new(Shared {
             problem,
             n,
@@ -226,10 +228,11 @@ impl<P: OdeProblem> Cvode<P> {
         };
         let m = cvode.mem.as_raw();
         let user_data = cvode.shared.as_user_data();
-        // SAFETY (all calls below): `m` is live CVODE memory owned by `cvode`; `user_data`
-        // points to the boxed Shared<P> that `cvode` frees only after CVodeFree; vectors,
-        // matrices and solvers passed are owned by `cvode` and outlive the memory (field
-        // order). The trampolines' type parameter is this problem type.
+        // SAFETY: (also for the blocks below that say "see above") `m` is live CVODE memory
+        // owned by `cvode`; `user_data` points to the boxed Shared<P> that `cvode` frees only
+        // after CVodeFree; vectors, matrices and solvers passed are owned by `cvode` and
+        // outlive the memory (field order). The trampolines' type parameter is this problem
+        // type.
         unsafe {
             cvode.check_cv(
                 "CVodeSetErrHandlerFn",
@@ -257,10 +260,12 @@ impl<P: OdeProblem> Cvode<P> {
                 let depth = c_int::try_from(anderson).map_err(|_| {
                     Error::Invalid(format!("iteration.anderson = {anderson} is too large"))
                 })?;
-                // SAFETY: `y` is a live template vector; the context is live.
-                let raw =
-                    unsafe { SUNNonlinSol_FixedPoint(cvode.y.as_raw(), depth, context.as_raw()) };
-                let nls = NonlinearSolver::new(raw, "SUNNonlinSol_FixedPoint", &context)?;
+                // SAFETY: `y` is a live template vector and the context is live; the new solver
+                // (or null) is owned by `nls` alone.
+                let nls = unsafe {
+                    let raw = SUNNonlinSol_FixedPoint(cvode.y.as_raw(), depth, context.as_raw());
+                    Owned::<NonlinearSolver>::new(raw, "SUNNonlinSol_FixedPoint", &context)
+                }?;
                 let raw = nls.as_raw();
                 cvode.nls = Some(nls);
                 // SAFETY: see above; `cvode.nls` owns the solver and frees it after CVodeFree.
@@ -271,19 +276,20 @@ impl<P: OdeProblem> Cvode<P> {
             Iteration::Newton {
                 linear: NewtonLinear::DenseDq,
             } => {
-                let nn = n as i64; // n ≤ i64::MAX: SerialVector::from_slice checked it.
-                                   // SAFETY: the context is live; SUNDenseMatrix returns a new matrix or null.
-                let a = Matrix::new(
-                    unsafe { SUNDenseMatrix(nn, nn, context.as_raw()) },
-                    "SUNDenseMatrix",
-                    &context,
-                )?;
-                // SAFETY: `y` and `a` are live and compatible (n × n, length n).
-                let ls = LinearSolver::new(
-                    unsafe { SUNLinSol_Dense(cvode.y.as_raw(), a.as_raw(), context.as_raw()) },
-                    "SUNLinSol_Dense",
-                    &context,
-                )?;
+                // n ≤ i64::MAX: SerialVector::from_slice checked it.
+                let nn = n as i64;
+                // SAFETY: the context is live; SUNDenseMatrix returns a new matrix (or null),
+                // owned by `a` alone.
+                let a = unsafe {
+                    let raw = SUNDenseMatrix(nn, nn, context.as_raw());
+                    Owned::<Matrix>::new(raw, "SUNDenseMatrix", &context)
+                }?;
+                // SAFETY: `y` and `a` are live and compatible (n × n, length n); the new solver
+                // (or null) is owned by `ls` alone.
+                let ls = unsafe {
+                    let raw = SUNLinSol_Dense(cvode.y.as_raw(), a.as_raw(), context.as_raw());
+                    Owned::<LinearSolver>::new(raw, "SUNLinSol_Dense", &context)
+                }?;
                 let (ls_raw, a_raw) = (ls.as_raw(), a.as_raw());
                 cvode.matrix = Some(a);
                 cvode.ls = Some(ls);

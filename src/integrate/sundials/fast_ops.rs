@@ -9,8 +9,21 @@
 //! `nvector_serial.c` of SUNDIALS 6.4 (sequential sums, `prod = x·w; sum += prod·prod`), so
 //! results are bit-for-bit those of the library; only the speed changes.
 //!
-//! Safety and aliasing: CVODE calls e.g. `N_VLinearSum(a, x, b, y, x)` with the output equal to
-//! an input, so the loops work on raw pointers element by element (never a `&mut` slice next to
+//! # Safety
+//! The operations are reached only through the ops table of a vector that [`install`] patched
+//! (a [`super::SerialVector`]) or of one of its clones (`N_VClone_Serial`, which CVODE and its
+//! solvers use, copies the table and allocates the clone's own data), and SUNDIALS dispatches an operation on the ops of its first vector
+//! argument while requiring all vector arguments of one call to be of the same implementation.
+//! So every `N_Vector` these functions receive is a live serial vector: `N_VGetArrayPointer`
+//! gives its `content->data`, valid for `N_VGetLength` doubles (null only for length 0, when no
+//! element is touched). CVODE and its solvers clone all their vectors from the one template `y`,
+//! so the vectors of a call have the same length; the loops still run only to the *smallest*
+//! length of their vectors, so no access can go out of bounds even if that ever changed (for
+//! equal lengths, the only case that occurs, this is the library's loop).
+//!
+//! Aliasing: CVODE calls e.g. `N_VLinearSum(a, x, b, y, x)` with the output equal to an input,
+//! as `nvector_serial.c` allows, so the loops work on raw pointers element by element, reading
+//! the inputs of entry `i` before writing entry `i` of the output (never a `&mut` slice next to
 //! a `&` slice of the same memory). No operation here can panic (no indexing, allocation or
 //! unwrap); each still runs inside `catch_unwind`, and a panic would leave NaN in the output (a
 //! norm of NaN), which CVODE treats as a failed step and jointrom reports as an error.
@@ -22,21 +35,30 @@ use sundials_sys::{realtype, N_VGetArrayPointer, N_VGetLength, N_Vector};
 /// Data pointer and length of a serial vector.
 ///
 /// # Safety
-/// `v` must be a valid serial `N_Vector`.
+/// `v` must be a live serial `N_Vector`.
 unsafe fn raw(v: N_Vector) -> (*mut f64, usize) {
-    let n = N_VGetLength(v).max(0) as usize;
-    (N_VGetArrayPointer(v), n)
+    // SAFETY: by this function's contract `v` is a live serial vector, for which both calls
+    // only read its content (length and data pointer).
+    unsafe {
+        let n = N_VGetLength(v).max(0) as usize;
+        (N_VGetArrayPointer(v), n)
+    }
 }
 
 /// Runs `f`; on a panic fills `z` with NaN.
 ///
 /// # Safety
-/// `z` must be a valid serial `N_Vector`.
+/// `z` must be a live serial `N_Vector`, and `f` must be sound to call (the callers' closures
+/// access only vectors that satisfy the module's contract).
 unsafe fn guarded(z: N_Vector, f: impl FnOnce()) {
     if catch_unwind(AssertUnwindSafe(f)).is_err() {
-        let (zp, n) = raw(z);
-        for i in 0..n {
-            *zp.add(i) = f64::NAN;
+        // SAFETY: `z` is a live serial vector (contract), so `zp` is valid for `n` writes;
+        // no reference to its data exists.
+        unsafe {
+            let (zp, n) = raw(z);
+            for i in 0..n {
+                *zp.add(i) = f64::NAN;
+            }
         }
     }
 }
@@ -48,164 +70,247 @@ fn guarded_value(f: impl FnOnce() -> f64) -> f64 {
 /// `z = a x + b y` (z may be x or y). As `N_VLinearSum_Serial`, `a = b` is computed as
 /// `a (x + y)` and `a = −b` as `a (x − y)`; its other special cases (a or b = ±1, in-place
 /// updates) give the same numbers as `a x + b y`.
+///
+/// # Safety
+/// `x`, `y`, `z` are live serial vectors (module docs); `z` may be `x` or `y`.
 unsafe extern "C" fn linear_sum(a: realtype, x: N_Vector, b: realtype, y: N_Vector, z: N_Vector) {
-    guarded(z, || {
-        let (xp, n) = raw(x);
-        let (yp, _) = raw(y);
-        let (zp, _) = raw(z);
-        let unit = a.abs() == 1.0 || b.abs() == 1.0;
-        if !unit && a == b {
-            for i in 0..n {
-                *zp.add(i) = a * (*xp.add(i) + *yp.add(i));
+    // SAFETY: `x`, `y` and `z` are live serial vectors (contract), each pointer valid for its
+    // vector's length, and `n` is the smallest of them. Entry `i` of `z` is written through a
+    // raw pointer after entries `i` of `x` and `y` are read, so `z` aliasing an input is fine.
+    unsafe {
+        guarded(z, || {
+            let (xp, nx) = raw(x);
+            let (yp, ny) = raw(y);
+            let (zp, nz) = raw(z);
+            let n = nx.min(ny).min(nz);
+            let unit = a.abs() == 1.0 || b.abs() == 1.0;
+            if !unit && a == b {
+                for i in 0..n {
+                    *zp.add(i) = a * (*xp.add(i) + *yp.add(i));
+                }
+            } else if !unit && a == -b {
+                for i in 0..n {
+                    *zp.add(i) = a * (*xp.add(i) - *yp.add(i));
+                }
+            } else {
+                for i in 0..n {
+                    *zp.add(i) = a * *xp.add(i) + b * *yp.add(i);
+                }
             }
-        } else if !unit && a == -b {
-            for i in 0..n {
-                *zp.add(i) = a * (*xp.add(i) - *yp.add(i));
-            }
-        } else {
-            for i in 0..n {
-                *zp.add(i) = a * *xp.add(i) + b * *yp.add(i);
-            }
-        }
-    })
+        })
+    }
 }
 
 /// `z = c`.
+///
+/// # Safety
+/// `z` is a live serial vector (module docs).
 unsafe extern "C" fn constant(c: realtype, z: N_Vector) {
-    guarded(z, || {
-        let (zp, n) = raw(z);
-        for i in 0..n {
-            *zp.add(i) = c;
-        }
-    })
+    // SAFETY: `z` is a live serial vector (contract): `zp` is valid for its `n` entries.
+    unsafe {
+        guarded(z, || {
+            let (zp, n) = raw(z);
+            for i in 0..n {
+                *zp.add(i) = c;
+            }
+        })
+    }
 }
 
 /// `z = x ∘ y`.
+///
+/// # Safety
+/// `x`, `y`, `z` are live serial vectors (module docs); `z` may be `x` or `y`.
 unsafe extern "C" fn prod(x: N_Vector, y: N_Vector, z: N_Vector) {
-    guarded(z, || {
-        let (xp, n) = raw(x);
-        let (yp, _) = raw(y);
-        let (zp, _) = raw(z);
-        for i in 0..n {
-            *zp.add(i) = *xp.add(i) * *yp.add(i);
-        }
-    })
+    // SAFETY: as in `linear_sum`.
+    unsafe {
+        guarded(z, || {
+            let (xp, nx) = raw(x);
+            let (yp, ny) = raw(y);
+            let (zp, nz) = raw(z);
+            for i in 0..nx.min(ny).min(nz) {
+                *zp.add(i) = *xp.add(i) * *yp.add(i);
+            }
+        })
+    }
 }
 
 /// `z = x / y` elementwise.
+///
+/// # Safety
+/// `x`, `y`, `z` are live serial vectors (module docs); `z` may be `x` or `y`.
 unsafe extern "C" fn div(x: N_Vector, y: N_Vector, z: N_Vector) {
-    guarded(z, || {
-        let (xp, n) = raw(x);
-        let (yp, _) = raw(y);
-        let (zp, _) = raw(z);
-        for i in 0..n {
-            *zp.add(i) = *xp.add(i) / *yp.add(i);
-        }
-    })
+    // SAFETY: as in `linear_sum`.
+    unsafe {
+        guarded(z, || {
+            let (xp, nx) = raw(x);
+            let (yp, ny) = raw(y);
+            let (zp, nz) = raw(z);
+            for i in 0..nx.min(ny).min(nz) {
+                *zp.add(i) = *xp.add(i) / *yp.add(i);
+            }
+        })
+    }
 }
 
 /// `z = c x`.
+///
+/// # Safety
+/// `x` and `z` are live serial vectors (module docs); `z` may be `x`.
 unsafe extern "C" fn scale(c: realtype, x: N_Vector, z: N_Vector) {
-    guarded(z, || {
-        let (xp, n) = raw(x);
-        let (zp, _) = raw(z);
-        for i in 0..n {
-            *zp.add(i) = c * *xp.add(i);
-        }
-    })
+    // SAFETY: `x` and `z` are live serial vectors (contract), each pointer valid for its
+    // vector's length, and the loop runs to the smaller one. Entry `i` of `x` is read before
+    // entry `i` of `z` is written through a raw pointer, so `z` may be `x`.
+    unsafe {
+        guarded(z, || {
+            let (xp, nx) = raw(x);
+            let (zp, nz) = raw(z);
+            for i in 0..nx.min(nz) {
+                *zp.add(i) = c * *xp.add(i);
+            }
+        })
+    }
 }
 
 /// `z = |x|`.
+///
+/// # Safety
+/// `x` and `z` are live serial vectors (module docs); `z` may be `x`.
 unsafe extern "C" fn abs(x: N_Vector, z: N_Vector) {
-    guarded(z, || {
-        let (xp, n) = raw(x);
-        let (zp, _) = raw(z);
-        for i in 0..n {
-            *zp.add(i) = (*xp.add(i)).abs();
-        }
-    })
+    // SAFETY: as in `scale`.
+    unsafe {
+        guarded(z, || {
+            let (xp, nx) = raw(x);
+            let (zp, nz) = raw(z);
+            for i in 0..nx.min(nz) {
+                *zp.add(i) = (*xp.add(i)).abs();
+            }
+        })
+    }
 }
 
 /// `z = 1 / x`.
+///
+/// # Safety
+/// `x` and `z` are live serial vectors (module docs); `z` may be `x`.
 unsafe extern "C" fn inv(x: N_Vector, z: N_Vector) {
-    guarded(z, || {
-        let (xp, n) = raw(x);
-        let (zp, _) = raw(z);
-        for i in 0..n {
-            *zp.add(i) = 1.0 / *xp.add(i);
-        }
-    })
+    // SAFETY: as in `scale`.
+    unsafe {
+        guarded(z, || {
+            let (xp, nx) = raw(x);
+            let (zp, nz) = raw(z);
+            for i in 0..nx.min(nz) {
+                *zp.add(i) = 1.0 / *xp.add(i);
+            }
+        })
+    }
 }
 
 /// `z = x + b`.
+///
+/// # Safety
+/// `x` and `z` are live serial vectors (module docs); `z` may be `x`.
 unsafe extern "C" fn add_const(x: N_Vector, b: realtype, z: N_Vector) {
-    guarded(z, || {
-        let (xp, n) = raw(x);
-        let (zp, _) = raw(z);
-        for i in 0..n {
-            *zp.add(i) = *xp.add(i) + b;
-        }
-    })
+    // SAFETY: as in `scale`.
+    unsafe {
+        guarded(z, || {
+            let (xp, nx) = raw(x);
+            let (zp, nz) = raw(z);
+            for i in 0..nx.min(nz) {
+                *zp.add(i) = *xp.add(i) + b;
+            }
+        })
+    }
 }
 
 /// `Σ (x_i w_i)²`, summed in order (as `N_VWSqrSumLocal_Serial`).
+///
+/// # Safety
+/// `x` and `w` are live serial vectors (module docs); they may be the same vector.
 unsafe fn wsqrsum(x: N_Vector, w: N_Vector) -> f64 {
-    let (xp, n) = raw(x);
-    let (wp, _) = raw(w);
-    let mut sum = 0.0;
-    for i in 0..n {
-        let p = *xp.add(i) * *wp.add(i);
-        sum += p * p;
+    // SAFETY: `x` and `w` are live serial vectors (contract), each pointer valid for its
+    // vector's length, and the loop runs to the smaller one; both are only read.
+    unsafe {
+        let (xp, nx) = raw(x);
+        let (wp, nw) = raw(w);
+        let mut sum = 0.0;
+        for i in 0..nx.min(nw) {
+            let p = *xp.add(i) * *wp.add(i);
+            sum += p * p;
+        }
+        sum
     }
-    sum
 }
 
 /// `sqrt(Σ (x_i w_i)² / n)`.
+///
+/// # Safety
+/// `x` and `w` are live serial vectors (module docs).
 unsafe extern "C" fn wrms_norm(x: N_Vector, w: N_Vector) -> realtype {
     guarded_value(|| {
-        let n = N_VGetLength(x);
-        (wsqrsum(x, w) / n as f64).sqrt()
+        // SAFETY: `x` and `w` are live serial vectors (contract).
+        let n = unsafe { N_VGetLength(x) };
+        // SAFETY: as above.
+        (unsafe { wsqrsum(x, w) } / n as f64).sqrt()
     })
 }
 
 /// `Σ (x_i w_i)²` (the local part of the norm).
+///
+/// # Safety
+/// `x` and `w` are live serial vectors (module docs).
 unsafe extern "C" fn wsqrsum_local(x: N_Vector, w: N_Vector) -> realtype {
-    guarded_value(|| wsqrsum(x, w))
+    // SAFETY: `x` and `w` are live serial vectors (contract).
+    guarded_value(|| unsafe { wsqrsum(x, w) })
 }
 
 /// `max |x_i|` (0 for an empty vector).
+///
+/// # Safety
+/// `x` is a live serial vector (module docs).
 unsafe extern "C" fn max_norm(x: N_Vector) -> realtype {
     guarded_value(|| {
-        let (xp, n) = raw(x);
-        let mut m = 0.0f64;
-        for i in 0..n {
-            let a = (*xp.add(i)).abs();
-            if a > m {
-                m = a;
+        // SAFETY: `x` is a live serial vector (contract): `xp` is valid for `n` reads.
+        unsafe {
+            let (xp, n) = raw(x);
+            let mut m = 0.0f64;
+            for i in 0..n {
+                let a = (*xp.add(i)).abs();
+                if a > m {
+                    m = a;
+                }
             }
+            m
         }
-        m
     })
 }
 
 /// Installs the operations above into the ops table of `v`.
 ///
 /// # Safety
-/// `v` must be a valid serial `N_Vector` with a valid, exclusively owned ops table.
+/// `v` must be a live serial `N_Vector` (from `N_VNew_Serial`) with a valid ops table that no
+/// other vector shares.
 pub(crate) unsafe fn install(v: N_Vector) {
-    let ops = (*v).ops;
+    // SAFETY: by this function's contract `v` points to a live vector; reading its `ops`
+    // pointer is a plain field read.
+    let ops = unsafe { (*v).ops };
     if ops.is_null() {
         return;
     }
-    (*ops).nvlinearsum = Some(linear_sum);
-    (*ops).nvconst = Some(constant);
-    (*ops).nvprod = Some(prod);
-    (*ops).nvdiv = Some(div);
-    (*ops).nvscale = Some(scale);
-    (*ops).nvabs = Some(abs);
-    (*ops).nvinv = Some(inv);
-    (*ops).nvaddconst = Some(add_const);
-    (*ops).nvwrmsnorm = Some(wrms_norm);
-    (*ops).nvwsqrsumlocal = Some(wsqrsum_local);
-    (*ops).nvmaxnorm = Some(max_norm);
+    // SAFETY: `ops` is the vector's own, valid table (contract), written only here while no
+    // SUNDIALS call is under way. The replacements have the serial operations' signatures and
+    // results, and `v` is serial, as they require.
+    unsafe {
+        (*ops).nvlinearsum = Some(linear_sum);
+        (*ops).nvconst = Some(constant);
+        (*ops).nvprod = Some(prod);
+        (*ops).nvdiv = Some(div);
+        (*ops).nvscale = Some(scale);
+        (*ops).nvabs = Some(abs);
+        (*ops).nvinv = Some(inv);
+        (*ops).nvaddconst = Some(add_const);
+        (*ops).nvwrmsnorm = Some(wrms_norm);
+        (*ops).nvwsqrsumlocal = Some(wsqrsum_local);
+        (*ops).nvmaxnorm = Some(max_norm);
+    }
 }

@@ -29,6 +29,14 @@
 //! failure becomes [`Error::Sundials`] with the C function's name, the flag (its SUNDIALS name
 //! where one exists, e.g. from [`cvode_flag_name`]) and the integration time in s — NaN for
 //! calls outside time integration. No C failure panics.
+//!
+//! # `unsafe` conventions
+//! Every `unsafe` block (and `unsafe impl`) states why it is sound in a `// SAFETY:` comment,
+//! every `unsafe fn` the caller's obligations in a `# Safety` section, and the body of an
+//! `unsafe fn` is not an unsafe context: its unsafe operations sit in their own commented
+//! blocks. The lints below enforce the first and the last rule.
+
+#![deny(unsafe_op_in_unsafe_fn, clippy::undocumented_unsafe_blocks)]
 
 mod callbacks;
 mod context;
@@ -191,8 +199,8 @@ mod tests {
             let c_len = unsafe { sundials_sys::N_VGetLength(v.as_raw()) };
             assert_eq!(c_len, len as i64);
             // SUNDIALS's own operations see the Rust writes.
-            // SAFETY: `v` is a live serial vector; N_VMaxNorm only reads it.
             if len > 0 {
+                // SAFETY: `v` is a live serial vector; N_VMaxNorm only reads it.
                 let norm = unsafe { sundials_sys::N_VMaxNorm(v.as_raw()) };
                 assert_eq!(norm, expected.iter().fold(0.0f64, |m, x| m.max(x.abs())));
             }
@@ -242,6 +250,8 @@ mod tests {
         use std::ffi::{c_int, c_void};
         use sundials_sys::*;
 
+        /// # Safety
+        /// Called by CVODE with two live serial vectors of length 2 with distinct data.
         unsafe extern "C" fn rhs(_t: f64, y: N_Vector, ydot: N_Vector, _: *mut c_void) -> c_int {
             // SAFETY: CVODE passes two live serial vectors of length 2 with distinct data.
             unsafe {

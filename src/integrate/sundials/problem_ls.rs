@@ -32,7 +32,7 @@ use sundials_sys::{
 };
 
 use super::callbacks::ffi_guard;
-use super::owners::LinearSolver;
+use super::owners::{LinearSolver, Owned};
 use super::Context;
 use crate::Error;
 
@@ -45,11 +45,15 @@ struct Content {
 }
 
 /// Creates the solver in `context` (ops set, content allocated; `ops.free` releases both).
-pub(crate) fn new(context: &Context) -> Result<LinearSolver, Error> {
-    // SAFETY: SUNLinSolNewEmpty returns a solver with allocated, zeroed ops and null content,
-    // or null (turned into an error by LinearSolver::new).
-    let raw = unsafe { SUNLinSolNewEmpty(context.as_raw()) };
-    let solver = LinearSolver::new(raw, "SUNLinSolNewEmpty", context)?;
+pub(crate) fn new(context: &Context) -> Result<Owned<LinearSolver>, Error> {
+    // SAFETY: the context is live; SUNLinSolNewEmpty returns a new solver with allocated,
+    // zeroed ops and null content (freed by SUNLinSolFree through the ops' default path until
+    // `free` is installed below), or null (turned into an error by Owned::new). Only `solver`
+    // frees it.
+    let solver = unsafe {
+        let raw = SUNLinSolNewEmpty(context.as_raw());
+        Owned::<LinearSolver>::new(raw, "SUNLinSolNewEmpty", context)
+    }?;
     let content = Box::new(Content {
         p_data: std::ptr::null_mut(),
         pset: None,
@@ -87,19 +91,24 @@ unsafe fn content<'a>(s: SUNLinearSolver) -> &'a mut Content {
     unsafe { &mut *(*s).content.cast::<Content>() }
 }
 
-unsafe extern "C" fn get_type(_s: SUNLinearSolver) -> SUNLinearSolver_Type {
+extern "C" fn get_type(_s: SUNLinearSolver) -> SUNLinearSolver_Type {
     SUNLinearSolver_Type_SUNLINEARSOLVER_ITERATIVE
 }
 
-unsafe extern "C" fn get_id(_s: SUNLinearSolver) -> SUNLinearSolver_ID {
+extern "C" fn get_id(_s: SUNLinearSolver) -> SUNLinearSolver_ID {
     SUNLinearSolver_ID_SUNLINEARSOLVER_CUSTOM
 }
 
 /// No-op: the product `A v` is never needed (one exact preconditioner solve per system).
-unsafe extern "C" fn set_atimes(_s: SUNLinearSolver, _data: *mut c_void, _f: SUNATimesFn) -> c_int {
+extern "C" fn set_atimes(_s: SUNLinearSolver, _data: *mut c_void, _f: SUNATimesFn) -> c_int {
     SUNLS_SUCCESS as c_int
 }
 
+/// `ops.setpreconditioner`: keeps CVLS's preconditioner data and functions.
+///
+/// # Safety
+/// `s` is a live solver made by [`new`] (SUNDIALS calls this through the solver's own ops),
+/// and no other call on `s` is under way.
 unsafe extern "C" fn set_preconditioner(
     s: SUNLinearSolver,
     p_data: *mut c_void,
@@ -117,6 +126,10 @@ unsafe extern "C" fn set_preconditioner(
 }
 
 /// Calls CVLS's preconditioner setup (the problem's `newton_setup`).
+///
+/// # Safety
+/// As [`set_preconditioner`]; CVLS, which registered the preconditioner, calls it while its
+/// CVODE memory is alive.
 unsafe extern "C" fn setup(s: SUNLinearSolver, _a: SUNMatrix) -> c_int {
     ffi_guard(SUNLS_PSET_FAIL_UNREC, || {
         // SAFETY: CVLS passes the solver it was given, made by `new`.
@@ -137,6 +150,9 @@ unsafe extern "C" fn setup(s: SUNLinearSolver, _a: SUNMatrix) -> c_int {
 }
 
 /// `x = P⁻¹ b` by one call of CVLS's preconditioner solve (the problem's `newton_solve`).
+///
+/// # Safety
+/// As [`setup`]; `x` and `b` are distinct live vectors of the problem's length.
 unsafe extern "C" fn solve(
     s: SUNLinearSolver,
     _a: SUNMatrix,
@@ -167,15 +183,19 @@ unsafe extern "C" fn solve(
 }
 
 /// One "iteration" per solve (so `CVodeGetNumLinIters` counts the solves).
-unsafe extern "C" fn num_iters(_s: SUNLinearSolver) -> c_int {
+extern "C" fn num_iters(_s: SUNLinearSolver) -> c_int {
     1
 }
 
 /// The solve is exact: zero residual.
-unsafe extern "C" fn res_norm(_s: SUNLinearSolver) -> realtype {
+extern "C" fn res_norm(_s: SUNLinearSolver) -> realtype {
     0.0
 }
 
+/// The flag of the last `setup` or `solve`.
+///
+/// # Safety
+/// As [`set_preconditioner`].
 unsafe extern "C" fn last_flag(s: SUNLinearSolver) -> sunindextype {
     ffi_guard(0, || {
         // SAFETY: CVODE passes the solver it was given, made by `new`.
@@ -184,6 +204,10 @@ unsafe extern "C" fn last_flag(s: SUNLinearSolver) -> sunindextype {
 }
 
 /// `ops.free`: releases the content, then the solver and its ops (`SUNLinSolFreeEmpty`).
+///
+/// # Safety
+/// `s` is null or a solver made by [`new`] that nothing uses afterwards (SUNLinSolFree calls
+/// this once, from the owner's `Drop`).
 unsafe extern "C" fn free(s: SUNLinearSolver) -> c_int {
     if s.is_null() {
         return SUNLS_SUCCESS as c_int;
