@@ -2,6 +2,8 @@
 
 use std::path::PathBuf;
 
+pub use crate::integrate::sundials::CvodeFlag;
+
 /// Everything that can go wrong in jointrom. Bad input is an error, never a panic.
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
@@ -35,7 +37,7 @@ pub enum Error {
     #[error("SUNDIALS: {function} returned {flag}{}", time_suffix(*time))]
     Sundials {
         function: &'static str,
-        flag: String,
+        flag: CvodeFlag,
         time: f64,
     },
     /// A problem callback failed during a time integration: it returned an error, panicked, or
@@ -43,13 +45,45 @@ pub enum Error {
     /// (`rhs`, `roots`, `newton_setup`, `newton_solve`), `message` is its last message (the
     /// panic text for a panic), `time` the time it was evaluated at (s), and `flag` what the
     /// integrator reported (e.g. `CVode returned CV_REPTD_RHSFUNC_ERR at t = 0.01 s`).
-    #[error("ODE callback `{callback}` failed at t = {time} s: {message} ({flag})")]
+    #[error("ODE callback `{callback}` failed at t = {time} s: {message} ({outcome})")]
     Callback {
         callback: &'static str,
         message: String,
         time: f64,
-        flag: String,
+        outcome: CallbackOutcome,
     },
+    /// Events: `roots` roots in a row without progress in time at `time` (s), a chattering
+    /// stick/slip or gap switch.
+    #[error(
+        "invalid request: events: {roots} roots without progress at t = {time} s \
+         (chattering switch); run with events off"
+    )]
+    Chatter { roots: usize, time: f64 },
+}
+
+/// What the integrator did about a failed callback.
+#[derive(Clone, Debug, PartialEq)]
+pub enum CallbackOutcome {
+    /// CVODE returned `flag` at `t` (s).
+    Returned { flag: CvodeFlag, t: f64 },
+    /// The integration was not run: a callback had panicked before.
+    NotRun,
+}
+
+impl std::fmt::Display for CallbackOutcome {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            CallbackOutcome::Returned { flag, t } => {
+                write!(f, "CVode returned {flag} at t = {t} s")
+            }
+            CallbackOutcome::NotRun => {
+                write!(
+                    f,
+                    "not run: a callback panicked earlier (call reinit to continue)"
+                )
+            }
+        }
+    }
 }
 
 fn time_suffix(time: f64) -> String {

@@ -115,9 +115,9 @@
 //! [`OdeProblem::atol_scale`]). Accuracy: see `cases/reference/SOURCE.md` (default vs 100×
 //! tighter tolerances).
 
+use crate::case::ContactSpec;
 use crate::error::Error;
-use crate::integrate::problem::{CallbackError, OdeOptions, OdeProblem, OdeStats, Stop};
-use crate::integrate::sundials::Cvode;
+use crate::integrate::problem::{CallbackError, OdeProblem};
 use crate::joint::law::{evaluate_pairs, PairLaw, PairState, DEFAULT_TAU};
 use crate::system::SecondOrderSystem;
 
@@ -218,9 +218,13 @@ pub struct MechanicalOde<S: SecondOrderSystem> {
 }
 
 impl<S: SecondOrderSystem> MechanicalOde<S> {
-    /// Wraps a system with the case's contact law.
-    pub fn new(sys: S, opts: &ProblemOptions) -> Result<MechanicalOde<S>, Error> {
-        let c = sys.contact();
+    /// Wraps a system with a contact law (k_n, μ, k_t).
+    pub fn new(
+        sys: S,
+        contact: &ContactSpec,
+        opts: &ProblemOptions,
+    ) -> Result<MechanicalOde<S>, Error> {
+        let c = contact;
         if !(opts.tau.is_finite() && opts.tau > 0.0) {
             return Err(Error::Invalid(format!(
                 "tau (slip relaxation time) must be finite and positive, got {} s",
@@ -665,212 +669,4 @@ impl<S: SecondOrderSystem> OdeProblem for MechanicalOde<S> {
         ze[1] = zd / self.e_scale;
         non_finite("the Newton correction", z)
     }
-}
-
-/// Options of [`run`]. Defaults: the integrator's defaults ([`OdeOptions::default`]: BDF,
-/// Newton with the structured solve, rtol 1e-8, atol 1e-6 — the paper's Table 1) except the
-/// maximum order [`DEFAULT_MAX_ORDER`] = 2, velocity tolerance [`DEFAULT_VELOCITY_SCALE`] × atol,
-/// friction on, events off, τ = 1e-6 s, outputs every 1e-4 s, the case's end time.
-#[derive(Clone, Debug, PartialEq, serde::Serialize)]
-pub struct TransientOptions {
-    /// Integrator options.
-    pub ode: OdeOptions,
-    /// Friction, events, τ.
-    pub problem: ProblemOptions,
-    /// Spacing of the output times, s (> 0).
-    pub output_step: f64,
-    /// End of the run, s (`None`: the case's `end_time`).
-    pub end_time: Option<f64>,
-}
-
-impl Default for TransientOptions {
-    fn default() -> Self {
-        TransientOptions {
-            ode: OdeOptions {
-                max_order: DEFAULT_MAX_ORDER,
-                ..OdeOptions::default()
-            },
-            problem: ProblemOptions::default(),
-            output_step: 1e-4,
-            end_time: None,
-        }
-    }
-}
-
-/// Output curves of a run, one entry per output time.
-#[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
-pub struct Curves {
-    /// Output times, s.
-    pub t: Vec<f64>,
-    /// ‖f_c‖, N.
-    pub contact_force_norm: Vec<f64>,
-    /// ‖f_R‖, N.
-    pub friction_force_norm: Vec<f64>,
-    /// Master node u_y, mm.
-    pub master_uy: Vec<f64>,
-    /// Kinetic energy, N·mm.
-    pub kinetic: Vec<f64>,
-    /// Strain energy, N·mm.
-    pub strain: Vec<f64>,
-    /// Pair (penalty and stick) energy, N·mm.
-    pub pair: Vec<f64>,
-    /// External work, N·mm.
-    pub external_work: Vec<f64>,
-    /// Dissipated energy, N·mm.
-    pub dissipated: Vec<f64>,
-}
-
-impl Curves {
-    fn push(&mut self, s: &EnergySample) {
-        self.t.push(s.t);
-        self.contact_force_norm.push(s.contact_force_norm);
-        self.friction_force_norm.push(s.friction_force_norm);
-        self.master_uy.push(s.master[1]);
-        self.kinetic.push(s.kinetic);
-        self.strain.push(s.strain);
-        self.pair.push(s.pair);
-        self.external_work.push(s.external_work);
-        self.dissipated.push(s.dissipated);
-    }
-
-    /// The energy balance `E_kin + E_strain + E_pair + D − W` at each output, N·mm.
-    pub fn balance(&self) -> Vec<f64> {
-        (0..self.t.len())
-            .map(|i| {
-                self.kinetic[i] + self.strain[i] + self.pair[i] + self.dissipated[i]
-                    - self.external_work[i]
-            })
-            .collect()
-    }
-}
-
-/// The result of [`run`].
-#[derive(Clone, Debug, PartialEq, serde::Serialize)]
-pub struct TransientResult {
-    /// Integrator statistics.
-    pub stats: OdeStats,
-    /// Wall-clock time of the integration (excluding the system's construction), s.
-    pub wall_s: f64,
-    /// Process CPU time of the integration, s (from `/proc/self/stat`, 10 ms resolution; NaN
-    /// where unavailable).
-    pub cpu_s: f64,
-    /// Events located (and re-initialisations done) with events on.
-    pub events: u64,
-    /// Output curves.
-    pub curves: Curves,
-    /// Final state `y` (q, v, s, W, D).
-    pub final_state: Vec<f64>,
-}
-
-/// Roots in a row at the same time after which [`run`] gives up.
-const MAX_STALLED_ROOTS: usize = 1000;
-
-/// Process CPU time (user + system), s, from `/proc/self/stat` (clock ticks of 1/100 s); NaN
-/// where unavailable.
-pub fn cpu_time() -> f64 {
-    std::fs::read_to_string("/proc/self/stat")
-        .ok()
-        .and_then(|s| {
-            // Fields after the command name (which is in parentheses and may contain spaces).
-            let rest = &s[s.rfind(')')? + 2..];
-            let f: Vec<&str> = rest.split_whitespace().collect();
-            let ut: f64 = f.get(11)?.parse().ok()?;
-            let st: f64 = f.get(12)?.parse().ok()?;
-            Some((ut + st) / 100.0)
-        })
-        .unwrap_or(f64::NAN)
-}
-
-/// Integrates a system from rest over `[0, end]` with CVODE and samples the outputs every
-/// `output_step`. With events on, each located root (gap or stick/slip switch) restarts the
-/// integrator there (`CVodeReInit`: order 1, history discarded — the right-hand side is only
-/// piecewise smooth across a switch).
-///
-/// # Errors
-/// [`Error::Invalid`] for a non-positive or non-finite `output_step`/`end_time` or `tau`; any
-/// integrator error ([`Error::Sundials`] with the flag and time reached, callback errors).
-pub fn run<S: SecondOrderSystem>(
-    system: S,
-    opts: &TransientOptions,
-) -> Result<TransientResult, Error> {
-    run_observed(system, opts, |_, _| {})
-}
-
-/// [`run`], calling `observe(t, q)` with the system's coordinates `q` (the first `dim` entries
-/// of the state) at t = 0 and at every output time — e.g. to keep displacement snapshots of a
-/// full-FE run for a POD basis ([`crate::reduction::snapshot_basis`]).
-///
-/// # Errors
-/// As [`run`].
-pub fn run_observed<S: SecondOrderSystem>(
-    system: S,
-    opts: &TransientOptions,
-    mut observe: impl FnMut(f64, &[f64]),
-) -> Result<TransientResult, Error> {
-    let end = opts.end_time.unwrap_or_else(|| system.end_time());
-    if !(end.is_finite() && end > 0.0) {
-        return Err(Error::Invalid(format!(
-            "end_time must be finite and positive, got {end} s"
-        )));
-    }
-    if !(opts.output_step.is_finite() && opts.output_step > 0.0) {
-        return Err(Error::Invalid(format!(
-            "output_step must be finite and positive, got {} s",
-            opts.output_step
-        )));
-    }
-    let mut ode = MechanicalOde::new(system, &opts.problem)?;
-    let dim = ode.coords();
-    let y0 = ode.initial_state();
-    let mut curves = Curves::default();
-    curves.push(&ode.sample(0.0, &y0));
-    observe(0.0, &y0[..dim]);
-    let wall = std::time::Instant::now();
-    let cpu0 = cpu_time();
-    let mut cv = Cvode::new(ode, 0.0, &y0, &opts.ode)?;
-    let steps = (end / opts.output_step - 1e-9).ceil().max(1.0) as usize;
-    let mut events = 0u64;
-    let mut last_root_t = f64::NEG_INFINITY;
-    let mut stalled = 0usize;
-    for k in 1..=steps {
-        let tout = (k as f64 * opts.output_step).min(end);
-        loop {
-            match cv.solve_to(tout)? {
-                Stop::Reached(_) => break,
-                Stop::Root { t, .. } => {
-                    events += 1;
-                    // Guard against chattering: roots that make no progress in time.
-                    if t - last_root_t <= 1e-13 * t.abs().max(1e-3) {
-                        stalled += 1;
-                        if stalled > MAX_STALLED_ROOTS {
-                            return Err(Error::Invalid(format!(
-                                "events: {MAX_STALLED_ROOTS} roots without progress at t = {t} s \
-                                 (chattering switch); run with events off"
-                            )));
-                        }
-                    } else {
-                        stalled = 0;
-                    }
-                    last_root_t = t;
-                    let y = cv.y().to_vec();
-                    cv.reinit(t, &y)?;
-                }
-            }
-        }
-        let t = cv.t();
-        let y = cv.y().to_vec();
-        let s = cv.problem_mut().sample(t, &y);
-        curves.push(&s);
-        observe(t, &y[..dim]);
-    }
-    let wall_s = wall.elapsed().as_secs_f64();
-    let cpu_s = cpu_time() - cpu0;
-    Ok(TransientResult {
-        stats: cv.stats(),
-        wall_s,
-        cpu_s,
-        events,
-        curves,
-        final_state: cv.y().to_vec(),
-    })
 }

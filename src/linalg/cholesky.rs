@@ -1,38 +1,166 @@
-//! Linear statics: `K q = f` by sparse Cholesky (faer), factored once for many right-hand sides.
+//! Sparse SPD Cholesky (faer): one symbolic analysis per pattern, numeric factorizations per
+//! value set, solves for one or many right-hand sides; `K q = f` with a residual check.
 
-use faer::linalg::solvers::Solve;
-use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
-use faer::{Mat, Side};
+use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
+use faer::linalg::cholesky::llt::factor::LltRegularization;
+use faer::linalg::solvers::LltError;
+use faer::sparse::linalg::cholesky::{
+    factorize_symbolic_cholesky, CholeskySymbolicParams, LltRef, SymbolicCholesky,
+    SymmetricOrdering,
+};
+use faer::sparse::linalg::LltError as SparseLltError;
+use faer::sparse::FaerError;
+use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
+use faer::{get_global_parallelism, Conj, Mat, MatMut, Par, Side};
 
 use crate::error::Error;
 use crate::linalg::SymCsc;
 
-/// A sparse Cholesky factorization `A = L Lᵀ` of a symmetric positive definite matrix.
+/// A sparse Cholesky factorization `A = L Lᵀ` of a symmetric positive definite matrix with a
+/// fixed pattern: the symbolic analysis (AMD ordering) once, numeric factorizations as often as
+/// the values change, solves for one column into preallocated scratch (no allocation: the
+/// Newton solve of a transient) or for many columns at once.
+///
+/// The one SPD factorization of jointrom: statics, constraint modes, shift-invert eigen solves,
+/// the mass and Newton matrices of the full model.
 pub struct SparseCholesky {
     n: usize,
-    llt: Llt<usize, f64>,
+    pattern: SymbolicSparseColMat<usize>,
+    symbolic: SymbolicCholesky<usize>,
+    l_values: Vec<f64>,
+    /// Parallelism of the numeric factorization and of many-column solves.
+    par: Par,
+    /// Scratch of the numeric factorization and of a one-column solve.
+    mem: MemBuffer,
+    factored: bool,
 }
 
 impl SparseCholesky {
-    /// Factors `a` (symbolic analysis with AMD ordering, then numeric). Errors if `a` is not
-    /// positive definite (e.g. an unsupported, singular structure).
+    /// Factors `a` (symbolic analysis with AMD ordering, then numeric, with faer's global
+    /// parallelism). Errors if `a` is not positive definite (e.g. an unsupported, singular
+    /// structure).
     pub fn new(a: &SymCsc) -> Result<SparseCholesky, Error> {
-        let mat = a.to_faer();
-        let symbolic = SymbolicLlt::try_new(mat.symbolic(), Side::Lower).map_err(|e| {
+        let mut chol = SparseCholesky::analyze_with(
+            a.n,
+            a.col_ptr.clone(),
+            a.row_idx.clone(),
+            get_global_parallelism(),
+        )
+        .map_err(|e| {
             Error::LinearAlgebra(format!("symbolic Cholesky of a {0}×{0} matrix: {e:?}", a.n))
         })?;
-        let llt = Llt::try_new_with_symbolic(symbolic, mat.as_ref(), Side::Lower).map_err(|e| {
+        chol.factor_with(&a.values, |e| {
             Error::LinearAlgebra(format!(
-                "the {0}×{0} matrix is not positive definite (singular or unsupported structure): {e:?}",
-                a.n
+                "the {0}×{0} matrix is not positive definite (singular or unsupported structure): {1:?}",
+                a.n,
+                SparseLltError::Numeric(e)
             ))
         })?;
-        Ok(SparseCholesky { n: a.n, llt })
+        Ok(chol)
     }
 
-    /// Solves in place for all columns of `rhs`.
+    /// The symbolic analysis of the pattern `col_ptr`/`row_idx` (n × n, both triangles,
+    /// sorted rows), for sequential numeric factorizations with [`SparseCholesky::factor`].
+    pub fn analyze(
+        n: usize,
+        col_ptr: Vec<usize>,
+        row_idx: Vec<usize>,
+    ) -> Result<SparseCholesky, Error> {
+        SparseCholesky::analyze_with(n, col_ptr, row_idx, Par::Seq)
+            .map_err(|e| Error::LinearAlgebra(format!("symbolic Cholesky ({n}×{n}): {e:?}")))
+    }
+
+    fn analyze_with(
+        n: usize,
+        col_ptr: Vec<usize>,
+        row_idx: Vec<usize>,
+        par: Par,
+    ) -> Result<SparseCholesky, FaerError> {
+        let pattern = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx);
+        let symbolic = factorize_symbolic_cholesky(
+            pattern.as_ref(),
+            Side::Lower,
+            SymmetricOrdering::Amd,
+            CholeskySymbolicParams::default(),
+        )?;
+        let req = StackReq::any_of(&[
+            symbolic.factorize_numeric_llt_scratch::<f64>(par, Default::default()),
+            symbolic.solve_in_place_scratch::<f64>(1, Par::Seq),
+        ]);
+        Ok(SparseCholesky {
+            n,
+            l_values: vec![0.0; symbolic.len_val()],
+            mem: MemBuffer::new(req),
+            pattern,
+            symbolic,
+            par,
+            factored: false,
+        })
+    }
+
+    /// Factors the values of the analysed pattern; `what` names the matrix in the error if it
+    /// is not positive definite.
+    pub fn factor(&mut self, values: &[f64], what: &str) -> Result<(), Error> {
+        let n = self.n;
+        self.factor_with(values, |e| {
+            Error::LinearAlgebra(format!("{what} ({n}×{n}) is not positive definite: {e:?}"))
+        })
+    }
+
+    fn factor_with(
+        &mut self,
+        values: &[f64],
+        error: impl FnOnce(LltError) -> Error,
+    ) -> Result<(), Error> {
+        self.factored = false;
+        let a = SparseColMatRef::new(self.pattern.as_ref(), values);
+        self.symbolic
+            .factorize_numeric_llt(
+                &mut self.l_values,
+                a,
+                Side::Lower,
+                LltRegularization::default(),
+                self.par,
+                MemStack::new(&mut self.mem),
+                Default::default(),
+            )
+            .map_err(error)?;
+        self.factored = true;
+        Ok(())
+    }
+
+    /// `x ← A⁻¹ x` for one column, sequential, in preallocated scratch (NaN if the last
+    /// factorization failed).
+    pub fn solve_vec_in_place(&mut self, x: &mut [f64]) {
+        if !self.factored {
+            x.fill(f64::NAN);
+            return;
+        }
+        let rhs = MatMut::from_column_major_slice_mut(x, self.n, 1);
+        LltRef::new(&self.symbolic, &self.l_values).solve_in_place_with_conj(
+            Conj::No,
+            rhs,
+            Par::Seq,
+            MemStack::new(&mut self.mem),
+        );
+    }
+
+    /// Solves in place for all columns of `rhs` (NaN if the last factorization failed).
     pub fn solve_in_place(&self, rhs: &mut Mat<f64>) {
-        self.llt.solve_in_place(rhs.as_mut());
+        if !self.factored {
+            rhs.fill(f64::NAN);
+            return;
+        }
+        let mut mem = MemBuffer::new(
+            self.symbolic
+                .solve_in_place_scratch::<f64>(rhs.ncols(), self.par),
+        );
+        LltRef::new(&self.symbolic, &self.l_values).solve_in_place_with_conj(
+            Conj::No,
+            rhs.as_mut(),
+            self.par,
+            MemStack::new(&mut mem),
+        );
     }
 
     /// Dimension.

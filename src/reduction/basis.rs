@@ -199,7 +199,7 @@ pub fn modal_rotation(model: &Model, phi: Mat<f64>) -> Result<(Mat<f64>, Vec<f64
     if phi.ncols() == 0 {
         return Ok((phi, Vec::new()));
     }
-    let k = super::compensated_gram(&model.stiffness, phi.as_ref());
+    let k = crate::linalg::compensated::compensated_gram(&model.stiffness, phi.as_ref());
     let evd = k
         .self_adjoint_eigen(Side::Lower)
         .map_err(|e| Error::LinearAlgebra(format!("reduced eigenproblem: {e:?}")))?;

@@ -26,7 +26,9 @@
 //! 4. [`final_basis`]: the parts concatenated and M-orthonormalized (so `M̃ = I`), dependent
 //!    directions dropped; [`build_basis`] then rotates Φ to the reduced eigenbasis
 //!    ([`modal_rotation`]: `K̃ = diag(ω²)`, same span) unless `BasisOptions::modal` is false.
-//! 5. [`ReducedModel`]: `K̃`, `M̃`, the reduced joint operator `B Φ` and the reduced load.
+//! 5. The reduced system on Φ ([`crate::system::ReducedSystem`], from
+//!    [`crate::system::FullSystem::reduce`] or [`crate::system::ReducedSystem::new`]): `K̃`, `M̃`,
+//!    the reduced joint operator `B Φ` and the reduced load.
 //!
 //! The competitors of the paper's Section 5, behind the same [`build_basis`] ([`BasisKind`]):
 //! modes only (more fixed-interface modes), [`jim`] (Joint Interface Modes, Section 5.3),
@@ -56,58 +58,3 @@ pub use competitors::{
 pub use craig_bampton::craig_bampton;
 pub use pod::{pod, pod_tvd, sigma_zero, Pod, DEFAULT_THRESHOLD, ZERO_EIGENVALUE};
 pub use tvd::{active_pairs, trial_vector_derivatives, Tvd, TvdFactor, TvdIndex, TvdOptions};
-
-use faer::Mat;
-
-use crate::error::Error;
-use crate::linalg::compensated::compensated_gram;
-use crate::model::Model;
-
-/// A model reduced on a basis Φ (eq. 7).
-#[derive(Clone, Debug)]
-pub struct ReducedModel {
-    /// The basis Φ (n × r).
-    pub phi: Mat<f64>,
-    /// `K̃ = ΦᵀKΦ` (r × r).
-    pub k: Mat<f64>,
-    /// `M̃ = ΦᵀMΦ` (r × r); the identity for a basis from [`final_basis`].
-    pub m: Mat<f64>,
-    /// `B Φ` (3w × r): rows normal, t1, t2 per pair, as [`crate::joint::JointOperator`].
-    pub b_phi: Mat<f64>,
-    /// `Φᵀ f_master` (r) for the case's final master load (N, N·mm), to be scaled by its ramp.
-    pub load: Vec<f64>,
-}
-
-impl ReducedModel {
-    /// Projects the model on `phi` (n × r).
-    pub fn new(model: &Model, phi: Mat<f64>) -> Result<ReducedModel, Error> {
-        if phi.nrows() != model.dofs() {
-            return Err(Error::Invalid(format!(
-                "basis has {} rows, the model {} DOF",
-                phi.nrows(),
-                model.dofs()
-            )));
-        }
-        let k = compensated_gram(&model.stiffness, phi.as_ref());
-        let m = compensated_gram(&model.mass, phi.as_ref());
-        let r = phi.ncols();
-        let b_phi = model.joint.reduce(phi.as_ref());
-        let f = model.load.master.to_array();
-        let master = model.master_dofs();
-        let load = (0..r)
-            .map(|c| (0..6).map(|d| phi[(master[d], c)] * f[d]).sum())
-            .collect();
-        Ok(ReducedModel {
-            phi,
-            k,
-            m,
-            b_phi,
-            load,
-        })
-    }
-
-    /// Reduced dimension r.
-    pub fn dim(&self) -> usize {
-        self.phi.ncols()
-    }
-}

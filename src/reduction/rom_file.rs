@@ -46,8 +46,7 @@ use crate::case::{ContactSpec, MasterLoadSpec, RampSpec};
 use crate::error::Error;
 use crate::joint::law::DEFAULT_TAU;
 use crate::model::Model;
-use crate::reduction::ReducedModel;
-use crate::system::{ReducedParts, ReducedSystem};
+use crate::system::{ReducedMatrices, ReducedSystem, Scene};
 
 /// Schema name of the file.
 pub const SCHEMA: &str = "jointrom-rom";
@@ -118,13 +117,10 @@ fn rows(a: &Mat<f64>) -> Vec<Vec<f64>> {
 
 impl RomFile {
     /// The file of a reduced model of `model`.
-    pub fn new(model: &Model, rom: &ReducedModel, basis: BasisInfo) -> Result<RomFile, Error> {
+    pub fn new(model: &Model, rom: &ReducedSystem, basis: BasisInfo) -> Result<RomFile, Error> {
         let r = rom.dim();
-        let master = model.master_dofs();
-        let phi_master = Mat::from_fn(6, r, |d, c| rom.phi[(master[d], c)]);
-        let column_size = (0..r)
-            .map(|c| rom.phi.col(c).iter().fold(0.0f64, |m, x| m.max(x.abs())))
-            .collect();
+        let phi_master = &rom.phi_master;
+        let column_size = rom.column_size.clone();
         Ok(RomFile {
             schema: SCHEMA.into(),
             version: VERSION,
@@ -135,8 +131,8 @@ impl RomFile {
             mass: rows(&rom.m),
             stiffness: rows(&rom.k),
             joint_operator: rows(&rom.b_phi),
-            master_rows: rows(&phi_master),
-            reduced_loads: rows(&phi_master),
+            master_rows: rows(phi_master),
+            reduced_loads: rows(phi_master),
             master_load: model.load.master,
             load_ramp: model.load.ramp,
             contact: model.contact,
@@ -237,18 +233,27 @@ impl RomFile {
             let nc = m.first().map_or(self.dimension, Vec::len);
             Mat::from_fn(m.len(), nc, |i, j| m[i][j])
         };
-        ReducedSystem::from_parts(ReducedParts {
-            k: mat(&self.stiffness),
-            m: mat(&self.mass),
-            b_phi: mat(&self.joint_operator),
-            phi_master: mat(&self.master_rows),
-            column_size: self.coordinate_size.clone(),
-            load: crate::case::LoadSpec {
-                master: self.master_load,
-                ramp: self.load_ramp,
+        ReducedSystem::from_matrices(
+            ReducedMatrices {
+                k: mat(&self.stiffness),
+                m: mat(&self.mass),
+                b_phi: mat(&self.joint_operator),
+                phi_master: mat(&self.master_rows),
+                column_size: self.coordinate_size.clone(),
+                load: crate::case::LoadSpec {
+                    master: self.master_load,
+                    ramp: self.load_ramp,
+                },
             },
+            None,
+        )
+    }
+
+    /// The contact law and the span the reduced model was exported with.
+    pub fn scene(&self) -> Scene {
+        Scene {
             contact: self.contact,
             end_time: self.end_time,
-        })
+        }
     }
 }

@@ -38,14 +38,14 @@ use std::time::Instant;
 use serde::Serialize;
 
 use crate::error::Error;
-use crate::integrate::mechanical::{ProblemOptions, TransientOptions};
 use crate::integrate::problem::{Iteration, OdeOptions, OdeStats};
+use crate::integrate::{integrate, ProblemOptions, Run, RunStatus, Scene, TransientOptions};
 use crate::model::Model;
-use crate::reduction::{build_basis, BasisKind, BasisOptions, ReducedModel};
+use crate::reduction::{build_basis, BasisKind, BasisOptions};
 use crate::report::chart::{LegendPosition, LineChart, Reference, Series};
 use crate::studies::convergence::{self as study, StudyOptions};
-use crate::studies::stability::{integrate_budgeted, relative_l2, Outcome};
-use crate::system::{FullSystem, ReducedSystem};
+use crate::studies::stability::{relative_l2, Outcome};
+use crate::system::{FullSystem, ReducedSystem, SecondOrderSystem};
 
 /// Options of [`run_report`]. Defaults: the full job (case end time, study g ≤ 60, functional
 /// iteration runs included), budgets 60 s per reduced run and 600 s for the full run, progress
@@ -92,7 +92,7 @@ pub struct RunRecord {
     /// `newton` or `functional`.
     pub iteration: String,
     /// `ok`, `budget` or the CVODE flag.
-    pub status: String,
+    pub status: RunStatus,
     /// Failure message.
     pub message: Option<String>,
     /// Time reached, s.
@@ -286,6 +286,29 @@ fn record(
     }
 }
 
+/// One run of the report through the driver, from rest over `span` = (end, output step) s,
+/// under a wall-clock budget (s); a system that could not be built is the run's status.
+fn budgeted<S: SecondOrderSystem>(
+    sys: Result<S, Error>,
+    model: &Model,
+    problem: &ProblemOptions,
+    ode: OdeOptions,
+    span: (f64, f64),
+    budget_s: f64,
+) -> Outcome {
+    let opts = TransientOptions {
+        ode,
+        problem: *problem,
+        output_step: span.1,
+        end_time: Some(span.0),
+        budget_s: Some(budget_s),
+    };
+    Outcome::of_run(match sys {
+        Ok(s) => integrate(s, &Scene::of(model), &opts, |_, _| {}),
+        Err(e) => Run::failed(e),
+    })
+}
+
 fn ode_options(functional: bool) -> OdeOptions {
     let mut ode = TransientOptions::default().ode;
     if functional {
@@ -367,12 +390,12 @@ pub fn run_report(
     let t0 = Instant::now();
     let full_sys = FullSystem::new(model);
     let build_full = t0.elapsed().as_secs_f64();
-    let full = integrate_budgeted(
+    let full = budgeted(
         full_sys,
+        model,
         &problem,
-        &ode_options(false),
-        end_time,
-        output_step,
+        ode_options(false),
+        (end_time, output_step),
         opts.full_budget_s,
     );
     if !full.ok() {
@@ -386,12 +409,12 @@ pub fn run_report(
     let mut runs = vec![record("full", None, model.dofs(), false, build_full, full)];
     bar.inc(1);
     bar.set_message("full FE model, functional iteration");
-    let full_fun = integrate_budgeted(
+    let full_fun = budgeted(
         FullSystem::new(model),
+        model,
         &problem,
-        &ode_options(true),
-        end_time,
-        output_step,
+        ode_options(true),
+        (end_time, output_step),
         if opts.quick {
             opts.full_functional_budget_s.min(2.0)
         } else {
@@ -426,20 +449,21 @@ pub fn run_report(
             },
         )?;
         let g_used = basis.g;
-        let rm = ReducedModel::new(model, basis.phi)?;
+        let rm = ReducedSystem::new(model, basis.phi)?;
         let build_s = t0.elapsed().as_secs_f64();
-        let o = integrate_budgeted(
-            ReducedSystem::new(model, &rm),
+        let dim = rm.dim();
+        let o = budgeted(
+            Ok(rm),
+            model,
             &problem,
-            &ode_options(p.functional),
-            end_time,
-            output_step,
+            ode_options(p.functional),
+            (end_time, output_step),
             opts.rom_budget_s,
         );
         runs.push(record(
             p.kind.name(),
             Some(g_used),
-            rm.dim(),
+            dim,
             p.functional,
             build_s,
             o,
@@ -460,7 +484,7 @@ pub fn run_report(
         )
     };
     for r in runs.iter_mut().skip(1) {
-        if r.status != "ok" {
+        if !r.status.finished() {
             continue;
         }
         r.error_fc = relative_l2(&r.t, &r.fc, &t_ref, &fc_ref);
@@ -559,8 +583,8 @@ fn relative(dir: &Path, f: &Path) -> String {
 fn mark_pareto(runs: &mut [RunRecord]) {
     let pts: Vec<Option<(f64, f64)>> = runs
         .iter()
-        .map(|r| match (r.status.as_str(), r.error_fc) {
-            ("ok", Some(e)) if r.cpu_s.is_finite() && e.is_finite() => Some((r.cpu_s, e)),
+        .map(|r| match (r.status.finished(), r.error_fc) {
+            (true, Some(e)) if r.cpu_s.is_finite() && e.is_finite() => Some((r.cpu_s, e)),
             _ => None,
         })
         .collect();
@@ -741,7 +765,7 @@ fn markdown(rep: &Report, stab: &Path, stability: bool) -> String {
             r.g.map_or("–".into(), |g| g.to_string()),
             r.size,
             r.iteration,
-            if r.status == "ok" {
+            if r.status.finished() {
                 "ok".to_string()
             } else {
                 format!("{} at t = {:.3e} s", r.status, r.t_reached)

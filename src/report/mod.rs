@@ -5,4 +5,5 @@ pub mod chart;
 pub mod heatmap;
 pub mod main_job;
 pub mod shapes;
+pub mod stability;
 pub mod vtu;

@@ -31,7 +31,7 @@
 //!
 //! The expensive parts run once: the full solution, Craig–Bampton, each TVD variant and its POD,
 //! and the ν + `max_g` fixed-interface modes of `modes`. Per g and kind only the
-//! M-orthonormalization of `6 + ν + g` columns, the projection (`ReducedModel`) and the dense
+//! M-orthonormalization of `6 + ν + g` columns, the projection (`ReducedSystem`) and the dense
 //! reduced contact solve remain.
 //!
 //! Two references without a g axis are recorded too: `tvd_spans`, the basis with *all* nonzero
@@ -88,8 +88,9 @@ use crate::model::contact_static_full;
 use crate::model::Model;
 use crate::reduction::{
     alldof_vectors, build_basis, craig_bampton, final_basis, jim_vectors, trial_vector_derivatives,
-    BasisKind, BasisOptions, JimSet, ReducedModel, TvdOptions, DEFAULT_DROP_TOL, DEFAULT_THRESHOLD,
+    BasisKind, BasisOptions, JimSet, TvdOptions, DEFAULT_DROP_TOL, DEFAULT_THRESHOLD,
 };
+use crate::system::ReducedSystem;
 
 /// The basis kinds of `jointrom static --basis`, by name (the one list; see [`parse_basis`]).
 pub const BASIS_KINDS: &[(&str, BasisKind)] = &[
@@ -153,14 +154,14 @@ pub struct ReducedStatic {
 /// ([`contact_static_reduced`] on `K̃` and the normal rows of `B Φ`).
 pub fn reduced_contact_static(
     model: &Model,
-    rm: &ReducedModel,
+    rm: &ReducedSystem,
     scale: f64,
     opts: &ContactOptions,
 ) -> Result<ReducedStatic, Error> {
     let w = model.joint.pairs();
     let r = rm.dim();
     let b_n = Mat::from_fn(w, r, |i, j| rm.b_phi[(3 * i + NORMAL, j)]);
-    let f: Vec<f64> = rm.load.iter().map(|v| v * scale).collect();
+    let f: Vec<f64> = rm.reduced_load().iter().map(|v| v * scale).collect();
     let (eta, state) = contact_static_reduced(
         rm.k.as_ref(),
         b_n.as_ref(),
@@ -168,8 +169,8 @@ pub fn reduced_contact_static(
         model.contact.normal_stiffness,
         opts,
     )?;
-    let master = model.master_dofs();
-    let master_displacement = master.map(|d| (0..r).map(|c| rm.phi[(d, c)] * eta[c]).sum::<f64>());
+    let master_displacement: [f64; 6] =
+        std::array::from_fn(|k| (0..r).map(|c| rm.phi_master[(k, c)] * eta[c]).sum::<f64>());
     Ok(ReducedStatic {
         eta,
         master_displacement,
@@ -183,7 +184,7 @@ pub fn reduced_contact_static(
 /// basis. Returns the solution and the first attempt's error if the fallback was needed.
 pub fn reduced_contact_static_restarting(
     model: &Model,
-    rm: &ReducedModel,
+    rm: &ReducedSystem,
     scale: f64,
     opts: &ContactOptions,
 ) -> Result<(ReducedStatic, Option<Error>), Error> {
@@ -215,7 +216,7 @@ pub fn reduced_contact_static_restarting(
 /// exactly. Starts from η = 0 (all pairs open); at most `20 · opts.max_iterations` steps.
 pub fn reduced_contact_static_damped(
     model: &Model,
-    rm: &ReducedModel,
+    rm: &ReducedSystem,
     scale: f64,
     opts: &ContactOptions,
 ) -> Result<ReducedStatic, Error> {
@@ -223,7 +224,7 @@ pub fn reduced_contact_static_damped(
     let r = rm.dim();
     let k_n = model.contact.normal_stiffness;
     let b = Mat::from_fn(w, r, |i, j| rm.b_phi[(3 * i + NORMAL, j)]);
-    let f: Vec<f64> = rm.load.iter().map(|v| v * scale).collect();
+    let f: Vec<f64> = rm.reduced_load().iter().map(|v| v * scale).collect();
     let gaps_of = |eta: &[f64]| -> Vec<f64> {
         (0..w)
             .map(|i| (0..r).map(|j| b[(i, j)] * eta[j]).sum())
@@ -275,9 +276,9 @@ pub fn reduced_contact_static_damped(
                 .zip(&active)
                 .map(|(&g, &a)| if a { k_n * g } else { 0.0 })
                 .collect();
-            let master = model.master_dofs();
-            let master_displacement =
-                master.map(|dof| (0..r).map(|c| rm.phi[(dof, c)] * full[c]).sum::<f64>());
+            let master_displacement = std::array::from_fn(|k| {
+                (0..r).map(|c| rm.phi_master[(k, c)] * full[c]).sum::<f64>()
+            });
             let state = ContactState {
                 contact_force_norm: forces.iter().map(|p| p * p).sum::<f64>().sqrt(),
                 pairs_in_contact: active.iter().filter(|&&a| a).count(),
@@ -369,7 +370,7 @@ pub fn basis_static(
     }
     let t1 = Instant::now();
     let basis_size = basis.phi.ncols();
-    let rm = ReducedModel::new(model, basis.phi)?;
+    let rm = ReducedSystem::new(model, basis.phi)?;
     let (solution, first) =
         reduced_contact_static_restarting(model, &rm, scale, &ContactOptions::default())?;
     Ok(BasisStatic {
@@ -624,7 +625,7 @@ fn span_reference(
     let t0 = Instant::now();
     let (phi, dropped) = final_basis(&[cb, tvd], &model.mass, opts.drop_tol)?;
     let basis_size = phi.ncols();
-    let rm = ReducedModel::new(model, phi)?;
+    let rm = ReducedSystem::new(model, phi)?;
     let norm = reduced_contact_static_restarting(model, &rm, opts.scale, &opts.contact)
         .map(|(s, _)| s.state.contact_force_norm)
         .unwrap_or(f64::NAN);
@@ -887,7 +888,7 @@ fn sweep(
     for g in 0..=top {
         let (phi, _) = final_basis(&[base, extra.subcols(0, g)], &model.mass, opts.drop_tol)?;
         let r = phi.ncols();
-        let rm = ReducedModel::new(model, phi)?;
+        let rm = ReducedSystem::new(model, phi)?;
         let sol = match reduced_contact_static_restarting(model, &rm, opts.scale, &opts.contact) {
             Ok((sol, None)) => sol,
             Ok((sol, Some(first))) => {

@@ -101,22 +101,18 @@
 //! written in failed cells.
 
 use std::io::IsTerminal;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::Instant;
 
 use serde::Serialize;
 
 use crate::case::Case;
 use crate::error::Error;
-use crate::integrate::mechanical::{EnergySample, MechanicalOde, ProblemOptions};
-use crate::integrate::problem::{
-    CallbackError, Iteration, NewtonLinear, OdeOptions, OdeProblem, OdeStats, Stop,
-};
-use crate::integrate::sundials::Cvode;
+use crate::integrate::problem::{Iteration, NewtonLinear, OdeOptions, OdeStats};
+use crate::integrate::{integrate, ProblemOptions, Run, RunStatus, Scene, TransientOptions};
 use crate::model::Model;
-use crate::reduction::{build_basis, BasisKind, BasisOptions, ReducedModel};
-use crate::report::heatmap::{sequential, HeatCell, HeatMap};
-use crate::system::{FullSystem, ReducedSystem, SecondOrderSystem};
+use crate::reduction::{build_basis, BasisKind, BasisOptions};
+use crate::system::{FullSystem, ReducedSystem};
 
 /// The model of a cell.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
@@ -308,8 +304,8 @@ pub struct Cell {
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Outcome {
     /// `ok`, the CVODE flag (`CV_TOO_MUCH_WORK`, `CV_CONV_FAILURE`, `CV_ERR_FAILURE`, ...),
-    /// `budget`, `chatter` or `error`.
-    pub status: String,
+    /// `budget`, `chatter` or `error` (serialized as [`RunStatus::name`]).
+    pub status: RunStatus,
     /// The failure's message (`None` when ok).
     pub message: Option<String>,
     /// Time reached, s.
@@ -339,39 +335,25 @@ pub struct Outcome {
 impl Outcome {
     /// Whether the integration reached its end.
     pub fn ok(&self) -> bool {
-        self.status == "ok"
+        self.status.finished()
     }
 
-    fn push(&mut self, s: EnergySample) {
-        self.t.push(s.t);
-        self.fc.push(s.contact_force_norm);
-        self.fr.push(s.friction_force_norm);
-        self.uy.push(s.master[1]);
+    /// The record of a run of the driver.
+    pub fn of_run(run: Run) -> Outcome {
+        Outcome {
+            status: run.status,
+            message: run.failure.map(|e| e.to_string()),
+            t_reached: run.t_reached,
+            stats: run.stats,
+            events_found: run.events,
+            wall_s: run.wall_s,
+            cpu_s: run.cpu_s,
+            t: run.curves.t,
+            fc: run.curves.contact_force_norm,
+            fr: run.curves.friction_force_norm,
+            uy: run.curves.master_uy,
+        }
     }
-}
-
-/// Integrates `sys` from rest over `[0, end]` with outputs every `output_step` under a
-/// wall-clock budget (checked in every right-hand side). Never fails as a whole: a setup or
-/// integration failure, or the budget running out (`budget`), becomes the outcome's status, with
-/// the curves up to the time reached.
-pub fn integrate_budgeted<S: SecondOrderSystem>(
-    sys: Result<S, Error>,
-    problem: &ProblemOptions,
-    ode: &OdeOptions,
-    end: f64,
-    output_step: f64,
-    budget_s: f64,
-) -> Outcome {
-    integrate(
-        sys,
-        &RunSpec {
-            problem: *problem,
-            ode: ode.clone(),
-            end,
-            output_step,
-            budget_s,
-        },
-    )
 }
 
 /// A reference run.
@@ -429,179 +411,6 @@ pub struct Sweep {
     pub wall_s: f64,
 }
 
-/// Wraps a problem with a wall-clock deadline checked in every right-hand-side evaluation.
-struct Budgeted<P> {
-    inner: P,
-    deadline: Instant,
-    exceeded: bool,
-}
-
-impl<P: OdeProblem> OdeProblem for Budgeted<P> {
-    fn dim(&self) -> usize {
-        self.inner.dim()
-    }
-    fn rhs(&mut self, t: f64, y: &[f64], ydot: &mut [f64]) -> Result<(), CallbackError> {
-        if Instant::now() > self.deadline {
-            self.exceeded = true;
-            return Err(CallbackError::Fatal("wall-clock budget exceeded".into()));
-        }
-        self.inner.rhs(t, y, ydot)
-    }
-    fn num_roots(&self) -> usize {
-        self.inner.num_roots()
-    }
-    fn roots(&mut self, t: f64, y: &[f64], g: &mut [f64]) -> Result<(), CallbackError> {
-        self.inner.roots(t, y, g)
-    }
-    fn atol_scale(&self, scale: &mut [f64]) -> bool {
-        self.inner.atol_scale(scale)
-    }
-    fn has_newton_solver(&self) -> bool {
-        self.inner.has_newton_solver()
-    }
-    fn newton_setup(
-        &mut self,
-        t: f64,
-        y: &[f64],
-        fy: &[f64],
-        jok: bool,
-        gamma: f64,
-    ) -> Result<bool, CallbackError> {
-        self.inner.newton_setup(t, y, fy, jok, gamma)
-    }
-    fn newton_solve(
-        &mut self,
-        t: f64,
-        y: &[f64],
-        r: &[f64],
-        z: &mut [f64],
-        gamma: f64,
-    ) -> Result<(), CallbackError> {
-        self.inner.newton_solve(t, y, r, z, gamma)
-    }
-}
-
-/// Roots in a row without progress in time after which a cell is `chatter`.
-const MAX_STALLED_ROOTS: usize = 1000;
-
-/// What one integration needs besides the system.
-#[derive(Clone, Debug)]
-struct RunSpec {
-    problem: ProblemOptions,
-    ode: OdeOptions,
-    end: f64,
-    output_step: f64,
-    budget_s: f64,
-}
-
-/// The status name of an integration error: the CVODE flag where there is one.
-fn classify(e: &Error) -> String {
-    let flag_in = |s: &str| {
-        s.split(|c: char| !(c.is_ascii_alphanumeric() || c == '_'))
-            .find(|w| w.starts_with("CV_"))
-            .map(str::to_string)
-    };
-    match e {
-        Error::Sundials { flag, .. } => flag_in(flag).unwrap_or_else(|| "sundials".into()),
-        Error::Callback { flag, .. } => flag_in(flag).unwrap_or_else(|| "callback".into()),
-        Error::Invalid(m) if m.contains("chattering") => "chatter".into(),
-        _ => "error".into(),
-    }
-}
-
-/// Integrates `sys` from rest; never fails as a whole: setup and integration errors become the
-/// outcome's status.
-fn integrate<S: SecondOrderSystem>(sys: Result<S, Error>, spec: &RunSpec) -> Outcome {
-    let mut out = Outcome {
-        status: "ok".into(),
-        message: None,
-        t_reached: 0.0,
-        stats: OdeStats::default(),
-        events_found: 0,
-        wall_s: 0.0,
-        cpu_s: 0.0,
-        t: Vec::new(),
-        fc: Vec::new(),
-        fr: Vec::new(),
-        uy: Vec::new(),
-    };
-    let fail = |mut out: Outcome, e: Error| {
-        out.status = classify(&e);
-        out.message = Some(e.to_string());
-        out
-    };
-    let ode = match sys.and_then(|s| MechanicalOde::new(s, &spec.problem)) {
-        Ok(o) => o,
-        Err(e) => return fail(out, e),
-    };
-    let mut ode = ode;
-    let y0 = ode.initial_state();
-    out.push(ode.sample(0.0, &y0));
-    let wall = Instant::now();
-    let cpu = crate::integrate::mechanical::cpu_time();
-    let problem = Budgeted {
-        inner: ode,
-        deadline: wall + std::time::Duration::from_secs_f64(spec.budget_s),
-        exceeded: false,
-    };
-    let mut cv = match Cvode::new(problem, 0.0, &y0, &spec.ode) {
-        Ok(c) => c,
-        Err(e) => return fail(out, e),
-    };
-    let outputs = (spec.end / spec.output_step - 1e-9).ceil().max(1.0) as usize;
-    let mut last_root_t = f64::NEG_INFINITY;
-    let mut stalled = 0usize;
-    let mut result: Result<(), Error> = Ok(());
-    'outer: for k in 1..=outputs {
-        let tout = (k as f64 * spec.output_step).min(spec.end);
-        loop {
-            match cv.solve_to(tout) {
-                Ok(Stop::Reached(_)) => break,
-                Ok(Stop::Root { t, .. }) => {
-                    out.events_found += 1;
-                    if t - last_root_t <= 1e-13 * t.abs().max(1e-3) {
-                        stalled += 1;
-                        if stalled > MAX_STALLED_ROOTS {
-                            result = Err(Error::Invalid(format!(
-                                "events: {MAX_STALLED_ROOTS} roots without progress at \
-                                 t = {t} s (chattering switch)"
-                            )));
-                            break 'outer;
-                        }
-                    } else {
-                        stalled = 0;
-                    }
-                    last_root_t = t;
-                    let y = cv.y().to_vec();
-                    if let Err(e) = cv.reinit(t, &y) {
-                        result = Err(e);
-                        break 'outer;
-                    }
-                }
-                Err(e) => {
-                    result = Err(e);
-                    break 'outer;
-                }
-            }
-        }
-        let t = cv.t();
-        let y = cv.y().to_vec();
-        out.push(cv.problem_mut().inner.sample(t, &y));
-    }
-    out.wall_s = wall.elapsed().as_secs_f64();
-    out.cpu_s = crate::integrate::mechanical::cpu_time() - cpu;
-    out.stats = cv.stats();
-    out.t_reached = cv.t();
-    if let Err(e) = result {
-        let budget = cv.problem().exceeded;
-        out = fail(out, e);
-        if budget {
-            out.status = "budget".into();
-        }
-    }
-    out
-}
-
 /// Relative L2 difference of `a` against `reference` over the times of `a` that the reference
 /// has too (matched to 1e-6 of the smaller spacing); `None` with fewer than 2 matched nonzero
 /// points or a zero reference.
@@ -636,14 +445,21 @@ pub fn relative_l2(t_a: &[f64], a: &[f64], t_ref: &[f64], reference: &[f64]) -> 
 /// A model of one k_n, ready to build systems.
 enum Prepared {
     Full,
-    Rom(Box<ReducedModel>),
+    Rom(Box<ReducedSystem>),
 }
 
-fn system_run(model: &Model, prep: &Prepared, spec: &RunSpec) -> Outcome {
-    match prep {
-        Prepared::Full => integrate(FullSystem::new(model), spec),
-        Prepared::Rom(rm) => integrate(ReducedSystem::new(model, rm), spec),
-    }
+/// Integrates a prepared model through the one driver; a system that cannot be built becomes
+/// the outcome's status.
+fn system_run(model: &Model, prep: &Prepared, opts: &TransientOptions) -> Outcome {
+    let scene = Scene::of(model);
+    let run = match prep {
+        Prepared::Full => match FullSystem::new(model) {
+            Ok(s) => integrate(s, &scene, opts, |_, _| {}),
+            Err(e) => Run::failed(e),
+        },
+        Prepared::Rom(rm) => integrate(rm.as_ref().clone(), &scene, opts, |_, _| {}),
+    };
+    Outcome::of_run(run)
 }
 
 fn check_options(o: &SweepOptions) -> Result<(), Error> {
@@ -744,7 +560,7 @@ pub fn run_sweep_model(base: &Model, model_s: f64, opts: &SweepOptions) -> Resul
                         .fold(f64::NAN, f64::max)
                         .sqrt()
                         / (2.0 * std::f64::consts::PI);
-                    let rm = ReducedModel::new(&model, basis.phi)?;
+                    let rm = ReducedSystem::new(&model, basis.phi)?;
                     let dim = rm.dim();
                     (Prepared::Rom(Box::new(rm)), dim, Some(basis.g), Some(fmax))
                 }
@@ -780,7 +596,7 @@ pub fn run_sweep_model(base: &Model, model_s: f64, opts: &SweepOptions) -> Resul
                     } else {
                         opts.end_time
                     };
-                    let spec = RunSpec {
+                    let spec = TransientOptions {
                         problem: ProblemOptions {
                             friction,
                             events: false,
@@ -795,16 +611,16 @@ pub fn run_sweep_model(base: &Model, model_s: f64, opts: &SweepOptions) -> Resul
                             max_steps: opts.max_steps.max(100_000),
                             ..OdeOptions::default()
                         },
-                        end,
+                        end_time: Some(end),
                         output_step: opts.full_output_step.min(end),
-                        budget_s: opts.reference_budget_s,
+                        budget_s: Some(opts.reference_budget_s),
                     };
                     let o = system_run(&model, prep, &spec);
                     progress(&format!(
                         "reference {} k_n = {kn:e} friction {}: {} t = {:.3e} s, {} steps, {:.2} s",
                         kind.name(),
                         on_off(friction),
-                        o.status,
+                        o.status.name(),
                         o.t_reached,
                         o.stats.steps,
                         o.wall_s
@@ -839,7 +655,7 @@ pub fn run_sweep_model(base: &Model, model_s: f64, opts: &SweepOptions) -> Resul
                 for &iteration in &opts.iterations {
                     for &max_order in &opts.max_orders {
                         for &events in &opts.events {
-                            let spec = RunSpec {
+                            let spec = TransientOptions {
                                 problem: ProblemOptions {
                                     friction,
                                     events,
@@ -854,9 +670,9 @@ pub fn run_sweep_model(base: &Model, model_s: f64, opts: &SweepOptions) -> Resul
                                     max_steps: opts.max_steps,
                                     ..OdeOptions::default()
                                 },
-                                end,
+                                end_time: Some(end),
                                 output_step: dt.min(end),
-                                budget_s: opts.budget_s,
+                                budget_s: Some(opts.budget_s),
                             };
                             let o = system_run(&model, prep, &spec);
                             let reference = refs_here
@@ -883,7 +699,7 @@ pub fn run_sweep_model(base: &Model, model_s: f64, opts: &SweepOptions) -> Resul
                                 iteration.name(),
                                 on_off(friction),
                                 on_off(events),
-                                o.status,
+                                o.status.name(),
                                 o.t_reached,
                                 o.stats.steps,
                                 o.stats.rhs_evals,
@@ -919,319 +735,12 @@ pub fn run_sweep_model(base: &Model, model_s: f64, opts: &SweepOptions) -> Resul
     })
 }
 
-fn on_off(b: bool) -> &'static str {
+pub(crate) fn on_off(b: bool) -> &'static str {
     if b {
         "on"
     } else {
         "off"
     }
-}
-
-/// The status with `CV_` stripped (short enough for a heat-map cell).
-fn short_status(s: &str) -> &str {
-    s.strip_prefix("CV_").unwrap_or(s)
-}
-
-fn status_color(s: &str) -> [u8; 3] {
-    match s {
-        "ok" => [120, 190, 120],
-        "budget" => [245, 170, 60],
-        "CV_TOO_MUCH_WORK" => [215, 80, 70],
-        "CV_CONV_FAILURE" => [150, 90, 190],
-        "CV_ERR_FAILURE" => [70, 110, 200],
-        "chatter" => [140, 90, 60],
-        _ => [110, 110, 110],
-    }
-}
-
-/// The markdown table of every cell.
-pub fn markdown_table(sweep: &Sweep) -> String {
-    let mut s = String::new();
-    s.push_str(&format!(
-        "# Stability map: {} (rtol {:e}, atol {:e}, window {} s ROM / {} s full, budget {} s/cell)\n\n",
-        sweep.case,
-        sweep.options.rtol,
-        sweep.options.atol,
-        sweep.options.end_time,
-        sweep.options.full_end_time,
-        sweep.options.budget_s
-    ));
-    s.push_str("| model | dim | iteration | max order | k_n (N/mm) | friction | events | status | t reached (s) | steps | RHS evals | nonlin iters | nonlin fails | err-test fails | events found | wall (s) | error | error vs full |\n");
-    s.push_str("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
-    let opt = |e: Option<f64>| e.map_or("–".into(), |e| format!("{e:.2e}"));
-    for c in &sweep.cells {
-        let o = &c.outcome;
-        s.push_str(&format!(
-            "| {} | {} | {} | {} | {:.0e} | {} | {} | {} | {:.4e} | {} | {} | {} | {} | {} | {} | {:.3} | {} | {} |\n",
-            c.model.name(),
-            c.dim,
-            c.iteration.name(),
-            c.max_order,
-            c.normal_stiffness,
-            on_off(c.friction),
-            on_off(c.events),
-            o.status,
-            o.t_reached,
-            o.stats.steps,
-            o.stats.rhs_evals,
-            o.stats.nonlinear_iterations,
-            o.stats.nonlinear_conv_failures,
-            o.stats.error_test_failures,
-            o.events_found,
-            o.wall_s,
-            opt(c.error),
-            opt(c.error_vs_full)
-        ));
-    }
-    s.push_str(
-        "\nReferences (Newton, max order 5, events off, tolerances ÷ reference_factor):\n\n",
-    );
-    s.push_str("| model | k_n (N/mm) | friction | status | t reached (s) | steps | wall (s) | error vs full |\n|---|---|---|---|---|---|---|---|\n");
-    for r in &sweep.references {
-        s.push_str(&format!(
-            "| {} | {:.0e} | {} | {} | {:.4e} | {} | {:.3} | {} |\n",
-            r.model.name(),
-            r.normal_stiffness,
-            on_off(r.friction),
-            r.outcome.status,
-            r.outcome.t_reached,
-            r.outcome.stats.steps,
-            r.outcome.wall_s,
-            opt(r.error_vs_full)
-        ));
-    }
-    s
-}
-
-/// What a heat map colours.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum MapKind {
-    /// Status (categorical).
-    Status,
-    /// log10 of the wall time.
-    Wall,
-    /// log10 of the error against the reference.
-    Error,
-}
-
-/// The heat map of a sweep: rows model × iteration × max order, columns k_n × friction ×
-/// events, in the order of the options; a combination that was not run is blank.
-pub fn heat_map(sweep: &Sweep, kind: MapKind) -> HeatMap {
-    let o = &sweep.options;
-    let mut rows = Vec::new();
-    for &m in &o.models {
-        for &it in &o.iterations {
-            for &mo in &o.max_orders {
-                rows.push((m, it, mo));
-            }
-        }
-    }
-    let mut cols = Vec::new();
-    for &kn in &o.normal_stiffness {
-        for &fr in &o.friction {
-            for &ev in &o.events {
-                cols.push((kn, fr, ev));
-            }
-        }
-    }
-    let find = |r: &(ModelKind, IterKind, usize), c: &(f64, bool, bool)| {
-        sweep.cells.iter().find(|x| {
-            x.model == r.0
-                && x.iteration == r.1
-                && x.max_order == r.2
-                && x.normal_stiffness == c.0
-                && x.friction == c.1
-                && x.events == c.2
-        })
-    };
-    let walls: Vec<f64> = sweep
-        .cells
-        .iter()
-        .map(|c| c.outcome.wall_s.max(1e-4).log10())
-        .collect();
-    let (wlo, whi) = bounds(&walls);
-    let errs: Vec<f64> = sweep
-        .cells
-        .iter()
-        .filter_map(|c| c.error)
-        .map(|e| e.max(1e-12).log10())
-        .collect();
-    let (elo, ehi) = bounds(&errs);
-    let scaled = |v: f64, lo: f64, hi: f64| {
-        if hi > lo {
-            (v - lo) / (hi - lo)
-        } else {
-            0.5
-        }
-    };
-    let cells: Vec<Vec<HeatCell>> = rows
-        .iter()
-        .map(|r| {
-            cols.iter()
-                .map(|c| match find(r, c) {
-                    None => HeatCell {
-                        color: [255, 255, 255],
-                        text: String::new(),
-                    },
-                    Some(x) => {
-                        let st = &x.outcome.status;
-                        let failed_text = short_status(st).to_string();
-                        match kind {
-                            MapKind::Status => HeatCell {
-                                color: status_color(st),
-                                text: if x.outcome.ok() {
-                                    "ok".into()
-                                } else {
-                                    format!("{failed_text} {:.1e}", x.outcome.t_reached)
-                                },
-                            },
-                            MapKind::Wall => {
-                                let v = x.outcome.wall_s.max(1e-4).log10();
-                                HeatCell {
-                                    color: sequential(scaled(v, wlo, whi)),
-                                    text: if x.outcome.ok() {
-                                        format!("{:.2} s", x.outcome.wall_s)
-                                    } else {
-                                        failed_text.clone()
-                                    },
-                                }
-                            }
-                            MapKind::Error => match x.error {
-                                Some(e) => {
-                                    let v = e.max(1e-12).log10();
-                                    HeatCell {
-                                        color: sequential(scaled(v, elo, ehi)),
-                                        text: format!("{e:.1e}"),
-                                    }
-                                }
-                                None => HeatCell {
-                                    color: if x.outcome.ok() {
-                                        [220, 220, 220]
-                                    } else {
-                                        status_color(st)
-                                    },
-                                    text: if x.outcome.ok() {
-                                        "no ref".into()
-                                    } else {
-                                        failed_text
-                                    },
-                                },
-                            },
-                        }
-                    }
-                })
-                .collect()
-        })
-        .collect();
-    let legend: Vec<(String, [u8; 3])> = match kind {
-        MapKind::Status => {
-            let mut seen: Vec<String> = Vec::new();
-            for c in &sweep.cells {
-                if !seen.contains(&c.outcome.status) {
-                    seen.push(c.outcome.status.clone());
-                }
-            }
-            seen.into_iter()
-                .map(|s| {
-                    let col = status_color(&s);
-                    (s, col)
-                })
-                .collect()
-        }
-        MapKind::Wall => ramp_legend(wlo, whi, "s"),
-        MapKind::Error => ramp_legend(elo, ehi, ""),
-    };
-    let what = match kind {
-        MapKind::Status => "status",
-        MapKind::Wall => "wall time (colour: log10)",
-        MapKind::Error => "relative L2 error of ‖f_c‖(t) vs reference (colour: log10)",
-    };
-    HeatMap {
-        title: format!("{}: {what}", sweep.case),
-        row_labels: rows
-            .iter()
-            .map(|(m, it, mo)| format!("{} {} order {mo}", m.name(), it.name()))
-            .collect(),
-        col_labels: cols
-            .iter()
-            .map(|(kn, fr, ev)| {
-                vec![
-                    format!("k_n {kn:.0e}"),
-                    format!("friction {}", on_off(*fr)),
-                    format!("events {}", on_off(*ev)),
-                ]
-            })
-            .collect(),
-        cells,
-        legend,
-        cell_size: (104, 30),
-        row_label_width: 230,
-    }
-}
-
-fn bounds(v: &[f64]) -> (f64, f64) {
-    v.iter()
-        .filter(|x| x.is_finite())
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| {
-            (a.min(x), b.max(x))
-        })
-}
-
-fn ramp_legend(lo: f64, hi: f64, unit: &str) -> Vec<(String, [u8; 3])> {
-    if !(lo.is_finite() && hi.is_finite()) {
-        return Vec::new();
-    }
-    (0..5)
-        .map(|k| {
-            let f = k as f64 / 4.0;
-            let v = lo + f * (hi - lo);
-            (format!("{:.1e} {unit}", 10f64.powf(v)), sequential(f))
-        })
-        .collect()
-}
-
-/// Writes `dir/stability.json`, `dir/stability.md` and the heat maps
-/// `dir/stability_{status,wall,error}.{svg,png}`; returns the files written.
-pub fn write_outputs(sweep: &Sweep, dir: &Path, charts: bool) -> Result<Vec<PathBuf>, Error> {
-    std::fs::create_dir_all(dir).map_err(|e| Error::Io {
-        file: dir.to_path_buf(),
-        source: e,
-    })?;
-    let write = |name: &str, text: String| -> Result<PathBuf, Error> {
-        let p = dir.join(name);
-        std::fs::write(&p, text).map_err(|e| Error::Io {
-            file: p.clone(),
-            source: e,
-        })?;
-        Ok(p)
-    };
-    let mut files = vec![
-        write("stability.json", sweep_json(sweep).to_string())?,
-        write("stability.md", markdown_table(sweep))?,
-    ];
-    if charts {
-        for (kind, name) in [
-            (MapKind::Status, "stability_status"),
-            (MapKind::Wall, "stability_wall"),
-            (MapKind::Error, "stability_error"),
-        ] {
-            files.extend(heat_map(sweep, kind).write(&dir.join(name))?);
-        }
-    }
-    Ok(files)
-}
-
-/// The JSON document of a sweep (what `stability.json` holds): the options, models,
-/// references and every cell, plus the ‖f_c‖ curves of the references.
-pub fn sweep_json(sweep: &Sweep) -> serde_json::Value {
-    let mut v = serde_json::to_value(sweep).unwrap_or(serde_json::Value::Null);
-    if let Some(refs) = v.get_mut("references").and_then(|r| r.as_array_mut()) {
-        for (j, r) in refs.iter_mut().zip(&sweep.references) {
-            j["t"] = serde_json::json!(r.outcome.t);
-            j["contact_force_norm"] = serde_json::json!(r.outcome.fc);
-        }
-    }
-    v
 }
 
 /// `jointrom stability CASE`: the stability map (see the module docs).
@@ -1358,10 +867,12 @@ pub fn stability_command(args: &StabilityArgs) -> Result<serde_json::Value, Erro
     let model = Model::from_case_name(&args.case)?;
     let sweep = run_sweep_model(&model, t0.elapsed().as_secs_f64(), &opts)?;
     let dir = args.out.join(&sweep.case);
-    let files = write_outputs(&sweep, &dir, !args.no_charts)?;
+    let files = crate::report::stability::write_outputs(&sweep, &dir, !args.no_charts)?;
     let mut by_status = std::collections::BTreeMap::<String, usize>::new();
     for c in &sweep.cells {
-        *by_status.entry(c.outcome.status.clone()).or_default() += 1;
+        *by_status
+            .entry(c.outcome.status.name().to_string())
+            .or_default() += 1;
     }
     Ok(serde_json::json!({
         "dir": dir,

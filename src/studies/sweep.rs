@@ -20,11 +20,10 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::error::Error;
-use crate::integrate::mechanical::{self as transient, Curves, TransientOptions};
 use crate::integrate::problem::OdeStats;
+use crate::integrate::{run, Curves, TransientOptions};
 use crate::model::Model;
-use crate::reduction::ReducedModel;
-use crate::system::{ReducedParts, ReducedSystem};
+use crate::system::{ReducedSystem, Scene};
 
 /// One variant of a sweep.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -129,9 +128,11 @@ pub struct SweepResult {
     pub threads: usize,
 }
 
-/// The system of one variant: the shared reduction with the variant's load factor and law.
-fn variant_system(base: &ReducedParts, v: &Variant) -> Result<ReducedSystem, Error> {
+/// The system and scene of one variant: the shared reduction with the variant's load factor and
+/// law.
+fn variant_system(base: &ReducedSystem, scene: &Scene, v: &Variant) -> (ReducedSystem, Scene) {
     let mut p = base.clone();
+    let mut scene = *scene;
     if let Some(s) = v.load_scale {
         let m = &mut p.load.master;
         for x in [
@@ -141,30 +142,31 @@ fn variant_system(base: &ReducedParts, v: &Variant) -> Result<ReducedSystem, Err
         }
     }
     if let Some(mu) = v.friction_coefficient {
-        p.contact.friction_coefficient = mu;
+        scene.contact.friction_coefficient = mu;
     }
     if let Some(k) = v.normal_stiffness {
-        p.contact.normal_stiffness = k;
+        scene.contact.normal_stiffness = k;
     }
     if let Some(k) = v.stick_stiffness {
-        p.contact.stick_stiffness = k;
+        scene.contact.stick_stiffness = k;
     }
-    ReducedSystem::from_parts(p)
+    (p, scene)
 }
 
 /// Runs every variant on the shared reduction `rom` of `model`, `parallel` across rayon's
 /// threads or one after the other. A variant that fails is recorded with its error.
 pub fn run_sweep(
     model: &Model,
-    rom: &ReducedModel,
+    rom: &ReducedSystem,
     variants: &[Variant],
     opts: &TransientOptions,
     parallel: bool,
 ) -> Result<SweepResult, Error> {
-    let base = ReducedParts::new(model, rom)?;
+    let base = Scene::of(model);
     let one = |v: &Variant| {
         let t0 = Instant::now();
-        let res = variant_system(&base, v).and_then(|s| transient::run(s, opts));
+        let (system, scene) = variant_system(rom, &base, v);
+        let res = run(system, &scene, opts);
         let wall_s = t0.elapsed().as_secs_f64();
         match res {
             Ok(r) => VariantRun {

@@ -5,7 +5,7 @@ use std::rc::Rc;
 
 use sundials_sys::{_SUNContext, SUNContext, SUNContext_Create, SUNContext_Free};
 
-use super::{check_library_version, sundials_error};
+use super::{check_library_version, sundials_error, CvodeFlag};
 use crate::Error;
 
 /// A SUNDIALS context (`SUNContext`): the handle every vector, matrix, solver and integrator is
@@ -46,7 +46,15 @@ impl Context {
             Some(raw) if flag == 0 => Ok(Self {
                 raw: Rc::new(RawContext(raw)),
             }),
-            _ => Err(sundials_error("SUNContext_Create", flag, f64::NAN)),
+            _ => Err(sundials_error(
+                "SUNContext_Create",
+                CvodeFlag {
+                    code: Some(flag),
+                    name: flag.to_string(),
+                    message: None,
+                },
+                f64::NAN,
+            )),
         }
     }
 

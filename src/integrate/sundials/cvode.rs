@@ -53,11 +53,11 @@ use sundials_sys::{
 
 use super::callbacks::{self, Failure, Shared};
 use super::owners::{CvodeMemory, LinearSolver, Matrix, NonlinearSolver, Owned};
-use super::{cvode_flag_name, cvode_ls_flag_name, problem_ls, Context, SerialVector};
+use super::{cvode_flag, cvode_flag_name, cvode_ls_flag_name, problem_ls, Context, SerialVector};
+use crate::error::{CallbackOutcome, Error};
 use crate::integrate::problem::{
     Iteration, Method, NewtonLinear, OdeOptions, OdeProblem, OdeStats, Stop,
 };
-use crate::Error;
 
 /// CVLS's tolerance factor ε_L for jointrom's problem solver: small, so that CVLS skips the
 /// Newton solve only when the residual is negligible (`‖b‖ ≤ ε_L · tq[4]`), as a direct solver
@@ -375,10 +375,7 @@ impl<P: OdeProblem> Cvode<P> {
             )));
         }
         if let Some(failure) = self.poisoned_failure() {
-            return Err(callback_error(
-                failure,
-                "not run: a callback panicked earlier (call reinit to continue)".into(),
-            ));
+            return Err(callback_error(failure, CallbackOutcome::NotRun));
         }
         if tout == self.t {
             return Ok(Stop::Reached(self.t));
@@ -420,11 +417,7 @@ impl<P: OdeProblem> Cvode<P> {
         let shared = self.shared.get_mut();
         let failure = shared.failure.take();
         let message = shared.cvode_message.take();
-        let flag_name = format!(
-            "{}{}",
-            cvode_flag_name(flag),
-            message.map(|m| format!(" ({m})")).unwrap_or_default()
-        );
+        let flag = cvode_flag(flag, cvode_flag_name, message);
         // The time CVODE reached (CVode leaves `t` unset on some failures, e.g. of the roots).
         let mut reached = self.t;
         // SAFETY: memory live; valid out-pointer.
@@ -449,11 +442,11 @@ impl<P: OdeProblem> Cvode<P> {
         match failure {
             Some(f) if f.fatal || f.time >= reached => Err(callback_error(
                 f,
-                format!("CVode returned {flag_name} at t = {reached} s"),
+                CallbackOutcome::Returned { flag, t: reached },
             )),
             _ => Err(Error::Sundials {
                 function: "CVode",
-                flag: flag_name,
+                flag,
                 time: reached,
             }),
         }
@@ -684,22 +677,19 @@ impl<P: OdeProblem> Cvode<P> {
         }
         Err(Error::Sundials {
             function,
-            flag: match message {
-                Some(m) => format!("{} ({m})", name(flag)),
-                None => name(flag),
-            },
+            flag: cvode_flag(flag, name, message),
             time: self.t,
         })
     }
 }
 
 /// The error for a callback failure.
-fn callback_error(f: Failure, flag: String) -> Error {
+fn callback_error(f: Failure, outcome: CallbackOutcome) -> Error {
     Error::Callback {
         callback: f.callback,
         message: f.message,
         time: f.time,
-        flag,
+        outcome,
     }
 }
 

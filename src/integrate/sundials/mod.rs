@@ -43,15 +43,16 @@ mod context;
 pub mod cvode;
 mod fast_ops;
 mod ffi;
+mod flag;
 mod owners;
 mod problem_ls;
 mod vector;
 
 use std::ffi::{c_char, CStr};
-use std::fmt::Display;
 
 pub use context::Context;
 pub use cvode::Cvode;
+pub use flag::CvodeFlag;
 pub use vector::SerialVector;
 
 use crate::Error;
@@ -106,9 +107,9 @@ fn check_library_version() -> Result<(), Error> {
         let (hmaj, hmin, hpat) = HEADER_VERSION;
         Err(sundials_error(
             "SUNDIALSGetVersionNumber",
-            format!(
+            CvodeFlag::condition(format!(
                 "library version {major}.{minor}.{patch}, compiled against {hmaj}.{hmin}.{hpat}"
-            ),
+            )),
             f64::NAN,
         ))
     }
@@ -148,11 +149,21 @@ unsafe fn take_c_string(name: *mut c_char) -> String {
 }
 
 /// The crate error for a failed SUNDIALS call.
-fn sundials_error(function: &'static str, flag: impl Display, time: f64) -> Error {
+fn sundials_error(function: &'static str, flag: CvodeFlag, time: f64) -> Error {
     Error::Sundials {
         function,
-        flag: flag.to_string(),
+        flag,
         time,
+    }
+}
+
+/// The flag `code` of CVODE (`cvode`: [`cvode_flag_name`]) or its linear-solver interface
+/// ([`cvode_ls_flag_name`]) with CVODE's message, if any.
+fn cvode_flag(code: i32, name: fn(i32) -> String, message: Option<String>) -> CvodeFlag {
+    CvodeFlag {
+        code: Some(code),
+        name: name(code),
+        message,
     }
 }
 
@@ -236,7 +247,7 @@ mod tests {
 
     #[test]
     fn error_names_function_and_flag() {
-        let e = sundials_error("CVode", cvode_flag_name(-1), 0.25);
+        let e = sundials_error("CVode", cvode_flag(-1, cvode_flag_name, None), 0.25);
         assert_eq!(
             e.to_string(),
             "SUNDIALS: CVode returned CV_TOO_MUCH_WORK at t = 0.25 s"

@@ -18,7 +18,7 @@ use sundials_sys::{
     SUNLinSolFree, SUNMatDestroy, SUNNonlinSolFree,
 };
 
-use super::{sundials_error, Context};
+use super::{sundials_error, Context, CvodeFlag};
 use crate::Error;
 
 mod sealed {
@@ -122,7 +122,8 @@ impl<T: SundialsObject> Owned<T> {
         function: &'static str,
         context: &Context,
     ) -> Result<Self, Error> {
-        let raw = NonNull::new(raw).ok_or_else(|| sundials_error(function, "NULL", f64::NAN))?;
+        let raw = NonNull::new(raw)
+            .ok_or_else(|| sundials_error(function, CvodeFlag::condition("NULL"), f64::NAN))?;
         Ok(Self {
             raw,
             _context: context.clone(),

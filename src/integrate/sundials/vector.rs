@@ -7,7 +7,7 @@ use sundials_sys::{
     N_Vector,
 };
 
-use super::{sundials_error, Context};
+use super::{sundials_error, Context, CvodeFlag};
 use crate::Error;
 
 /// A serial SUNDIALS vector (`N_VNew_Serial`) owning its `f64` data, destroyed (`N_VDestroy`) on
@@ -32,8 +32,9 @@ impl SerialVector {
         // SAFETY: the context pointer is valid while `context` lives, and the vector keeps a
         // clone of it. N_VNew_Serial returns a new vector owning `n` doubles, or null.
         let raw = unsafe { N_VNew_Serial(n, context.as_raw()) };
-        let raw =
-            NonNull::new(raw).ok_or_else(|| sundials_error("N_VNew_Serial", "NULL", f64::NAN))?;
+        let raw = NonNull::new(raw).ok_or_else(|| {
+            sundials_error("N_VNew_Serial", CvodeFlag::condition("NULL"), f64::NAN)
+        })?;
         let vector = Self {
             raw,
             len,

@@ -1,0 +1,459 @@
+//! The one driver loop: a [`SecondOrderSystem`] with its joint law integrated from rest by
+//! CVODE, sampled every `output_step`, optionally under a wall-clock deadline, with an observer
+//! of the coordinates at every output. Every caller — the `transient` command, the stability
+//! map, the main job's report, sweeps, POD training — runs through [`integrate`] and gets a typed
+//! [`RunStatus`].
+//!
+//! With events on, each located root (a gap or a stick/slip switch changing sign) restarts the
+//! integrator there (`CVodeReInit`: order 1, history discarded — the right-hand side is only
+//! piecewise smooth across a switch); [`MAX_STALLED_ROOTS`] roots in a row without progress in
+//! time end the run as [`RunStatus::Chatter`].
+
+use std::time::{Duration, Instant};
+
+use serde::{Serialize, Serializer};
+
+use super::mechanical::{EnergySample, MechanicalOde, ProblemOptions, DEFAULT_MAX_ORDER};
+use super::problem::{CallbackError, OdeOptions, OdeProblem, OdeStats, Stop};
+use super::sundials::{Cvode, CvodeFlag};
+use crate::error::{CallbackOutcome, Error};
+use crate::system::{Scene, SecondOrderSystem};
+
+/// Options of [`integrate`]. Defaults: the integrator's defaults ([`OdeOptions::default`]: BDF,
+/// Newton with the structured solve, rtol 1e-8, atol 1e-6 — the paper's Table 1) except the
+/// maximum order [`DEFAULT_MAX_ORDER`] = 2, velocity tolerance
+/// [`super::mechanical::DEFAULT_VELOCITY_SCALE`] × atol, friction on, events off, τ = 1e-6 s,
+/// outputs every 1e-4 s, the scene's end time, no wall-clock budget.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct TransientOptions {
+    /// Integrator options.
+    pub ode: OdeOptions,
+    /// Friction, events, τ.
+    pub problem: ProblemOptions,
+    /// Spacing of the output times, s (> 0).
+    pub output_step: f64,
+    /// End of the run, s (`None`: the scene's `end_time`).
+    pub end_time: Option<f64>,
+    /// Wall-clock budget of the integration, s (`None`: unlimited), checked in every
+    /// right-hand side; running out ends the run as [`RunStatus::Budget`].
+    #[serde(skip)]
+    pub budget_s: Option<f64>,
+}
+
+impl Default for TransientOptions {
+    fn default() -> Self {
+        TransientOptions {
+            ode: OdeOptions {
+                max_order: DEFAULT_MAX_ORDER,
+                ..OdeOptions::default()
+            },
+            problem: ProblemOptions::default(),
+            output_step: 1e-4,
+            end_time: None,
+            budget_s: None,
+        }
+    }
+}
+
+/// Output curves of a run, one entry per output time.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct Curves {
+    /// Output times, s.
+    pub t: Vec<f64>,
+    /// ‖f_c‖, N.
+    pub contact_force_norm: Vec<f64>,
+    /// ‖f_R‖, N.
+    pub friction_force_norm: Vec<f64>,
+    /// Master node u_y, mm.
+    pub master_uy: Vec<f64>,
+    /// Kinetic energy, N·mm.
+    pub kinetic: Vec<f64>,
+    /// Strain energy, N·mm.
+    pub strain: Vec<f64>,
+    /// Pair (penalty and stick) energy, N·mm.
+    pub pair: Vec<f64>,
+    /// External work, N·mm.
+    pub external_work: Vec<f64>,
+    /// Dissipated energy, N·mm.
+    pub dissipated: Vec<f64>,
+}
+
+impl Curves {
+    fn push(&mut self, s: &EnergySample) {
+        self.t.push(s.t);
+        self.contact_force_norm.push(s.contact_force_norm);
+        self.friction_force_norm.push(s.friction_force_norm);
+        self.master_uy.push(s.master[1]);
+        self.kinetic.push(s.kinetic);
+        self.strain.push(s.strain);
+        self.pair.push(s.pair);
+        self.external_work.push(s.external_work);
+        self.dissipated.push(s.dissipated);
+    }
+
+    /// The energy balance `E_kin + E_strain + E_pair + D − W` at each output, N·mm.
+    pub fn balance(&self) -> Vec<f64> {
+        (0..self.t.len())
+            .map(|i| {
+                self.kinetic[i] + self.strain[i] + self.pair[i] + self.dissipated[i]
+                    - self.external_work[i]
+            })
+            .collect()
+    }
+}
+
+/// How a run ended. Serialized as its [`RunStatus::name`].
+#[derive(Clone, Debug, PartialEq)]
+pub enum RunStatus {
+    /// The end time was reached.
+    Finished,
+    /// The wall-clock budget ran out at `t` (s).
+    Budget {
+        /// Time reached, s.
+        t: f64,
+    },
+    /// Events: [`MAX_STALLED_ROOTS`] roots in a row without progress in time at `t` (s).
+    Chatter {
+        /// Time reached, s.
+        t: f64,
+    },
+    /// A SUNDIALS call failed (`function` returned `flag`), or a problem callback failed and
+    /// made CVODE return `flag` (`callback` names it) at `t` (s).
+    Failed {
+        /// The C function that failed (`CVode`, `CVodeReInit`, ...).
+        function: &'static str,
+        /// Its return flag.
+        flag: CvodeFlag,
+        /// The callback whose failure caused it, if any.
+        callback: Option<&'static str>,
+        /// Time reached, s.
+        t: f64,
+    },
+    /// Anything else (the system or the integrator could not be set up, an invalid option).
+    Error,
+}
+
+impl RunStatus {
+    /// `ok`, the CVODE flag's name (`CV_TOO_MUCH_WORK`, `CV_CONV_FAILURE`, ...), `sundials` or
+    /// `callback` for a failure without a CVODE flag name, `budget`, `chatter` or `error`.
+    pub fn name(&self) -> &str {
+        match self {
+            RunStatus::Finished => "ok",
+            RunStatus::Budget { .. } => "budget",
+            RunStatus::Chatter { .. } => "chatter",
+            RunStatus::Failed { flag, .. } if flag.name.starts_with("CV_") => &flag.name,
+            RunStatus::Failed { callback: None, .. } => "sundials",
+            RunStatus::Failed { .. } => "callback",
+            RunStatus::Error => "error",
+        }
+    }
+
+    /// Whether the run reached its end.
+    pub fn finished(&self) -> bool {
+        *self == RunStatus::Finished
+    }
+
+    /// The status of a run that failed with `e` at `t` (s); `budget`: the deadline had passed.
+    fn of_error(e: &Error, t: f64, budget: bool) -> RunStatus {
+        if budget {
+            return RunStatus::Budget { t };
+        }
+        match e {
+            Error::Sundials { function, flag, .. } => RunStatus::Failed {
+                function,
+                flag: flag.clone(),
+                callback: None,
+                t,
+            },
+            Error::Callback {
+                callback,
+                outcome: CallbackOutcome::Returned { flag, .. },
+                ..
+            } => RunStatus::Failed {
+                function: "CVode",
+                flag: flag.clone(),
+                callback: Some(callback),
+                t,
+            },
+            _ => RunStatus::Error,
+        }
+    }
+}
+
+impl std::fmt::Display for RunStatus {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl Serialize for RunStatus {
+    fn serialize<Z: Serializer>(&self, s: Z) -> Result<Z::Ok, Z::Error> {
+        s.serialize_str(self.name())
+    }
+}
+
+/// The result of [`integrate`]: status, statistics, timings and the curves up to the time
+/// reached.
+#[derive(Debug, Serialize)]
+pub struct Run {
+    /// How the run ended.
+    pub status: RunStatus,
+    /// Time reached, s.
+    pub t_reached: f64,
+    /// Integrator statistics.
+    pub stats: OdeStats,
+    /// Wall-clock time of the integration (excluding the system's construction), s.
+    pub wall_s: f64,
+    /// CPU time of the integrating thread, s (NaN where unavailable).
+    pub cpu_s: f64,
+    /// Events located (and re-initialisations done) with events on.
+    pub events: u64,
+    /// Output curves (from t = 0 to the last output reached).
+    pub curves: Curves,
+    /// Final state `y` (q, v, s, W, D).
+    pub final_state: Vec<f64>,
+    /// The error that ended a run that did not finish.
+    #[serde(skip)]
+    pub failure: Option<Error>,
+}
+
+impl Run {
+    /// The run if it finished, else the error that ended it.
+    pub fn finished(self) -> Result<Run, Error> {
+        match self.failure {
+            Some(e) => Err(e),
+            None => Ok(self),
+        }
+    }
+
+    /// A run that could not start: its system or options failed with `e`.
+    pub fn failed(e: Error) -> Run {
+        Run {
+            status: RunStatus::of_error(&e, 0.0, false),
+            t_reached: 0.0,
+            stats: OdeStats::default(),
+            wall_s: 0.0,
+            cpu_s: 0.0,
+            events: 0,
+            curves: Curves::default(),
+            final_state: Vec::new(),
+            failure: Some(e),
+        }
+    }
+}
+
+/// Roots in a row at the same time after which a run is [`RunStatus::Chatter`].
+pub const MAX_STALLED_ROOTS: usize = 1000;
+
+/// CPU time of the calling thread, s (NaN where unavailable): a run's own cost even while
+/// other runs share the process (rayon sweeps).
+pub fn thread_cpu_s() -> f64 {
+    cpu_time::ThreadTime::try_now()
+        .map(|t| t.as_duration().as_secs_f64())
+        .unwrap_or(f64::NAN)
+}
+
+/// Integrates `system` under `scene` from rest over `[0, end]` (end: `opts.end_time` or the
+/// scene's) and samples the outputs every `opts.output_step`; `observe(t, q)` sees the
+/// coordinates at t = 0 and at every output. Never fails as a whole: a setup or integration
+/// failure, the budget running out or chattering events become the run's [`RunStatus`], with
+/// the curves up to the time reached and the error in [`Run::failure`].
+pub fn integrate<S: SecondOrderSystem>(
+    system: S,
+    scene: &Scene,
+    opts: &TransientOptions,
+    observe: impl FnMut(f64, &[f64]),
+) -> Run {
+    match Driver::new(system, scene, opts) {
+        Ok(d) => d.run(observe),
+        Err(e) => Run::failed(e),
+    }
+}
+
+/// [`integrate`] without an observer, as a `Result`: the run if it finished, else its error.
+///
+/// # Errors
+/// [`Error::Invalid`] for a non-positive or non-finite `output_step`/`end_time` or `tau`; any
+/// integrator error ([`Error::Sundials`] with the flag and time reached, callback errors, a
+/// chattering switch).
+pub fn run<S: SecondOrderSystem>(
+    system: S,
+    scene: &Scene,
+    opts: &TransientOptions,
+) -> Result<Run, Error> {
+    integrate(system, scene, opts, |_, _| {}).finished()
+}
+
+/// A problem with an optional wall-clock deadline checked in every right-hand side.
+struct Deadline<P> {
+    inner: P,
+    deadline: Option<Instant>,
+    exceeded: bool,
+}
+
+impl<P: OdeProblem> OdeProblem for Deadline<P> {
+    fn dim(&self) -> usize {
+        self.inner.dim()
+    }
+    fn rhs(&mut self, t: f64, y: &[f64], ydot: &mut [f64]) -> Result<(), CallbackError> {
+        if let Some(d) = self.deadline {
+            if Instant::now() > d {
+                self.exceeded = true;
+                return Err(CallbackError::Fatal("wall-clock budget exceeded".into()));
+            }
+        }
+        self.inner.rhs(t, y, ydot)
+    }
+    fn num_roots(&self) -> usize {
+        self.inner.num_roots()
+    }
+    fn roots(&mut self, t: f64, y: &[f64], g: &mut [f64]) -> Result<(), CallbackError> {
+        self.inner.roots(t, y, g)
+    }
+    fn atol_scale(&self, scale: &mut [f64]) -> bool {
+        self.inner.atol_scale(scale)
+    }
+    fn has_newton_solver(&self) -> bool {
+        self.inner.has_newton_solver()
+    }
+    fn newton_setup(
+        &mut self,
+        t: f64,
+        y: &[f64],
+        fy: &[f64],
+        jok: bool,
+        gamma: f64,
+    ) -> Result<bool, CallbackError> {
+        self.inner.newton_setup(t, y, fy, jok, gamma)
+    }
+    fn newton_solve(
+        &mut self,
+        t: f64,
+        y: &[f64],
+        r: &[f64],
+        z: &mut [f64],
+        gamma: f64,
+    ) -> Result<(), CallbackError> {
+        self.inner.newton_solve(t, y, r, z, gamma)
+    }
+}
+
+/// The state of one run between setup and the end.
+struct Driver<S: SecondOrderSystem> {
+    cv: Cvode<Deadline<MechanicalOde<S>>>,
+    dim: usize,
+    end: f64,
+    output_step: f64,
+    curves: Curves,
+    y0: Vec<f64>,
+    events: u64,
+    last_root_t: f64,
+    stalled: usize,
+}
+
+impl<S: SecondOrderSystem> Driver<S> {
+    fn new(system: S, scene: &Scene, opts: &TransientOptions) -> Result<Driver<S>, Error> {
+        let end = opts.end_time.unwrap_or(scene.end_time);
+        if !(end.is_finite() && end > 0.0) {
+            return Err(Error::Invalid(format!(
+                "end_time must be finite and positive, got {end} s"
+            )));
+        }
+        if !(opts.output_step.is_finite() && opts.output_step > 0.0) {
+            return Err(Error::Invalid(format!(
+                "output_step must be finite and positive, got {} s",
+                opts.output_step
+            )));
+        }
+        let mut ode = MechanicalOde::new(system, &scene.contact, &opts.problem)?;
+        let dim = ode.coords();
+        let y0 = ode.initial_state();
+        let mut curves = Curves::default();
+        curves.push(&ode.sample(0.0, &y0));
+        let problem = Deadline {
+            inner: ode,
+            deadline: opts
+                .budget_s
+                .map(|b| Instant::now() + Duration::from_secs_f64(b)),
+            exceeded: false,
+        };
+        let cv = Cvode::new(problem, 0.0, &y0, &opts.ode)?;
+        Ok(Driver {
+            cv,
+            dim,
+            end,
+            output_step: opts.output_step,
+            curves,
+            y0,
+            events: 0,
+            last_root_t: f64::NEG_INFINITY,
+            stalled: 0,
+        })
+    }
+
+    fn run(mut self, mut observe: impl FnMut(f64, &[f64])) -> Run {
+        observe(0.0, &self.y0[..self.dim]);
+        let wall = Instant::now();
+        let cpu0 = thread_cpu_s();
+        let outputs = (self.end / self.output_step - 1e-9).ceil().max(1.0) as usize;
+        let mut failure = None;
+        for k in 1..=outputs {
+            let tout = (k as f64 * self.output_step).min(self.end);
+            if let Err(e) = self.advance_to(tout) {
+                failure = Some(e);
+                break;
+            }
+            let t = self.cv.t();
+            let y = self.cv.y().to_vec();
+            let s = self.cv.problem_mut().inner.sample(t, &y);
+            self.curves.push(&s);
+            observe(t, &y[..self.dim]);
+        }
+        let wall_s = wall.elapsed().as_secs_f64();
+        let cpu_s = thread_cpu_s() - cpu0;
+        let t_reached = self.cv.t();
+        let status = match &failure {
+            None => RunStatus::Finished,
+            Some(Error::Chatter { .. }) => RunStatus::Chatter { t: t_reached },
+            Some(e) => RunStatus::of_error(e, t_reached, self.cv.problem().exceeded),
+        };
+        Run {
+            status,
+            t_reached,
+            stats: self.cv.stats(),
+            wall_s,
+            cpu_s,
+            events: self.events,
+            curves: self.curves,
+            final_state: self.cv.y().to_vec(),
+            failure,
+        }
+    }
+
+    /// Integrates to `tout`, re-initialising at every root.
+    fn advance_to(&mut self, tout: f64) -> Result<(), Error> {
+        loop {
+            match self.cv.solve_to(tout)? {
+                Stop::Reached(_) => return Ok(()),
+                Stop::Root { t, .. } => {
+                    self.events += 1;
+                    // Guard against chattering: roots that make no progress in time.
+                    if t - self.last_root_t <= 1e-13 * t.abs().max(1e-3) {
+                        self.stalled += 1;
+                        if self.stalled > MAX_STALLED_ROOTS {
+                            return Err(Error::Chatter {
+                                roots: MAX_STALLED_ROOTS,
+                                time: t,
+                            });
+                        }
+                    } else {
+                        self.stalled = 0;
+                    }
+                    self.last_root_t = t;
+                    let y = self.cv.y().to_vec();
+                    self.cv.reinit(t, &y)?;
+                }
+            }
+        }
+    }
+}
