@@ -376,7 +376,7 @@ pub fn run_report(
         file: study_dir.clone(),
         source: e,
     })?;
-    for f in study::write_charts(&st, &study_dir)? {
+    for f in crate::report::convergence::write_charts(&st, &study_dir)? {
         files.push(relative(dir, &f));
     }
 

@@ -2,6 +2,7 @@
 //! ([`vtu`], [`shapes`]) and the main job's report ([`main_job`]).
 
 pub mod chart;
+pub mod convergence;
 pub mod heatmap;
 pub mod main_job;
 pub mod shapes;
