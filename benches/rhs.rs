@@ -13,10 +13,10 @@ use std::hint::black_box;
 use std::time::Duration;
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use jointrom::integrate::mechanical::{run, MechanicalOde, ProblemOptions, TransientOptions};
 use jointrom::integrate::problem::OdeProblem;
-use jointrom::reduction::{build_basis, BasisKind, BasisOptions, ReducedModel};
-use jointrom::system::{FullSystem, ReducedSystem, SecondOrderSystem};
+use jointrom::integrate::{run, MechanicalOde, ProblemOptions, TransientOptions};
+use jointrom::reduction::{build_basis, BasisKind, BasisOptions};
+use jointrom::system::{FullSystem, ReducedSystem, Scene, SecondOrderSystem};
 use jointrom::Model;
 
 /// Mean time of `f` over a calibrated number of calls, ns.
@@ -35,24 +35,24 @@ fn time_ns(mut f: impl FnMut()) -> f64 {
     }
 }
 
-fn state_after<S: SecondOrderSystem>(sys: S) -> Vec<f64> {
+fn state_after<S: SecondOrderSystem>(sys: S, scene: &Scene) -> Vec<f64> {
     let opts = TransientOptions {
         end_time: Some(0.02),
         ..TransientOptions::default()
     };
-    run(sys, &opts).expect("0.02 s run").final_state
+    run(sys, scene, &opts).expect("0.02 s run").final_state
 }
 
 fn rhs(c: &mut Criterion) {
     let model = Model::from_case_name("friction_bar").expect("friction bar");
     let basis = build_basis(&model, BasisKind::Tvd, &BasisOptions::default()).expect("basis");
-    let rom = ReducedModel::new(&model, basis.phi).expect("ROM");
+    let rom = ReducedSystem::new(&model, basis.phi).expect("ROM");
+    let scene = Scene::of(&model);
     let (r, w) = (rom.dim(), model.joint.pairs());
     let po = ProblemOptions::default();
 
-    let y = state_after(ReducedSystem::new(&model, &rom).expect("system"));
-    let mut ode =
-        MechanicalOde::new(ReducedSystem::new(&model, &rom).expect("system"), &po).expect("ode");
+    let y = state_after(rom.clone(), &scene);
+    let mut ode = MechanicalOde::new(rom.clone(), &scene.contact, &po).expect("ode");
     let mut ydot = vec![0.0; y.len()];
     let ns = time_ns(|| {
         ode.rhs(0.02, black_box(&y), &mut ydot).expect("rhs");
@@ -64,8 +64,9 @@ fn rhs(c: &mut Criterion) {
         flops / ns
     );
 
-    let yf = state_after(FullSystem::new(&model).expect("full"));
-    let mut full = MechanicalOde::new(FullSystem::new(&model).expect("full"), &po).expect("ode");
+    let yf = state_after(FullSystem::new(&model).expect("full"), &scene);
+    let mut full = MechanicalOde::new(FullSystem::new(&model).expect("full"), &scene.contact, &po)
+        .expect("ode");
     let mut yfdot = vec![0.0; yf.len()];
     let nsf = time_ns(|| {
         full.rhs(0.02, black_box(&yf), &mut yfdot).expect("rhs");

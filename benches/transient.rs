@@ -16,10 +16,10 @@
 use std::time::Duration;
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use jointrom::integrate::mechanical::{run, ProblemOptions, TransientOptions, TransientResult};
 use jointrom::integrate::problem::{Iteration, NewtonLinear, OdeOptions};
-use jointrom::reduction::{build_basis, BasisKind, BasisOptions, ReducedModel};
-use jointrom::system::{FullSystem, ReducedSystem};
+use jointrom::integrate::{run, ProblemOptions, Run, TransientOptions};
+use jointrom::reduction::{build_basis, BasisKind, BasisOptions};
+use jointrom::system::{FullSystem, ReducedSystem, Scene};
 use jointrom::Model;
 
 fn options(iteration: Iteration, end: f64) -> TransientOptions {
@@ -36,7 +36,7 @@ fn options(iteration: Iteration, end: f64) -> TransientOptions {
     }
 }
 
-fn report(name: &str, end: f64, r: &TransientResult) {
+fn report(name: &str, end: f64, r: &Run) {
     let s = &r.stats;
     println!(
         "{name}: {end} s in {:.3} s wall ({:.3} s CPU): {} steps, {} RHS evals, {} nonlinear \
@@ -70,7 +70,8 @@ fn transient(c: &mut Criterion) {
         basis.g,
         basis.phi.ncols()
     );
-    let rom = ReducedModel::new(&model, basis.phi).expect("reduced model");
+    let rom = ReducedSystem::new(&model, basis.phi).expect("reduced model");
+    let scene = Scene::of(&model);
     let rom_end = env_or("JOINTROM_BENCH_ROM_END", 0.2);
     let full_end = env_or("JOINTROM_BENCH_FULL_END", 0.2);
     let full_functional_end = env_or("JOINTROM_BENCH_FULL_FUNCTIONAL_END", 5e-4);
@@ -88,13 +89,13 @@ fn transient(c: &mut Criterion) {
     group.warm_up_time(Duration::from_millis(500));
     group.measurement_time(Duration::from_secs(5));
     for (name, it) in iterations {
-        let sys = || ReducedSystem::new(&model, &rom).expect("reduced system");
-        match run(sys(), &options(it, rom_end)) {
+        let sys = || rom.clone();
+        match run(sys(), &scene, &options(it, rom_end)) {
             Ok(r) => report(&format!("rom {name} (report window)"), rom_end, &r),
             Err(e) => println!("rom {name} (report window): failed: {e}"),
         }
         group.bench_function(format!("rom_{name}_0.02s"), |b| {
-            b.iter(|| run(sys(), &options(it, 0.02)).expect("ROM run"))
+            b.iter(|| run(sys(), &scene, &options(it, 0.02)).expect("ROM run"))
         });
     }
     for (name, it) in iterations {
@@ -104,7 +105,7 @@ fn transient(c: &mut Criterion) {
         } else {
             full_end
         };
-        match run(sys(), &options(it, end)) {
+        match run(sys(), &scene, &options(it, end)) {
             Ok(r) => {
                 report(&format!("full {name} (report window)"), end, &r);
                 if end < rom_end {
@@ -117,7 +118,7 @@ fn transient(c: &mut Criterion) {
             Err(e) => println!("full {name} (report window): failed: {e}"),
         }
         group.bench_function(format!("full_{name}_1e-4s"), |b| {
-            b.iter(|| run(sys(), &options(it, 1e-4)).expect("full run"))
+            b.iter(|| run(sys(), &scene, &options(it, 1e-4)).expect("full run"))
         });
     }
     group.finish();

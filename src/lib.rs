@@ -4,13 +4,23 @@
 //! with contact and friction in the joints, by model order reduction with trial vector
 //! derivatives (Witteveen & Pichler 2014, `shared/paper`).
 //!
-//! The pipeline:
+//! The folders of the crate are the pipeline (see `ARCHITECTURE.md`: each uses only the ones
+//! above it):
 //!
-//! 1. [`case`]: a JSON case file (units mm, N, t, s) is parsed and validated;
-//! 2. [`mesh`]: the sheets, weld beams, clamps, rigid ties and joint pairs are generated;
-//! 3. [`element`]: `Shell4` and `Beam2` element matrices;
-//! 4. [`assembly`]: sparse global K and M on the independent DOF (clamp and rigid tie eliminated);
-//! 5. [`modes`] and [`statics`]: eigenmodes (master free or fixed) and linear static solutions.
+//! 1. [`linalg`]: symmetric sparse storage, the SPD Cholesky, compensated arithmetic, eigen;
+//! 2. [`case`]: a JSON case file (units mm, N, t, s) is parsed and its fields validated;
+//! 3. [`mesh`]: the sheets, weld beams, clamps, rigid ties and joint pairs are generated (and the
+//!    geometry validated);
+//! 4. [`element`]: `Shell4` and `Beam2` element matrices;
+//! 5. [`assembly`]: sparse global K and M on the independent DOF (clamp and rigid tie
+//!    eliminated);
+//! 6. [`joint`]: pair frames, the joint operator B, the contact and friction law, contact statics;
+//! 7. [`model`]: the [`Model`] (from a case or a user's matrices), its modes and statics;
+//! 8. [`system`]: the second-order-system boundary, full and reduced;
+//! 9. [`reduction`]: Craig–Bampton, trial vector derivatives, POD, the basis Φ and competitors;
+//! 10. [`integrate`]: the mechanical ODE and the one CVODE driver loop;
+//! 11. [`studies`]: convergence study, stability map, sweeps;
+//! 12. [`report`]: charts, heat maps, VTU, the main job's report.
 //!
 //! ```no_run
 //! let model = jointrom::Model::from_case_name("friction_bar")?;

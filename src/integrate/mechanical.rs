@@ -53,8 +53,9 @@
 //!
 //! ## Running
 //!
-//! [`run`] drives a [`MechanicalOde`] with [`crate::integrate::sundials::Cvode`] from rest to the case's
-//! end time, sampling [`EnergySample`]s into [`Curves`] every `output_step` (1e-4 s by
+//! [`crate::integrate::driver`] drives a [`MechanicalOde`] with [`crate::integrate::sundials::Cvode`]
+//! from rest to the scene's end time, sampling [`EnergySample`]s into
+//! [`crate::integrate::Curves`] every `output_step` (1e-4 s by
 //! default). With events on, every located root (a gap or a stick/slip switch changing sign)
 //! re-initialises the integrator (order 1, history discarded); 1000 roots in a row without
 //! progress in time end the run with an error (a chattering switch).
@@ -130,7 +131,7 @@ use crate::system::SecondOrderSystem;
 /// is held to atol/ω in displacement, 10⁻¹¹ mm for a 1 MHz shell mode: see the module docs.
 pub const DEFAULT_VELOCITY_SCALE: f64 = 1e3;
 
-/// Default maximum BDF order of [`TransientOptions`]: 2 (see the module docs — BDF orders 3–5
+/// Default maximum BDF order of [`crate::integrate::TransientOptions`]: 2 (see the module docs — BDF orders 3–5
 /// are not A-stable, and the undamped FE model's high-frequency modes on the imaginary axis
 /// then force steps of ~1e-8 s).
 pub const DEFAULT_MAX_ORDER: usize = 2;

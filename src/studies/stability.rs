@@ -94,7 +94,7 @@
 
 //! ## Outputs
 //!
-//! [`write_outputs`]: `stability.json` (every cell, the options and the references),
+//! [`crate::report::stability::write_outputs`]: `stability.json` (every cell, the options and the references),
 //! `stability.md` (a markdown table) and three heat maps (SVG + PNG) — rows model × iteration ×
 //! max order, columns k_n × friction × events — coloured by status, by log10 of the wall time and
 //! by log10 of the error, the failure flag (and, on the status map, the time reached, s)

@@ -11,7 +11,7 @@
 //! - **modified Newton**: `(I − γ J) δ = −G(y)`, with either a dense LU of `I − γJ` and J by
 //!   CVODE's difference quotients ([`NewtonLinear::DenseDq`]) or the problem's own solver
 //!   ([`NewtonLinear::Problem`], e.g. the structured `M + γ C + γ² K_t` of a second-order model,
-//!   see [`super::problem_ls`]).
+//!   see `problem_ls`).
 //!
 //! Undamped structures have eigenvalues ±iω on the imaginary axis, where BDF of orders 3–5 are
 //! not A-stable; [`OdeOptions::stab_lim_det`] switches on CVODE's stability-limit detection,
@@ -33,7 +33,7 @@
 //! Every return code is checked: [`Error::Sundials`] names the C function, the flag (CVODE's
 //! name, plus CVODE's own message where it gave one) and the time reached; a failing callback
 //! gives [`Error::Callback`] with the callback's name, last message, time and the flag. See
-//! [`super::callbacks`] for panics and NaN/Inf.
+//! `callbacks` for panics and NaN/Inf.
 
 use std::ffi::{c_int, c_long, c_void};
 use std::ptr::NonNull;
