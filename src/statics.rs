@@ -1,8 +1,16 @@
 //! Linear statics: `K q = f` by sparse Cholesky (faer), factored once for many right-hand sides.
 
-use faer::linalg::solvers::Solve;
-use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
-use faer::{Mat, MatRef, Side};
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::reborrow::ReborrowMut;
+use faer::sparse::linalg::cholesky::{
+    factorize_symbolic_cholesky, supernodal::SupernodalLltRef, LltRef, SymbolicCholesky,
+    SymbolicCholeskyRaw,
+};
+use faer::sparse::linalg::triangular_solve::{
+    solve_lower_triangular_in_place, solve_lower_triangular_transpose_in_place,
+};
+use faer::sparse::SparseColMatRef;
+use faer::{Conj, Mat, MatMut, MatRef, Par, Side};
 
 use crate::assembly::SymCsc;
 use crate::error::Error;
@@ -16,10 +24,21 @@ pub struct StaticSolution {
     pub master_displacement: [f64; 6],
 }
 
-/// A sparse Cholesky factorization `A = L Lᵀ` of a symmetric positive definite matrix.
+/// A sparse Cholesky factorization `P A Pᵀ = L Lᵀ` (fill-reducing permutation P) of a symmetric
+/// positive definite matrix.
 pub struct SparseCholesky {
     n: usize,
-    llt: Llt<usize, f64>,
+    symbolic: SymbolicCholesky<usize>,
+    values: Vec<f64>,
+}
+
+impl std::fmt::Debug for SparseCholesky {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("SparseCholesky")
+            .field("n", &self.n)
+            .field("nnz_l", &self.values.len())
+            .finish()
+    }
 }
 
 impl SparseCholesky {
@@ -27,21 +46,109 @@ impl SparseCholesky {
     /// positive definite (e.g. an unsupported, singular structure).
     pub fn new(a: &SymCsc) -> Result<SparseCholesky, Error> {
         let mat = a.to_faer();
-        let symbolic = SymbolicLlt::try_new(mat.symbolic(), Side::Lower).map_err(|e| {
+        let symbolic = factorize_symbolic_cholesky(
+            mat.symbolic(),
+            Side::Lower,
+            Default::default(),
+            Default::default(),
+        )
+        .map_err(|e| {
             Error::LinearAlgebra(format!("symbolic Cholesky of a {0}×{0} matrix: {e:?}", a.n))
         })?;
-        let llt = Llt::try_new_with_symbolic(symbolic, mat.as_ref(), Side::Lower).map_err(|e| {
-            Error::LinearAlgebra(format!(
-                "the {0}×{0} matrix is not positive definite (singular or unsupported structure): {e:?}",
-                a.n
-            ))
-        })?;
-        Ok(SparseCholesky { n: a.n, llt })
+        let mut values = vec![0.0; symbolic.len_val()];
+        let par = faer::get_global_parallelism();
+        let scratch = symbolic.factorize_numeric_llt_scratch::<f64>(par, Default::default());
+        symbolic
+            .factorize_numeric_llt(
+                &mut values,
+                mat.as_ref(),
+                Side::Lower,
+                Default::default(),
+                par,
+                MemStack::new(&mut MemBuffer::new(scratch)),
+                Default::default(),
+            )
+            .map_err(|e| {
+                Error::LinearAlgebra(format!(
+                    "the {0}×{0} matrix is not positive definite (singular or unsupported structure): {e:?}",
+                    a.n
+                ))
+            })?;
+        Ok(SparseCholesky {
+            n: a.n,
+            symbolic,
+            values,
+        })
     }
 
     /// Solves in place for all columns of `rhs`.
     pub fn solve_in_place(&self, rhs: &mut Mat<f64>) {
-        self.llt.solve_in_place(rhs.as_mut());
+        let par = faer::get_global_parallelism();
+        let scratch = self
+            .symbolic
+            .solve_in_place_scratch::<f64>(rhs.ncols(), par);
+        LltRef::new(&self.symbolic, &self.values).solve_in_place_with_conj(
+            Conj::No,
+            rhs.as_mut(),
+            par,
+            MemStack::new(&mut MemBuffer::new(scratch)),
+        );
+    }
+
+    /// Half solve `x ← L⁻¹ P x` for all columns (sequential): with [`Self::half_solve_transpose`],
+    /// `A⁻¹ = (Pᵀ L⁻ᵀ)(L⁻¹ P)`.
+    pub(crate) fn half_solve(&self, mut x: MatMut<'_, f64>) {
+        self.permute(x.rb_mut(), false);
+        self.triangular(x, false);
+    }
+
+    /// Half solve `x ← Pᵀ L⁻ᵀ x` for all columns (sequential).
+    pub(crate) fn half_solve_transpose(&self, mut x: MatMut<'_, f64>) {
+        self.triangular(x.rb_mut(), true);
+        self.permute(x, true);
+    }
+
+    /// `x ← P x` (`inverse` false) or `x ← Pᵀ x`, in faer's convention `(P x)_i = x_{fwd(i)}`.
+    fn permute(&self, mut x: MatMut<'_, f64>, inverse: bool) {
+        let Some(perm) = self.symbolic.perm() else {
+            return;
+        };
+        let (fwd, inv) = perm.arrays();
+        let map = if inverse { inv } else { fwd };
+        let mut tmp = vec![0.0; self.n];
+        for j in 0..x.ncols() {
+            for (t, &src) in tmp.iter_mut().zip(map) {
+                *t = x[(src, j)];
+            }
+            for (i, &t) in tmp.iter().enumerate() {
+                x[(i, j)] = t;
+            }
+        }
+    }
+
+    /// `x ← L⁻¹ x` or (`transpose`) `x ← L⁻ᵀ x` with the (permuted) factor L.
+    fn triangular(&self, x: MatMut<'_, f64>, transpose: bool) {
+        let par = Par::Seq;
+        match self.symbolic.raw() {
+            SymbolicCholeskyRaw::Simplicial(s) => {
+                let l = SparseColMatRef::<'_, usize, f64>::new(s.factor(), &self.values);
+                if transpose {
+                    solve_lower_triangular_transpose_in_place(l, Conj::No, x, par);
+                } else {
+                    solve_lower_triangular_in_place(l, Conj::No, x, par);
+                }
+            }
+            SymbolicCholeskyRaw::Supernodal(s) => {
+                let scratch = s.solve_in_place_scratch::<f64>(x.ncols(), par);
+                let stack = &mut MemBuffer::new(scratch);
+                let l = SupernodalLltRef::new(s, &self.values);
+                if transpose {
+                    l.l_transpose_solve_with_conj(Conj::No, x, par, MemStack::new(stack));
+                } else {
+                    l.l_solve_with_conj(Conj::No, x, par, MemStack::new(stack));
+                }
+            }
+        }
     }
 
     /// Dimension.
