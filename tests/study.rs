@@ -13,10 +13,10 @@ use jointrom::reduction::{
     build_basis, craig_bampton, final_basis, BasisKind, BasisOptions, ReducedModel,
 };
 use jointrom::report::chart::{LineChart, Reference, Series};
+use jointrom::report::convergence::write_charts;
 use jointrom::studies::convergence::{
-    basis_static, dense_fixed_interface_modes, reduced_contact_static,
-    reduced_contact_static_damped, reduced_contact_static_restarting, run_study, within,
-    write_charts, StudyOptions,
+    basis_static, reduced_contact_static, reduced_contact_static_damped,
+    reduced_contact_static_restarting, run_study, within, StudyOptions,
 };
 use jointrom::{Interface, Model};
 
@@ -79,13 +79,31 @@ fn reduced_statics_exact_with_the_whole_joint_space() {
     }
 }
 
-/// The dense fixed-interface modes agree with the sparse Lanczos ones where both work
+/// Fixed-interface modes `skip + 1 ..= skip + count` by the sparse solver as the `modes` series
+/// builds them (n × count, zero on the master DOF).
+fn sparse_fixed_interface_modes(
+    model: &Model,
+    skip: usize,
+    count: usize,
+) -> Result<Mat<f64>, jointrom::Error> {
+    let modes = model.modes(skip + count, Interface::Fixed)?;
+    let m = modes.shapes.nrows();
+    Ok(Mat::from_fn(model.dofs(), count, |r, c| {
+        if r < m {
+            modes.shapes[(r, skip + c)]
+        } else {
+            0.0
+        }
+    }))
+}
+
+/// The study's fixed-interface modes (skip/count columns) agree with `Model::modes`
 /// (frequencies to 1e-8, same subspace) and are M-orthonormal.
 #[test]
 fn dense_modes_match_lanczos() {
     let model = Model::from_case_name("friction_bar").unwrap();
     let lanczos = model.modes(12, Interface::Fixed).unwrap();
-    let dense = dense_fixed_interface_modes(&model, 0, 12).unwrap();
+    let dense = sparse_fixed_interface_modes(&model, 0, 12).unwrap();
     let n = model.dofs();
     let mut mx = vec![0.0; n];
     let mut kx = vec![0.0; n];
@@ -112,8 +130,8 @@ fn dense_modes_match_lanczos() {
         }
     }
     // `skip` returns the later modes: mode 13 of a skip-12 call is the 13th overall.
-    let later = dense_fixed_interface_modes(&model, 12, 1).unwrap();
-    let all = dense_fixed_interface_modes(&model, 0, 13).unwrap();
+    let later = sparse_fixed_interface_modes(&model, 12, 1).unwrap();
+    let all = sparse_fixed_interface_modes(&model, 0, 13).unwrap();
     let dot: f64 = (0..n).map(|r| later[(r, 0)] * all[(r, 12)]).sum::<f64>();
     let nrm: f64 = (0..n).map(|r| later[(r, 0)].powi(2)).sum::<f64>();
     assert!((dot.abs() / nrm - 1.0).abs() < 1e-8);

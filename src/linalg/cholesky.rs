@@ -4,9 +4,13 @@
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::cholesky::llt::factor::LltRegularization;
 use faer::linalg::solvers::LltError;
+use faer::reborrow::ReborrowMut;
 use faer::sparse::linalg::cholesky::{
-    factorize_symbolic_cholesky, CholeskySymbolicParams, LltRef, SymbolicCholesky,
-    SymmetricOrdering,
+    factorize_symbolic_cholesky, supernodal::SupernodalLltRef, CholeskySymbolicParams, LltRef,
+    SymbolicCholesky, SymbolicCholeskyRaw, SymmetricOrdering,
+};
+use faer::sparse::linalg::triangular_solve::{
+    solve_lower_triangular_in_place, solve_lower_triangular_transpose_in_place,
 };
 use faer::sparse::linalg::LltError as SparseLltError;
 use faer::sparse::FaerError;
@@ -16,8 +20,8 @@ use faer::{get_global_parallelism, Conj, Mat, MatMut, Par, Side};
 use crate::error::Error;
 use crate::linalg::SymCsc;
 
-/// A sparse Cholesky factorization `A = L Lᵀ` of a symmetric positive definite matrix with a
-/// fixed pattern: the symbolic analysis (AMD ordering) once, numeric factorizations as often as
+/// A sparse Cholesky factorization `P A Pᵀ = L Lᵀ` (fill-reducing permutation P, AMD) of a
+/// symmetric positive definite matrix with a fixed pattern: the symbolic analysis (AMD ordering) once, numeric factorizations as often as
 /// the values change, solves for one column into preallocated scratch (no allocation: the
 /// Newton solve of a transient) or for many columns at once.
 ///
@@ -161,6 +165,62 @@ impl SparseCholesky {
             self.par,
             MemStack::new(&mut mem),
         );
+    }
+
+    /// Half solve `x ← L⁻¹ P x` for all columns (sequential): with [`Self::half_solve_transpose`],
+    /// `A⁻¹ = (Pᵀ L⁻ᵀ)(L⁻¹ P)`.
+    pub(crate) fn half_solve(&self, mut x: MatMut<'_, f64>) {
+        self.permute(x.rb_mut(), false);
+        self.triangular(x, false);
+    }
+
+    /// Half solve `x ← Pᵀ L⁻ᵀ x` for all columns (sequential).
+    pub(crate) fn half_solve_transpose(&self, mut x: MatMut<'_, f64>) {
+        self.triangular(x.rb_mut(), true);
+        self.permute(x, true);
+    }
+
+    /// `x ← P x` (`inverse` false) or `x ← Pᵀ x`, in faer's convention `(P x)_i = x_{fwd(i)}`.
+    fn permute(&self, mut x: MatMut<'_, f64>, inverse: bool) {
+        let Some(perm) = self.symbolic.perm() else {
+            return;
+        };
+        let (fwd, inv) = perm.arrays();
+        let map = if inverse { inv } else { fwd };
+        let mut tmp = vec![0.0; self.n];
+        for j in 0..x.ncols() {
+            for (t, &src) in tmp.iter_mut().zip(map) {
+                *t = x[(src, j)];
+            }
+            for (i, &t) in tmp.iter().enumerate() {
+                x[(i, j)] = t;
+            }
+        }
+    }
+
+    /// `x ← L⁻¹ x` or (`transpose`) `x ← L⁻ᵀ x` with the (permuted) factor L.
+    fn triangular(&self, x: MatMut<'_, f64>, transpose: bool) {
+        let par = Par::Seq;
+        match self.symbolic.raw() {
+            SymbolicCholeskyRaw::Simplicial(s) => {
+                let l = SparseColMatRef::<'_, usize, f64>::new(s.factor(), &self.l_values);
+                if transpose {
+                    solve_lower_triangular_transpose_in_place(l, Conj::No, x, par);
+                } else {
+                    solve_lower_triangular_in_place(l, Conj::No, x, par);
+                }
+            }
+            SymbolicCholeskyRaw::Supernodal(s) => {
+                let scratch = s.solve_in_place_scratch::<f64>(x.ncols(), par);
+                let stack = &mut MemBuffer::new(scratch);
+                let l = SupernodalLltRef::new(s, &self.l_values);
+                if transpose {
+                    l.l_transpose_solve_with_conj(Conj::No, x, par, MemStack::new(stack));
+                } else {
+                    l.l_solve_with_conj(Conj::No, x, par, MemStack::new(stack));
+                }
+            }
+        }
     }
 
     /// Dimension.

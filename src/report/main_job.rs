@@ -222,10 +222,6 @@ fn plans(case: &str, g_chosen: usize, pairs: usize, quick: bool) -> Vec<Plan> {
     let competitor_g: Vec<usize> = if quick { vec![paper[0]] } else { paper.clone() };
     for kind in [BasisKind::TvdPlain, BasisKind::Modes, BasisKind::Jim] {
         for &g in &competitor_g {
-            // Modes only: the Lanczos solver is trusted up to ~40 modes (ν + g).
-            if kind == BasisKind::Modes && g > 30 {
-                continue;
-            }
             out.push(Plan {
                 kind,
                 g,

@@ -75,17 +75,13 @@
 
 use std::time::Instant;
 
-use faer::linalg::triangular_solve::{
-    solve_lower_triangular_in_place, solve_upper_triangular_in_place,
-};
-use faer::{Mat, MatRef, Par, Side};
+use faer::{Mat, MatRef, Side};
 use serde::Serialize;
 
 use crate::error::Error;
 use crate::joint::statics::{contact_static_reduced, ContactOptions, ContactState};
 use crate::joint::NORMAL;
-use crate::model::contact_static_full;
-use crate::model::Model;
+use crate::model::{contact_static_full, Interface, Model};
 use crate::reduction::{
     alldof_vectors, build_basis, craig_bampton, final_basis, jim_vectors, trial_vector_derivatives,
     BasisKind, BasisOptions, JimSet, TvdOptions, DEFAULT_DROP_TOL, DEFAULT_THRESHOLD,
@@ -794,11 +790,19 @@ pub fn run_study(model: &Model, opts: &StudyOptions) -> Result<Study, Error> {
         series.push(ConvergenceSeries { prepare_s, ..s });
     }
 
-    // Modes only: modes ν+1 ..= ν+max_g once (dense, see `dense_fixed_interface_modes`);
+    // Modes only: fixed-interface modes ν+1 ..= ν+max_g once (sparse, zero on the master DOF);
     // g extra modes = their leading columns.
     {
         let t0 = Instant::now();
-        let extra = dense_fixed_interface_modes(model, opts.nu, opts.max_g)?;
+        let modes = model.modes(opts.nu + opts.max_g, Interface::Fixed)?;
+        let m = modes.shapes.nrows();
+        let extra = Mat::from_fn(model.dofs(), opts.max_g, |r, c| {
+            if r < m {
+                modes.shapes[(r, opts.nu + c)]
+            } else {
+                0.0
+            }
+        });
         let prepare_s = t0.elapsed().as_secs_f64();
         let s = sweep(
             model,
@@ -949,65 +953,3 @@ pub fn within(g: &[usize], err: &[f64], tol: f64) -> Within {
 
 /// Floor for drawing a zero relative error on a log axis.
 pub const ERROR_FLOOR: f64 = 1e-16;
-
-/// Fixed-interface normal modes `skip + 1 ..= skip + count` (`K_ii φ = ω² M_ii φ`, master
-/// clamped, M-orthonormal, zero on the master DOF), n × count, by a dense solve: `K_ii = L Lᵀ`,
-/// the symmetric eigenproblem `L⁻¹ M_ii L⁻ᵀ y = μ y` with `μ = 1/ω²` (largest μ = lowest
-/// modes), `φ = L⁻ᵀ y / sqrt(μ)`.
-///
-/// Used for the `modes` series because it needs ν + 60 modes and the sparse Lanczos solver
-/// ([`Model::modes`]) fails its backward-error check beyond ~40 modes on the built-in cases.
-/// O(n³): fine for the built-in meshes (≈ 900 DOF, well under a second).
-pub fn dense_fixed_interface_modes(
-    model: &Model,
-    skip: usize,
-    count: usize,
-) -> Result<Mat<f64>, Error> {
-    let n = model.dofs();
-    let m = n.saturating_sub(6);
-    if skip + count > m {
-        return Err(Error::Invalid(format!(
-            "{} fixed-interface modes requested, the model has {m} interior DOF",
-            skip + count
-        )));
-    }
-    let k = model.stiffness.leading(m).to_dense();
-    let mut x = model.mass.leading(m).to_dense();
-    let llt = k.llt(Side::Lower).map_err(|e| {
-        Error::LinearAlgebra(format!("dense K_ii (fixed interface) Cholesky: {e:?}"))
-    })?;
-    let l = llt.L();
-    solve_lower_triangular_in_place(l, x.as_mut(), Par::Seq); // L⁻¹ M
-    let mut c = x.transpose().to_owned(); // M L⁻ᵀ
-    solve_lower_triangular_in_place(l, c.as_mut(), Par::Seq); // L⁻¹ M L⁻ᵀ
-    let c = Mat::from_fn(m, m, |i, j| 0.5 * (c[(i, j)] + c[(j, i)]));
-    let evd = c
-        .self_adjoint_eigen(Side::Lower)
-        .map_err(|e| Error::LinearAlgebra(format!("dense fixed-interface modes: {e:?}")))?;
-    let mu = evd.S().column_vector();
-    let u = evd.U();
-    let mut y = Mat::<f64>::zeros(m, count);
-    let mut scale = vec![0.0; count];
-    for c in 0..count {
-        let i = m - 1 - (skip + c); // ascending order: largest μ last
-        if !(mu[i] > 0.0 && mu[i].is_finite()) {
-            return Err(Error::LinearAlgebra(format!(
-                "dense fixed-interface mode {}: μ = 1/ω² = {:e} is not positive",
-                skip + c + 1,
-                mu[i]
-            )));
-        }
-        scale[c] = 1.0 / mu[i].sqrt();
-        for r in 0..m {
-            y[(r, c)] = u[(r, i)];
-        }
-    }
-    solve_upper_triangular_in_place(l.transpose(), y.as_mut(), Par::Seq); // L⁻ᵀ y
-    Ok(Mat::from_fn(n, count, |r, c| {
-        if r < m {
-            y[(r, c)] * scale[c]
-        } else {
-            0.0
-        }
-    }))
-}
