@@ -100,7 +100,6 @@
 //! by log10 of the error, the failure flag (and, on the status map, the time reached, s)
 //! written in failed cells.
 
-use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -1234,131 +1233,21 @@ pub fn sweep_json(sweep: &Sweep) -> serde_json::Value {
     v
 }
 
-/// `jointrom stability CASE`: the stability map (see the module docs).
-#[derive(clap::Args, Debug, Clone)]
-pub struct StabilityArgs {
-    /// Case file, matrix map (`jointrom-matrices` JSON) or built-in name.
-    pub case: String,
-    /// Output folder (OUT/CASE/stability.json, .md and heat maps).
-    #[arg(long, default_value = "out")]
-    pub out: PathBuf,
-    /// Models: full, rom-g0, rom (comma-separated).
-    #[arg(long, value_delimiter = ',', default_value = "full,rom-g0,rom")]
-    pub models: Vec<String>,
-    /// Iterations: functional, newton.
-    #[arg(long, value_delimiter = ',', default_value = "functional,newton")]
-    pub iterations: Vec<String>,
-    /// Penalty stiffnesses k_n, N/mm.
-    #[arg(long, value_delimiter = ',', default_value = "1e2,1e4,1e6")]
-    pub kn: Vec<f64>,
-    /// Friction values: off, on.
-    #[arg(long, value_delimiter = ',', default_value = "off,on")]
-    pub friction: Vec<String>,
-    /// Events values: off, on.
-    #[arg(long, value_delimiter = ',', default_value = "off,on")]
-    pub events: Vec<String>,
-    /// BDF maximum orders.
-    #[arg(long, value_delimiter = ',', default_value = "2,5")]
-    pub max_order: Vec<usize>,
-    /// ROM window, s.
-    #[arg(long, default_value_t = 0.01)]
-    pub end_time: f64,
-    /// Full-model window, s.
-    #[arg(long, default_value_t = 2e-4)]
-    pub full_end_time: f64,
-    /// ROM output spacing, s.
-    #[arg(long, default_value_t = 1e-4)]
-    pub output_step: f64,
-    /// Full-model and reference output spacing, s.
-    #[arg(long, default_value_t = 1e-5)]
-    pub full_output_step: f64,
-    /// Relative tolerance.
-    #[arg(long, default_value_t = 1e-8)]
-    pub rtol: f64,
-    /// Absolute tolerance.
-    #[arg(long, default_value_t = 1e-6)]
-    pub atol: f64,
-    /// Velocity tolerance per displacement tolerance, 1/s (1: the paper's one number).
-    #[arg(long, default_value_t = crate::integrate::mechanical::DEFAULT_VELOCITY_SCALE)]
-    pub velocity_scale: f64,
-    /// CVODE maximum steps per output interval.
-    #[arg(long, default_value_t = 20_000)]
-    pub max_steps: usize,
-    /// Wall-clock budget per cell, s.
-    #[arg(long, default_value_t = 20.0)]
-    pub budget: f64,
-    /// Wall-clock budget per reference run, s.
-    #[arg(long, default_value_t = 60.0)]
-    pub reference_budget: f64,
-    /// Tolerance factor of the references.
-    #[arg(long, default_value_t = 100.0)]
-    pub reference_factor: f64,
-    /// Skip the reference runs (no errors).
-    #[arg(long)]
-    pub no_reference: bool,
-    /// Skip the heat maps.
-    #[arg(long)]
-    pub no_charts: bool,
-}
-
-fn parse_on_off(flag: &str, v: &[String]) -> Result<Vec<bool>, Error> {
-    v.iter()
-        .map(|s| match s.as_str() {
-            "on" => Ok(true),
-            "off" => Ok(false),
-            _ => Err(Error::Invalid(format!(
-                "--{flag}: expected on or off, got {s:?}"
-            ))),
-        })
-        .collect()
-}
-
-impl StabilityArgs {
-    /// The sweep options these arguments ask for.
-    pub fn options(&self) -> Result<SweepOptions, Error> {
-        Ok(SweepOptions {
-            models: self
-                .models
-                .iter()
-                .map(|s| ModelKind::parse(s))
-                .collect::<Result<_, _>>()?,
-            iterations: self
-                .iterations
-                .iter()
-                .map(|s| IterKind::parse(s))
-                .collect::<Result<_, _>>()?,
-            normal_stiffness: self.kn.clone(),
-            friction: parse_on_off("friction", &self.friction)?,
-            events: parse_on_off("events", &self.events)?,
-            max_orders: self.max_order.clone(),
-            end_time: self.end_time,
-            full_end_time: self.full_end_time,
-            output_step: self.output_step,
-            full_output_step: self.full_output_step,
-            rtol: self.rtol,
-            atol: self.atol,
-            velocity_scale: self.velocity_scale,
-            max_steps: self.max_steps,
-            budget_s: self.budget,
-            reference_factor: self.reference_factor,
-            reference_budget_s: self.reference_budget,
-            references: !self.no_reference,
-            basis: BasisOptions::default(),
-            progress: std::io::stderr().is_terminal(),
-        })
-    }
-}
-
-/// Runs `jointrom stability`: the sweep, then `OUT/CASE/stability.{json,md}` and the heat maps.
+/// The stability study of a case (what `jointrom stability CASE` runs): loads the case, runs the
+/// sweep of `opts`, writes `out/CASE/stability.{json,md}` and, with `charts`, the heat maps.
 /// Returns a summary: the output folder, files, number of cells, failed cells by status, the
 /// total wall time.
-pub fn stability_command(args: &StabilityArgs) -> Result<serde_json::Value, Error> {
-    let opts = args.options()?;
+pub fn stability_study(
+    case: &str,
+    out: &Path,
+    charts: bool,
+    opts: &SweepOptions,
+) -> Result<serde_json::Value, Error> {
     let t0 = Instant::now();
-    let model = Model::from_case_name(&args.case)?;
-    let sweep = run_sweep_model(&model, t0.elapsed().as_secs_f64(), &opts)?;
-    let dir = args.out.join(&sweep.case);
-    let files = write_outputs(&sweep, &dir, !args.no_charts)?;
+    let model = Model::from_case_name(case)?;
+    let sweep = run_sweep_model(&model, t0.elapsed().as_secs_f64(), opts)?;
+    let dir = out.join(&sweep.case);
+    let files = write_outputs(&sweep, &dir, charts)?;
     let mut by_status = std::collections::BTreeMap::<String, usize>::new();
     for c in &sweep.cells {
         *by_status.entry(c.outcome.status.clone()).or_default() += 1;
