@@ -31,7 +31,6 @@
 //!
 //! `quick` shortens the transient window to 0.02 s and the study to g ≤ 20 (< 20 s in all).
 
-use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -49,7 +48,7 @@ use crate::system::{FullSystem, ReducedSystem, SecondOrderSystem};
 
 /// Options of [`run_report`]. Defaults: the full job (case end time, study g ≤ 60, functional
 /// iteration runs included), budgets 60 s per reduced run and 600 s for the full run, progress
-/// on a terminal only, the stored stability maps under `results/stability`.
+/// reported, the stored stability maps under `results/stability`.
 #[derive(Clone, Debug)]
 pub struct ReportOptions {
     /// Short variant: 0.02 s window, study g ≤ 20, fewer runs.
@@ -61,7 +60,8 @@ pub struct ReportOptions {
     /// Wall-clock budget of the full FE run with functional iteration, s (it is expected to fail:
     /// the budget bounds what that failure costs; at most 2 s when `quick`).
     pub full_functional_budget_s: f64,
-    /// Show a progress bar (only drawn when stderr is a terminal).
+    /// Report progress to the observer of [`run_report_observed`] (`jointrom run` draws it as a
+    /// bar when stderr is a terminal).
     pub progress: bool,
     /// Folder holding stored stability maps (`<dir>/<case>/stability_status.png`).
     pub stability_dir: PathBuf,
@@ -313,8 +313,58 @@ fn ode_options(functional: bool) -> OdeOptions {
     ode
 }
 
+/// Where the main job stands, as [`run_report_observed`] reports it: the stage now running, the
+/// steps done and the steps in all (known once the static study has chosen g; 1 before).
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Progress {
+    /// What runs now (e.g. `full FE model, Newton`).
+    pub stage: String,
+    /// Steps done.
+    pub position: u64,
+    /// Steps in all.
+    pub total: u64,
+    /// The runs are over (a progress bar is cleared).
+    pub finished: bool,
+}
+
+/// Sends every change of a [`Progress`] to an observer (nothing when `on` is false).
+struct Tracker<'a> {
+    on: bool,
+    state: Progress,
+    observer: &'a mut dyn FnMut(&Progress),
+}
+
+impl Tracker<'_> {
+    fn notify(&mut self) {
+        if self.on {
+            (self.observer)(&self.state);
+        }
+    }
+
+    fn set_message(&mut self, stage: impl Into<String>) {
+        self.state.stage = stage.into();
+        self.notify();
+    }
+
+    fn set_length(&mut self, total: u64) {
+        self.state.total = total;
+        self.notify();
+    }
+
+    fn inc(&mut self, steps: u64) {
+        self.state.position += steps;
+        self.notify();
+    }
+
+    fn finish_and_clear(&mut self) {
+        self.state.finished = true;
+        self.notify();
+    }
+}
+
 /// Runs the main job on `model` and writes the report into `dir` (created if missing);
-/// `extra` fields are added to `results.json`.
+/// `extra` fields are added to `results.json`. No progress is reported (see
+/// [`run_report_observed`]).
 ///
 /// # Errors
 /// Building the model's bases or the full reference run failing, charts or files that cannot be
@@ -324,6 +374,20 @@ pub fn run_report(
     dir: &Path,
     opts: &ReportOptions,
     extra: serde_json::Map<String, serde_json::Value>,
+) -> Result<Report, Error> {
+    run_report_observed(model, dir, opts, extra, &mut |_| {})
+}
+
+/// [`run_report`], reporting its progress to `observer` when [`ReportOptions::progress`] is set.
+///
+/// # Errors
+/// As [`run_report`].
+pub fn run_report_observed(
+    model: &Model,
+    dir: &Path,
+    opts: &ReportOptions,
+    extra: serde_json::Map<String, serde_json::Value>,
+    observer: &mut dyn FnMut(&Progress),
 ) -> Result<Report, Error> {
     let t_all = Instant::now();
     std::fs::create_dir_all(dir).map_err(|e| Error::Io {
@@ -339,18 +403,13 @@ pub fn run_report(
     let output_step = 1e-4;
     let problem = ProblemOptions::default();
 
-    let bar = if opts.progress && std::io::stderr().is_terminal() {
-        let b = indicatif::ProgressBar::new(1);
-        b.set_style(
-            indicatif::ProgressStyle::with_template(
-                "{elapsed_precise} [{bar:30}] {pos}/{len} {msg}",
-            )
-            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar())
-            .progress_chars("=> "),
-        );
-        b
-    } else {
-        indicatif::ProgressBar::hidden()
+    let mut bar = Tracker {
+        on: opts.progress,
+        state: Progress {
+            total: 1,
+            ..Progress::default()
+        },
+        observer,
     };
 
     // 1. Static study and the a-priori g.

@@ -5,11 +5,15 @@
 //! the time reached, s) written in failed cells.
 
 use std::path::{Path, PathBuf};
+use std::time::Instant;
 
 use crate::error::Error;
 use crate::integrate::RunStatus;
+use crate::model::Model;
 use crate::report::heatmap::{sequential, HeatCell, HeatMap};
-use crate::studies::stability::{on_off, IterKind, ModelKind, Sweep};
+use crate::studies::stability::{
+    on_off, run_sweep_model, IterKind, ModelKind, Sweep, SweepOptions,
+};
 
 /// The status with `CV_` stripped (short enough for a heat-map cell).
 fn short_status(s: &RunStatus) -> &str {
@@ -316,4 +320,34 @@ pub fn sweep_json(sweep: &Sweep) -> serde_json::Value {
         }
     }
     v
+}
+
+/// The stability study of a case (what `jointrom stability CASE` runs): loads the case, runs the
+/// sweep of `opts`, writes `out/CASE/stability.{json,md}` and, with `charts`, the heat maps.
+/// Returns a summary: the output folder, files, number of cells, failed cells by status, the
+/// total wall time.
+pub fn stability_study(
+    case: &str,
+    out: &Path,
+    charts: bool,
+    opts: &SweepOptions,
+) -> Result<serde_json::Value, Error> {
+    let t0 = Instant::now();
+    let model = Model::from_case_name(case)?;
+    let sweep = run_sweep_model(&model, t0.elapsed().as_secs_f64(), opts)?;
+    let dir = out.join(&sweep.case);
+    let files = write_outputs(&sweep, &dir, charts)?;
+    let mut by_status = std::collections::BTreeMap::<String, usize>::new();
+    for c in &sweep.cells {
+        *by_status
+            .entry(c.outcome.status.name().to_string())
+            .or_default() += 1;
+    }
+    Ok(serde_json::json!({
+        "dir": dir,
+        "files": files,
+        "cells": sweep.cells.len(),
+        "status_counts": by_status,
+        "wall_s": sweep.wall_s,
+    }))
 }

@@ -1,0 +1,245 @@
+//! The command line: subcommands, their enumerated flag values, and today's error texts for bad
+//! values of those flags.
+
+use clap::error::{ContextKind, ContextValue, ErrorKind};
+use clap::{Parser, Subcommand, ValueEnum};
+
+use jointrom::reduction::BasisKind;
+use jointrom::studies::convergence as study;
+use jointrom::studies::stability::{IterKind, ModelKind};
+use jointrom::{Error, Interface};
+
+use crate::commands::{
+    basis, export, export_matrices, info, modes, run, shapes, stability, statics,
+    study as study_cmd, sweep, transient,
+};
+
+#[derive(Parser)]
+#[command(
+    name = "jointrom",
+    version,
+    about = "Reduced-order transient dynamics of jointed sheet structures (trial vector derivatives)"
+)]
+pub struct Cli {
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+#[derive(Subcommand)]
+pub enum Command {
+    /// Model summary: DOF, joint pairs, nodes, elements.
+    Info(info::InfoArgs),
+    /// Lowest eigenfrequencies (joint open, no contact stiffness).
+    Modes(modes::ModesArgs),
+    /// Static response to the case's master load.
+    Static(statics::StaticArgs),
+    /// The TVD basis (Algorithm 2): POD energy ratios w(g), chosen g, sizes, build time.
+    Basis(basis::BasisArgs),
+    /// Static convergence study: ‖f_c‖ of each reduced basis against the number of added
+    /// vectors g, w(g); writes OUT/CASE/study.json and SVG/PNG charts.
+    Study(study_cmd::StudyArgs),
+    /// Stability map of the transient methods: model × iteration × k_n × friction × events ×
+    /// max order → status (ok or the CVODE flag and time reached), cost, error; writes
+    /// OUT/CASE/stability.json, stability.md and heat maps (SVG/PNG).
+    Stability(stability::StabilityArgs),
+
+    /// Transient run from rest (CVODE): contact force norm, friction force norm and master uy
+    /// over time, solver statistics and wall time.
+    Transient(transient::TransientArgs),
+    /// Writes the Craig–Bampton vectors, the first TVD and joint modes as VTU (ParaView) and a
+    /// picture of the first joint modes (PNG + SVG) → DIR/CASE/.
+    Shapes(shapes::ShapesArgs),
+    /// Runs a list of variants (load factor, μ, k_n, k_t) of one reduced model in parallel,
+    /// sharing the basis → a table (or JSON with every run's curves).
+    Sweep(sweep::SweepArgs),
+    /// Writes a reduced model as a versioned JSON file (schema `jointrom-rom` v1: M̃, K̃, BΦ,
+    /// master rows, reduced loads, contact law, load ramp; see `jointrom::reduction::rom_file`).
+    Export(export::ExportArgs),
+    /// Writes a model's K and M as MatrixMarket files plus the JSON map (`K.mtx`, `M.mtx`,
+    /// `model.json`; see `jointrom::model::matrices`): the format a user's own model comes in. Any
+    /// command takes `DIR/model.json` where it takes a case.
+    ExportMatrices(export_matrices::ExportMatricesArgs),
+    /// The main job on a case (default: the friction bar): static study, full FE and reduced
+    /// transients, speed against accuracy → DIR/CASE/report.md, charts, results.json.
+    Run(run::RunArgs),
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+pub enum InterfaceArg {
+    /// Master node clamped (Craig–Bampton fixed-interface normal modes).
+    Fixed,
+    /// Master node free (the cantilever's own modes).
+    Free,
+}
+
+impl From<InterfaceArg> for Interface {
+    fn from(a: InterfaceArg) -> Interface {
+        match a {
+            InterfaceArg::Fixed => Interface::Fixed,
+            InterfaceArg::Free => Interface::Free,
+        }
+    }
+}
+
+// A reduced basis kind (`--basis`), spelled as `BasisKind::NAMES`.
+#[derive(Clone, Copy, ValueEnum)]
+pub enum BasisArg {
+    #[value(name = "tvd")]
+    Tvd,
+    #[value(name = "tvd-plain")]
+    TvdPlain,
+    #[value(name = "modes")]
+    Modes,
+    #[value(name = "jim")]
+    Jim,
+    #[value(name = "alldof")]
+    AllDof,
+}
+
+impl From<BasisArg> for BasisKind {
+    fn from(a: BasisArg) -> BasisKind {
+        match a {
+            BasisArg::Tvd => BasisKind::Tvd,
+            BasisArg::TvdPlain => BasisKind::TvdPlain,
+            BasisArg::Modes => BasisKind::Modes,
+            BasisArg::Jim => BasisKind::Jim,
+            BasisArg::AllDof => BasisKind::AllDof,
+        }
+    }
+}
+
+// The TVD bases `jointrom basis --kind` describes.
+#[derive(Clone, Copy, ValueEnum)]
+pub enum TvdKindArg {
+    #[value(name = "tvd")]
+    Tvd,
+    #[value(name = "tvd-plain")]
+    TvdPlain,
+}
+
+impl From<TvdKindArg> for BasisKind {
+    fn from(a: TvdKindArg) -> BasisKind {
+        match a {
+            TvdKindArg::Tvd => BasisKind::Tvd,
+            TvdKindArg::TvdPlain => BasisKind::TvdPlain,
+        }
+    }
+}
+
+// The nonlinear iteration (`--iteration`, `--iterations`).
+#[derive(Clone, Copy, ValueEnum)]
+pub enum IterationArg {
+    #[value(name = "newton")]
+    Newton,
+    #[value(name = "functional")]
+    Functional,
+}
+
+impl From<IterationArg> for IterKind {
+    fn from(a: IterationArg) -> IterKind {
+        match a {
+            IterationArg::Newton => IterKind::Newton,
+            IterationArg::Functional => IterKind::Functional,
+        }
+    }
+}
+
+// A switch: `on` or `off`.
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum OnOff {
+    #[value(name = "on")]
+    On,
+    #[value(name = "off")]
+    Off,
+}
+
+impl OnOff {
+    pub fn is_on(self) -> bool {
+        self == OnOff::On
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            OnOff::On => "on",
+            OnOff::Off => "off",
+        }
+    }
+}
+
+// The models of the stability map (`--models`).
+#[derive(Clone, Copy, ValueEnum)]
+pub enum MapModelArg {
+    #[value(name = "full")]
+    Full,
+    #[value(name = "rom-g0")]
+    RomG0,
+    #[value(name = "rom")]
+    Rom,
+}
+
+impl From<MapModelArg> for ModelKind {
+    fn from(a: MapModelArg) -> ModelKind {
+        match a {
+            MapModelArg::Full => ModelKind::Full,
+            MapModelArg::RomG0 => ModelKind::RomG0,
+            MapModelArg::Rom => ModelKind::Rom,
+        }
+    }
+}
+
+/// The error `jointrom` reported for a bad value of an enumerated flag before the flags were
+/// typed (they were parsed by the commands then); `None` for every other parse error, which
+/// clap reports itself. `args` is the command line (program name first).
+pub fn legacy_value_error(e: &clap::Error, args: &[String]) -> Option<Error> {
+    if e.kind() != ErrorKind::InvalidValue {
+        return None;
+    }
+    let text = |k| match e.get(k) {
+        Some(ContextValue::String(s)) => Some(s.clone()),
+        _ => None,
+    };
+    let arg = text(ContextKind::InvalidArg)?;
+    let value = text(ContextKind::InvalidValue)?;
+    let flag = arg.split([' ', '=']).next().unwrap_or_default();
+    // clap reports a missing value as an empty one; only a given empty value went to the
+    // command before.
+    if value.is_empty() && !has_value(args, flag) {
+        return None;
+    }
+    value_error(args.get(1)?, flag, &value)
+}
+
+/// Whether `flag` is given a value on the command line (`--flag=…` or `--flag …`).
+fn has_value(args: &[String], flag: &str) -> bool {
+    args.iter().enumerate().any(|(i, a)| {
+        a.strip_prefix(flag).is_some_and(|r| r.starts_with('='))
+            || (a == flag && args.get(i + 1).is_some_and(|v| !v.starts_with('-')))
+    })
+}
+
+/// Today's error for `value` given to `flag` of `subcommand`.
+fn value_error(subcommand: &str, flag: &str, v: &str) -> Option<Error> {
+    let invalid = |s: String| Some(Error::Invalid(s));
+    match (subcommand, flag) {
+        ("static", "--basis") => study::parse_basis(v).err(),
+        ("sweep" | "export", "--basis") => BasisKind::from_name(v)
+            .err()
+            .and_then(|e| invalid(format!("--basis: {e}"))),
+        ("basis", "--kind") => match study::parse_basis(v) {
+            Ok(_) => invalid(format!("--kind {v}: must be tvd or tvd-plain")),
+            Err(_) => invalid(format!("--kind {v:?}: valid: tvd, tvd-plain")),
+        },
+        ("transient", "--iteration") => invalid(format!(
+            "--iteration must be `newton` or `functional`, got `{v}`"
+        )),
+        ("transient", "--friction" | "--events" | "--stab-lim-det") => {
+            invalid(format!("{flag} must be `on` or `off`, got `{v}`"))
+        }
+        ("stability", "--models") => ModelKind::parse(v).err(),
+        ("stability", "--iterations") => IterKind::parse(v).err(),
+        ("stability", "--friction" | "--events") => {
+            invalid(format!("{flag}: expected on or off, got {v:?}"))
+        }
+        _ => None,
+    }
+}

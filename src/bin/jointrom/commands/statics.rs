@@ -1,0 +1,167 @@
+//! `jointrom static`: static response to the case's master load (full or reduced).
+
+use clap::Args;
+use serde_json::{json, Value};
+
+use jointrom::joint::statics as contact;
+use jointrom::reduction::{BasisKind, BasisOptions};
+use jointrom::studies::convergence as study;
+use jointrom::{Error, Model};
+
+use crate::cli::BasisArg;
+use crate::common::{print_json, print_master_displacement};
+
+#[derive(Args)]
+pub struct StaticArgs {
+    /// Case file, matrix map (`jointrom-matrices` JSON) or built-in name.
+    case: String,
+    /// Linear analysis without contact (the joint may interpenetrate); default: full FE
+    /// model with frictionless penalty contact in the joint pairs.
+    #[arg(long)]
+    linear: bool,
+    /// Factor on the case's load (e.g. -1 reverses it).
+    #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
+    scale: f64,
+    /// Solve the reduced model on this basis instead of the full FE model: tvd, tvd-plain,
+    /// modes, ... (see `jointrom::studies::convergence::BASIS_KINDS`).
+    #[arg(long, value_enum)]
+    basis: Option<BasisArg>,
+    /// Enrichment vectors of the basis (joint modes; extra modes for `modes`); default: the
+    /// smallest g with w(g) >= 0.999. Larger than available is an error.
+    #[arg(long)]
+    g: Option<usize>,
+    /// Fixed-interface modes ν of the basis.
+    #[arg(long, default_value_t = 10)]
+    nu: usize,
+    /// One JSON document on stdout.
+    #[arg(long)]
+    json: bool,
+}
+
+pub fn run(a: StaticArgs) -> Result<(), Error> {
+    let scale = a.scale;
+    if !scale.is_finite() {
+        return Err(Error::Invalid(format!(
+            "--scale must be finite, got {scale}"
+        )));
+    }
+    if a.basis.is_none() && a.g.is_some() {
+        return Err(Error::Invalid("--g needs --basis".into()));
+    }
+    if let Some(kind) = a.basis {
+        if a.linear {
+            return Err(Error::Invalid(
+                "--linear and --basis do not combine: --basis solves the reduced contact statics"
+                    .into(),
+            ));
+        }
+        let model = Model::from_case_name(&a.case)?;
+        return reduced_static(&model, kind.into(), a.g, a.nu, scale, a.json);
+    }
+    let model = Model::from_case_name(&a.case)?;
+    let v = if a.linear {
+        static_json(&model, scale)?
+    } else {
+        contact_json(&model, scale)?
+    };
+    if a.json {
+        print_json(&v);
+        return Ok(());
+    }
+    let kind = if a.linear {
+        "linear"
+    } else {
+        "with contact (frictionless)"
+    };
+    println!("{} — static {kind}, load × {scale}:", model.name);
+    let u = &v["master_displacement"];
+    print_master_displacement(|k| u[k].as_f64().unwrap_or(f64::NAN));
+    if !a.linear {
+        println!(
+            "  ‖f_c‖ = {:.6} N, {} of {} pairs in contact",
+            v["contact_force_norm"].as_f64().unwrap_or(f64::NAN),
+            v["pairs_in_contact"],
+            model.pair_count()
+        );
+    }
+    Ok(())
+}
+
+/// The linear static solution under `scale` × the master load (also part of `run`'s
+/// results.json).
+pub fn static_json(model: &Model, scale: f64) -> Result<Value, Error> {
+    let load = model.master_load().map(|v| v * scale);
+    let sol = model.static_linear(&[load])?.remove(0);
+    Ok(json!({
+        "case": model.name,
+        "linear": true,
+        "load": load,
+        "master_displacement": sol.master_displacement,
+    }))
+}
+
+fn contact_json(model: &Model, scale: f64) -> Result<Value, Error> {
+    let load = model.master_load().map(|v| v * scale);
+    let sol =
+        jointrom::model::contact_static_full(model, load, &contact::ContactOptions::default())?;
+    Ok(json!({
+        "case": model.name,
+        "linear": false,
+        "load": load,
+        "master_displacement": sol.master_displacement,
+        "contact_force_norm": sol.state.contact_force_norm,
+        "pairs_in_contact": sol.state.pairs_in_contact,
+        "iterations": sol.state.iterations,
+    }))
+}
+
+fn reduced_static(
+    model: &Model,
+    kind: BasisKind,
+    g: Option<usize>,
+    nu: usize,
+    scale: f64,
+    json: bool,
+) -> Result<(), Error> {
+    let load = study::scaled_load(model, scale)?;
+    let opts = BasisOptions {
+        nu,
+        g,
+        ..BasisOptions::default()
+    };
+    let r = study::basis_static(model, kind, &opts, scale)?;
+    let st = &r.solution.state;
+    let v = json!({
+        "case": model.name,
+        "linear": false,
+        "load": load,
+        "master_displacement": r.solution.master_displacement,
+        "contact_force_norm": st.contact_force_norm,
+        "pairs_in_contact": st.pairs_in_contact,
+        "iterations": st.iterations,
+        "basis": r.basis,
+        "g": r.g,
+        "basis_size": r.basis_size,
+        "restarted": r.restarted,
+        "build_s": r.build_s,
+        "solve_s": r.solve_s,
+    });
+    if json {
+        print_json(&v);
+        return Ok(());
+    }
+    println!(
+        "{} — reduced static with contact (frictionless), basis {} (g = {}, {} columns), load × {scale}:",
+        model.name, r.basis, r.g, r.basis_size
+    );
+    print_master_displacement(|k| r.solution.master_displacement[k]);
+    println!(
+        "  ‖f_c‖ = {:.6} N, {} of {} pairs in contact; basis {:.1} ms, solve {:.1} ms",
+        st.contact_force_norm,
+        st.pairs_in_contact,
+        model.pair_count(),
+        r.build_s * 1e3,
+        r.solve_s * 1e3
+    );
+    Ok(())
+}

@@ -1,0 +1,110 @@
+//! `jointrom sweep`: variants of one reduced model, in parallel, sharing the basis.
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use clap::Args;
+use serde_json::json;
+
+use jointrom::integrate::TransientOptions;
+use jointrom::reduction::{build_basis, BasisKind, BasisOptions};
+use jointrom::studies::sweep::{self, SweepResult};
+use jointrom::system::ReducedSystem;
+use jointrom::{Error, Model};
+
+use crate::cli::BasisArg;
+use crate::common::{positive, print_json};
+
+#[derive(Args)]
+pub struct SweepArgs {
+    /// Case file, matrix map (`jointrom-matrices` JSON) or built-in name.
+    case: String,
+    /// The variant file (`{"variants": [{"name", "load_scale", "friction_coefficient",
+    /// "normal_stiffness", "stick_stiffness"}, ...]}`).
+    #[arg(long)]
+    variants: PathBuf,
+    /// Basis kind: tvd, tvd-plain, modes, jim, alldof.
+    #[arg(long, value_enum, default_value_t = BasisArg::Tvd)]
+    basis: BasisArg,
+    /// Enrichment vectors g; default: the smallest g with w(g) >= 0.999.
+    #[arg(long)]
+    g: Option<usize>,
+    /// End time, s (default: the case's).
+    #[arg(long)]
+    end_time: Option<f64>,
+    /// Run the variants one after the other.
+    #[arg(long)]
+    sequential: bool,
+    /// One JSON document on stdout (with the curves).
+    #[arg(long)]
+    json: bool,
+}
+
+pub fn run(a: SweepArgs) -> Result<(), Error> {
+    let model = Model::from_case_name(&a.case)?;
+    let list = sweep::read_variants(&a.variants)?;
+    let kind = BasisKind::from(a.basis);
+    let t0 = Instant::now();
+    let b = build_basis(
+        &model,
+        kind,
+        &BasisOptions {
+            g: a.g,
+            ..BasisOptions::default()
+        },
+    )?;
+    let g_used = b.g;
+    let rom = ReducedSystem::new(&model, b.phi)?;
+    let build_s = t0.elapsed().as_secs_f64();
+    let mut opts = TransientOptions::default();
+    if let Some(t) = a.end_time {
+        opts.end_time = Some(positive("end-time", t)?);
+    }
+    let res = sweep::run_sweep(&model, &rom, &list, &opts, !a.sequential)?;
+    if a.json {
+        print_json(&json!({
+            "case": model.name,
+            "basis": kind.name(),
+            "g": g_used,
+            "basis_size": rom.dim(),
+            "build_s": build_s,
+            "sweep": res,
+        }));
+    } else {
+        println!(
+            "{} — {} basis, g = {g_used}, r = {} (built once, {:.3} s); {} variants on {} threads",
+            model.name,
+            kind.name(),
+            rom.dim(),
+            build_s,
+            res.runs.len(),
+            res.threads
+        );
+        print_runs(&res);
+    }
+    Ok(())
+}
+
+/// One line per run (plus its status when it failed), then the wall times.
+fn print_runs(res: &SweepResult) {
+    for r in &res.runs {
+        let last = |v: &[f64]| v.last().copied().unwrap_or(f64::NAN);
+        println!(
+            "  {:<20} {:<6} {:>8.3} s {:>8} steps  final |f_c| {:.4e} N  |f_R| {:.4e} N  uy {:.4e} mm",
+            r.variant.name,
+            if r.status == "ok" { "ok" } else { "failed" },
+            r.wall_s,
+            r.stats.steps,
+            last(&r.curves.contact_force_norm),
+            last(&r.curves.friction_force_norm),
+            last(&r.curves.master_uy)
+        );
+        if r.status != "ok" {
+            println!("    {}", r.status);
+        }
+    }
+    println!(
+        "sweep wall {:.3} s, sum of runs {:.3} s",
+        res.wall_s, res.sum_wall_s
+    );
+}

@@ -1,0 +1,481 @@
+//! `jointrom transient`: a transient run from rest (CVODE) of the full FE model or a reduced
+//! one; curves, solver statistics, wall time, optionally files and VTU frames.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use clap::Args;
+use serde_json::{json, Value};
+
+use jointrom::integrate::problem::{Iteration, NewtonLinear};
+use jointrom::integrate::{self as driver, integrate, Curves, Run, TransientOptions};
+use jointrom::reduction::rom_file as export;
+use jointrom::reduction::{build_basis, snapshot_basis, BasisKind, BasisOptions};
+use jointrom::system::{FullSystem, ReducedSystem, Scene, SecondOrderSystem};
+use jointrom::{Error, Model};
+
+use crate::cli::{IterationArg, OnOff};
+use crate::common::{create_dir, positive, print_json, write_file};
+
+#[derive(Args)]
+pub struct TransientArgs {
+    /// Case file, matrix map (`jointrom-matrices` JSON) or built-in name.
+    case: String,
+    /// full (FE model) or a reduced basis: tvd, tvd-plain, modes, jim, alldof, pod (POD of
+    /// the displacement snapshots of a full-FE training run, paper Section 5.2), or
+    /// file:PATH (a reduced model written by `jointrom export`; CASE is still loaded).
+    #[arg(long, default_value = "tvd")]
+    model: String,
+    /// Enrichment vectors of the basis; default: the smallest g with w(g) >= 0.999.
+    #[arg(long)]
+    g: Option<usize>,
+    /// `--model pod`: end of the full-FE training run, s (default: the run's end time).
+    #[arg(long)]
+    train_end: Option<f64>,
+    /// `--model pod`: about this many snapshots kept from the training run (every k-th output,
+    /// k = outputs / N).
+    #[arg(long, default_value_t = 200)]
+    snapshots: usize,
+    /// Fixed-interface modes ν of the basis.
+    #[arg(long, default_value_t = 10)]
+    nu: usize,
+    /// Nonlinear iteration: newton (structured solve) or functional (fixed point).
+    #[arg(long, value_enum, default_value_t = IterationArg::Newton)]
+    iteration: IterationArg,
+    /// Friction on or off.
+    #[arg(long, value_enum, default_value_t = OnOff::On)]
+    friction: OnOff,
+    /// Event location on gaps and stick/slip switches, on or off.
+    #[arg(long, value_enum, default_value_t = OnOff::Off)]
+    events: OnOff,
+    /// Relative tolerance.
+    #[arg(long)]
+    rtol: Option<f64>,
+    /// Absolute tolerance, mm of the physical displacement field.
+    #[arg(long)]
+    atol: Option<f64>,
+    /// Velocity tolerance per displacement tolerance, 1/s.
+    #[arg(long)]
+    velocity_scale: Option<f64>,
+    /// Maximum BDF order (1–5).
+    #[arg(long)]
+    max_order: Option<usize>,
+    /// BDF stability-limit detection, on or off.
+    #[arg(long, value_enum)]
+    stab_lim_det: Option<OnOff>,
+    /// End time, s (default: the case's).
+    #[arg(long)]
+    end_time: Option<f64>,
+    /// Output spacing, s.
+    #[arg(long, default_value_t = 1e-4)]
+    output_step: f64,
+    /// One JSON document on stdout (with the curves).
+    #[arg(long)]
+    json: bool,
+    /// Write curves.csv and transient.json into this folder.
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Write the displacement field over time as VTU files plus a `.pvd` collection
+    /// (ParaView plays it) into this folder: DIR/u_NNNN.vtu, DIR/u.pvd. Reduced runs are
+    /// expanded with their basis, u = Φ q.
+    #[arg(long)]
+    vtu: Option<PathBuf>,
+    /// `--vtu`: about this many frames (every k-th output, k = outputs / N).
+    #[arg(long, default_value_t = 100)]
+    vtu_frames: usize,
+}
+
+/// What `--model` names: the full FE model, the POD of a full-FE training run, a reduced model
+/// exported by `jointrom export`, or a basis kind.
+enum ModelChoice {
+    Full,
+    Pod,
+    File(PathBuf),
+    Basis(BasisKind),
+}
+
+impl ModelChoice {
+    fn parse(name: &str) -> Result<ModelChoice, Error> {
+        Ok(match name {
+            "full" => ModelChoice::Full,
+            "pod" => ModelChoice::Pod,
+            _ if name.starts_with("file:") => {
+                ModelChoice::File(PathBuf::from(&name["file:".len()..]))
+            }
+            _ => ModelChoice::Basis(
+                BasisKind::from_name(name)
+                    .map_err(|e| Error::Invalid(format!("--model: {e} (or full, pod)")))?,
+            ),
+        })
+    }
+}
+
+/// Kept states: (time in s, state).
+type Frames = Vec<(f64, Vec<f64>)>;
+
+/// A finished run: the result, its size, g, the POD training run (`--model pod`) and the kept
+/// states in physical DOF (reduced states are expanded with Φ).
+struct Outcome {
+    res: Run,
+    basis_size: usize,
+    g: Option<usize>,
+    training: Option<Value>,
+    frames: Frames,
+}
+
+pub fn run(a: TransientArgs) -> Result<(), Error> {
+    let opts = transient_options(&a)?;
+    let model = Model::from_case_name(&a.case)?;
+    let vtu_every = vtu_every(&a, &opts, &model)?;
+    let t0 = Instant::now();
+    let mut o = run_model(&a, &model, &opts, vtu_every)?;
+    let total_s = t0.elapsed().as_secs_f64();
+    let c = &o.res.curves;
+    let doc = json!({
+        "case": model.name,
+        "model": a.model,
+        "basis_size": o.basis_size,
+        "g": o.g,
+        "options": opts,
+        "stats": o.res.stats,
+        "events": o.res.events,
+        "wall_s": o.res.wall_s,
+        "cpu_s": o.res.cpu_s,
+        "total_s": total_s,
+        "curves": c,
+        "energy_balance": c.balance(),
+        "training": o.training,
+    });
+    if let Some(dir) = &a.vtu {
+        let (times, states): (Vec<f64>, Vec<Vec<f64>>) =
+            std::mem::take(&mut o.frames).into_iter().unzip();
+        let pvd = jointrom::report::vtu::write_series(&model, "u", &times, &states, dir)?;
+        eprintln!("{} frames → {}", times.len(), pvd.display());
+    }
+    if let Some(dir) = &a.out {
+        write_outputs(dir, &doc, c)?;
+    }
+    if a.json {
+        print_json(&doc);
+    } else {
+        print_summary(&a, &model, &o, total_s);
+    }
+    Ok(())
+}
+
+/// The options of a `transient` run from its flags (errors name the flag).
+fn transient_options(a: &TransientArgs) -> Result<TransientOptions, Error> {
+    let mut o = TransientOptions::default();
+    o.ode.iteration = match a.iteration {
+        IterationArg::Newton => Iteration::Newton {
+            linear: NewtonLinear::Problem,
+        },
+        IterationArg::Functional => Iteration::Functional { anderson: 0 },
+    };
+    o.problem.friction = a.friction.is_on();
+    o.problem.events = a.events.is_on();
+    if let Some(r) = a.rtol {
+        o.ode.rtol = positive("rtol", r)?;
+    }
+    if let Some(r) = a.atol {
+        o.ode.atol = positive("atol", r)?;
+    }
+    if let Some(v) = a.velocity_scale {
+        o.problem.velocity_scale = positive("velocity-scale", v)?;
+    }
+    if let Some(k) = a.max_order {
+        if !(1..=5).contains(&k) {
+            return Err(Error::Invalid(format!(
+                "--max-order must be 1..=5 (BDF), got {k}"
+            )));
+        }
+        o.ode.max_order = k;
+    }
+    if let Some(s) = a.stab_lim_det {
+        o.ode.stab_lim_det = s.is_on();
+    }
+    if let Some(t) = a.end_time {
+        o.end_time = Some(positive("end-time", t)?);
+    }
+    o.output_step = positive("output-step", a.output_step)?;
+    Ok(o)
+}
+
+/// `--vtu`: every how many outputs a frame is kept (`None` without `--vtu`).
+fn vtu_every(
+    a: &TransientArgs,
+    opts: &TransientOptions,
+    model: &Model,
+) -> Result<Option<usize>, Error> {
+    match &a.vtu {
+        None => Ok(None),
+        Some(_) if a.vtu_frames == 0 => {
+            Err(Error::Invalid("--vtu-frames must be at least 1".into()))
+        }
+        Some(_) => {
+            let end = opts.end_time.unwrap_or(model.end_time);
+            let outputs = (end / opts.output_step).ceil().max(1.0) as usize + 1;
+            Ok(Some((outputs / a.vtu_frames).max(1)))
+        }
+    }
+}
+
+fn train_end_error() -> Error {
+    Error::Invalid("--train-end applies to --model pod only".into())
+}
+
+/// Runs the model `--model` names.
+fn run_model(
+    a: &TransientArgs,
+    model: &Model,
+    opts: &TransientOptions,
+    vtu_every: Option<usize>,
+) -> Result<Outcome, Error> {
+    let choice = match ModelChoice::parse(&a.model) {
+        Err(_) | Ok(ModelChoice::Basis(_)) if a.train_end.is_some() => {
+            return Err(train_end_error())
+        }
+        c => c?,
+    };
+    match choice {
+        ModelChoice::Full => {
+            if a.g.is_some() {
+                return Err(Error::Invalid(
+                    "--g applies to reduced models, not --model full".into(),
+                ));
+            }
+            if a.train_end.is_some() {
+                return Err(train_end_error());
+            }
+            let (res, frames) =
+                run_keeping(FullSystem::new(model)?, &Scene::of(model), opts, vtu_every)?;
+            Ok(Outcome {
+                res,
+                basis_size: model.dofs(),
+                g: None,
+                training: None,
+                frames,
+            })
+        }
+        ModelChoice::Pod => run_pod(a, model, opts, vtu_every),
+        ModelChoice::File(path) => run_file(a, &path, opts),
+        ModelChoice::Basis(kind) => {
+            let basis = build_basis(
+                model,
+                kind,
+                &BasisOptions {
+                    g: a.g,
+                    nu: a.nu,
+                    ..Default::default()
+                },
+            )?;
+            run_reduced(model, basis.phi, basis.g, None, opts, vtu_every)
+        }
+    }
+}
+
+/// Paper Section 5.2: the POD of displacement snapshots of a full-FE run (here over
+/// [0, train_end] with the same options), Euclidean, added to Craig–Bampton.
+fn run_pod(
+    a: &TransientArgs,
+    model: &Model,
+    opts: &TransientOptions,
+    vtu_every: Option<usize>,
+) -> Result<Outcome, Error> {
+    let train_end = match a.train_end {
+        Some(t) => positive("train-end", t)?,
+        None => opts.end_time.unwrap_or(model.end_time),
+    };
+    if a.snapshots < 2 {
+        return Err(Error::Invalid(format!(
+            "--snapshots must be at least 2, got {}",
+            a.snapshots
+        )));
+    }
+    let train_opts = TransientOptions {
+        end_time: Some(train_end),
+        ..opts.clone()
+    };
+    let outputs = (train_end / opts.output_step).ceil().max(1.0) as usize + 1;
+    let every = (outputs / a.snapshots).max(1);
+    let mut states: Vec<Vec<f64>> = Vec::new();
+    let mut k = 0usize;
+    let train = integrate(
+        FullSystem::new(model)?,
+        &Scene::of(model),
+        &train_opts,
+        |_, q| {
+            if k % every == 0 {
+                states.push(q.to_vec());
+            }
+            k += 1;
+        },
+    )
+    .finished()?;
+    let n = model.dofs();
+    let y = faer::Mat::from_fn(n, states.len(), |r, c| states[c][r]);
+    let basis = snapshot_basis(
+        model,
+        y.as_ref(),
+        None,
+        &BasisOptions {
+            g: a.g,
+            nu: a.nu,
+            ..Default::default()
+        },
+    )?;
+    let training = json!({
+        "end_time": train_end,
+        "snapshots": states.len(),
+        "wall_s": train.wall_s,
+        "cpu_s": train.cpu_s,
+        "steps": train.stats.steps,
+        "w": basis.w,
+    });
+    run_reduced(model, basis.phi, basis.g, Some(training), opts, vtu_every)
+}
+
+/// A reduced model exported by `jointrom export` (schema jointrom-rom v1).
+fn run_file(a: &TransientArgs, path: &Path, opts: &TransientOptions) -> Result<Outcome, Error> {
+    if a.g.is_some() || a.train_end.is_some() {
+        return Err(Error::Invalid(
+            "--g and --train-end do not apply to --model file:PATH".into(),
+        ));
+    }
+    if a.vtu.is_some() {
+        return Err(Error::Invalid(
+            "--vtu needs the basis Φ, which an exported reduced model does not carry; \
+             run the basis by name instead (e.g. --model tvd)"
+                .into(),
+        ));
+    }
+    let f = export::RomFile::read(path)?;
+    Ok(Outcome {
+        res: driver::run(f.system()?, &f.scene(), opts)?,
+        basis_size: f.dimension,
+        g: Some(f.basis.g),
+        training: None,
+        frames: Vec::new(),
+    })
+}
+
+/// The run of the reduced model on the basis `phi` (g added vectors).
+fn run_reduced(
+    model: &Model,
+    phi: faer::Mat<f64>,
+    g: usize,
+    training: Option<Value>,
+    opts: &TransientOptions,
+    vtu_every: Option<usize>,
+) -> Result<Outcome, Error> {
+    let rom = ReducedSystem::new(model, phi)?;
+    let basis_size = rom.dim();
+    let phi = rom.phi.clone();
+    let (res, kept) = run_keeping(rom, &Scene::of(model), opts, vtu_every)?;
+    Ok(Outcome {
+        res,
+        basis_size,
+        g: Some(g),
+        training,
+        frames: match phi {
+            Some(phi) if !kept.is_empty() => expand_frames(&phi, kept),
+            _ => kept,
+        },
+    })
+}
+
+/// A transient run that keeps every `every`-th state (with its time) when `every` is given.
+fn run_keeping<S: SecondOrderSystem>(
+    sys: S,
+    scene: &Scene,
+    opts: &TransientOptions,
+    every: Option<usize>,
+) -> Result<(Run, Frames), Error> {
+    let Some(every) = every else {
+        return Ok((driver::run(sys, scene, opts)?, Vec::new()));
+    };
+    let mut frames = Vec::new();
+    let mut k = 0usize;
+    let res = integrate(sys, scene, opts, |t, q| {
+        if k % every == 0 {
+            frames.push((t, q.to_vec()));
+        }
+        k += 1;
+    })
+    .finished()?;
+    Ok((res, frames))
+}
+
+/// Reduced states `q` (r) to physical DOF `Φ q` (n): one product `Φ [q_1 … q_f]`.
+fn expand_frames(phi: &faer::Mat<f64>, kept: Frames) -> Frames {
+    let q = faer::Mat::from_fn(phi.ncols(), kept.len(), |i, j| kept[j].1[i]);
+    let u = phi * &q;
+    kept.iter()
+        .enumerate()
+        .map(|(j, &(t, _))| (t, u.col(j).iter().copied().collect()))
+        .collect()
+}
+
+/// `--out DIR`: DIR/transient.json (the JSON document) and DIR/curves.csv.
+fn write_outputs(dir: &Path, doc: &Value, c: &Curves) -> Result<(), Error> {
+    create_dir(dir)?;
+    write_file(
+        &dir.join("transient.json"),
+        serde_json::to_string(doc).expect("JSON values serialise"),
+    )?;
+    let mut csv = String::from(
+        "t_s,contact_force_norm_N,friction_force_norm_N,master_uy_mm,kinetic_Nmm,strain_Nmm,pair_Nmm,external_work_Nmm,dissipated_Nmm\n",
+    );
+    for i in 0..c.t.len() {
+        csv.push_str(&format!(
+            "{:.8e},{:.10e},{:.10e},{:.10e},{:.10e},{:.10e},{:.10e},{:.10e},{:.10e}\n",
+            c.t[i],
+            c.contact_force_norm[i],
+            c.friction_force_norm[i],
+            c.master_uy[i],
+            c.kinetic[i],
+            c.strain[i],
+            c.pair[i],
+            c.external_work[i],
+            c.dissipated[i]
+        ));
+    }
+    write_file(&dir.join("curves.csv"), csv)
+}
+
+/// The text summary of a run.
+fn print_summary(a: &TransientArgs, model: &Model, o: &Outcome, total_s: f64) {
+    let (res, c) = (&o.res, &o.res.curves);
+    let s = &res.stats;
+    println!(
+        "{} — model {} (n = {}{}), friction {}, events {}",
+        model.name,
+        a.model,
+        o.basis_size,
+        o.g.map(|g| format!(", g = {g}")).unwrap_or_default(),
+        a.friction.name(),
+        a.events.name()
+    );
+    println!(
+        "t_end {:.4e} s: {} steps, {} RHS, {} nonlinear iterations ({} conv. failures), {} error-test failures, {} setups, last order {}, last h {:.2e} s",
+        c.t.last().copied().unwrap_or(0.0),
+        s.steps,
+        s.rhs_evals,
+        s.nonlinear_iterations,
+        s.nonlinear_conv_failures,
+        s.error_test_failures,
+        s.linear_setups,
+        s.last_order,
+        s.last_step
+    );
+    println!(
+        "wall {:.3} s, cpu {:.2} s (total incl. model {:.3} s)",
+        res.wall_s, res.cpu_s, total_s
+    );
+    if let Some(i) = c.t.len().checked_sub(1) {
+        println!(
+            "final: |f_c| {:.6e} N, |f_R| {:.6e} N, master uy {:.6e} mm",
+            c.contact_force_norm[i], c.friction_force_norm[i], c.master_uy[i]
+        );
+    }
+}

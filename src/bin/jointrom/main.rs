@@ -1,0 +1,36 @@
+//! `jointrom` command line: a thin layer over the library. The subcommands are defined in
+//! [`cli`], each one runs in its own module of [`commands`].
+
+mod cli;
+mod commands;
+mod common;
+
+use std::process::ExitCode;
+
+use clap::Parser;
+
+use cli::Cli;
+
+fn main() -> ExitCode {
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => {
+            let args: Vec<String> = std::env::args_os()
+                .map(|s| s.to_string_lossy().into_owned())
+                .collect();
+            match cli::legacy_value_error(&e, &args) {
+                Some(err) => return fail(&err),
+                None => e.exit(),
+            }
+        }
+    };
+    match commands::run(cli.command) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => fail(&e),
+    }
+}
+
+fn fail(e: &jointrom::Error) -> ExitCode {
+    eprintln!("jointrom: error: {e}");
+    ExitCode::FAILURE
+}
