@@ -1,366 +1,16 @@
-//! The main job, `jointrom run`: build the model, choose the reduced model's size a priori, run
-//! it against the full FE model and write a report a structural-dynamics engineer reads.
-//!
-//! One call of [`run_report`] measures everything it shows, in the same process on the same
-//! machine:
-//!
-//! 1. the static convergence study ([`crate::studies::convergence`]: ‖f_c‖ of every basis kind against the
-//!    number g of added vectors, and the POD energy ratios w(g) of eq. (26) — the paper's Figs.
-//!    7, 8, 15, 16, 19);
-//! 2. the full FE transient with friction (BDF + Newton with the structured sparse solve), the
-//!    reference of every error below;
-//! 3. reduced transients: TVD with g = 0, the paper's sizes (friction bar 10, 25; multilayer
-//!    sheet 20, 60) and the a-priori g (smallest g with w(g) ≥ the threshold, eq. 26), plus the
-//!    competitors (plain POD, modes only, Joint Interface Modes, all joint DOF) and functional
-//!    (fixed-point) iteration next to Newton; every run under a wall-clock budget, so a method
-//!    that does not finish is a measured failure, not a hang;
-//! 4. charts: ‖f_c‖(t), ‖f_R‖(t), master u_y(t) (Figs. 9, 11, 12, 17, 18), and speed against
-//!    accuracy — integration CPU time (log) against the relative L2 error of ‖f_c‖(t)
-//!
-//!    ```text
-//!    e = sqrt( Σ_k (‖f_c‖_ROM(t_k) − ‖f_c‖_full(t_k))² / Σ_k ‖f_c‖_full(t_k)² )
-//!    ```
-//!
-//!    over the output times t_k — with the full run's CPU time and the paper's CPU ratios (Sections
-//!    4.1.5, 4.2.4) as vertical anchors and the Pareto front (points no other point beats in both
-//!    time and error) drawn through;
-//! 5. the first joint modes as VTU files and a picture (`shapes/`, [`crate::report::shapes`]);
-//!    the stored stability map of the case (`results/stability/CASE`, made by
-//!    `jointrom stability CASE`; 17 min, too long to repeat here), copied in when present;
-//! 6. `report.md` (the charts as PNG, SVG alongside) and `results.json` with every number.
-//!
-//! `quick` shortens the transient window to 0.02 s and the study to g ≤ 20 (< 20 s in all).
+//! The main job's report, `jointrom run` (steps 4–6 of [`crate::studies::main_job`]): the
+//! study's charts, ‖f_c‖(t), ‖f_R‖(t), master u_y(t) and speed against accuracy, the first joint
+//! modes (VTU and a picture), the stored stability map, `report.md` and `results.json`.
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use serde::Serialize;
-
 use crate::error::Error;
-use crate::integrate::problem::{Iteration, OdeOptions, OdeStats};
-use crate::integrate::{integrate, ProblemOptions, Run, RunStatus, Scene, TransientOptions};
 use crate::model::Model;
-use crate::reduction::{build_basis, BasisKind, BasisOptions};
+use crate::reduction::BasisOptions;
 use crate::report::chart::{LegendPosition, LineChart, Reference, Series};
-use crate::studies::convergence::{self as study, StudyOptions};
-use crate::studies::stability::{relative_l2, Outcome};
-use crate::system::{FullSystem, ReducedSystem, SecondOrderSystem};
-
-/// Options of [`run_report`]. Defaults: the full job (case end time, study g ≤ 60, functional
-/// iteration runs included), budgets 60 s per reduced run and 600 s for the full run, progress
-/// reported, the stored stability maps under `results/stability`.
-#[derive(Clone, Debug)]
-pub struct ReportOptions {
-    /// Short variant: 0.02 s window, study g ≤ 20, fewer runs.
-    pub quick: bool,
-    /// Wall-clock budget of one reduced run, s.
-    pub rom_budget_s: f64,
-    /// Wall-clock budget of the full FE Newton run, s.
-    pub full_budget_s: f64,
-    /// Wall-clock budget of the full FE run with functional iteration, s (it is expected to fail:
-    /// the budget bounds what that failure costs; at most 2 s when `quick`).
-    pub full_functional_budget_s: f64,
-    /// Report progress to the observer of [`run_report_observed`] (`jointrom run` draws it as a
-    /// bar when stderr is a terminal).
-    pub progress: bool,
-    /// Folder holding stored stability maps (`<dir>/<case>/stability_status.png`).
-    pub stability_dir: PathBuf,
-}
-
-impl Default for ReportOptions {
-    fn default() -> Self {
-        ReportOptions {
-            quick: false,
-            rom_budget_s: 60.0,
-            full_budget_s: 600.0,
-            full_functional_budget_s: 5.0,
-            progress: true,
-            stability_dir: PathBuf::from("results/stability"),
-        }
-    }
-}
-
-/// One transient run of the report.
-#[derive(Clone, Debug, Serialize)]
-pub struct RunRecord {
-    /// `full` or a basis kind name (`tvd`, `tvd-plain`, `modes`, `jim`, `alldof`).
-    pub model: String,
-    /// Added vectors g (reduced models).
-    pub g: Option<usize>,
-    /// Coordinates (full: DOF; reduced: basis size r).
-    pub size: usize,
-    /// `newton` or `functional`.
-    pub iteration: String,
-    /// `ok`, `budget` or the CVODE flag.
-    pub status: RunStatus,
-    /// Failure message.
-    pub message: Option<String>,
-    /// Time reached, s.
-    pub t_reached: f64,
-    /// Basis (or model) construction time, s.
-    pub build_s: f64,
-    /// Integration wall time, s.
-    pub wall_s: f64,
-    /// Integration CPU time, s.
-    pub cpu_s: f64,
-    /// Solver statistics.
-    pub stats: OdeStats,
-    /// Relative L2 error of ‖f_c‖(t) against the full run (`None`: not comparable).
-    pub error_fc: Option<f64>,
-    /// Relative L2 error of master u_y(t).
-    pub error_uy: Option<f64>,
-    /// Relative L2 error of ‖f_R‖(t).
-    pub error_fr: Option<f64>,
-    /// Full-run integration CPU time over this run's (speed-up).
-    pub speedup: Option<f64>,
-    /// This run's CPU time in % of the full run's (the paper's measure).
-    pub cpu_percent: Option<f64>,
-    /// On the Pareto front of (CPU time, error of ‖f_c‖).
-    pub pareto: bool,
-    /// Output times, s.
-    #[serde(skip)]
-    pub t: Vec<f64>,
-    /// ‖f_c‖(t), N.
-    #[serde(skip)]
-    pub fc: Vec<f64>,
-    /// ‖f_R‖(t), N.
-    #[serde(skip)]
-    pub fr: Vec<f64>,
-    /// Master u_y(t), mm.
-    #[serde(skip)]
-    pub uy: Vec<f64>,
-}
-
-/// The paper's CPU-time ratio of a reduced run to the full run.
-#[derive(Clone, Debug, Serialize)]
-pub struct PaperAnchor {
-    /// g.
-    pub g: usize,
-    /// CPU time in % of the full FE model.
-    pub cpu_percent: f64,
-}
-
-/// Everything [`run_report`] measured (written as `results.json`).
-#[derive(Clone, Debug, Serialize)]
-pub struct Report {
-    /// Case name.
-    pub case: String,
-    /// The CASE argument that reproduces the model: a built-in name, a case file or a matrix map.
-    pub source: String,
-    /// The command line.
-    pub command_line: Vec<String>,
-    /// Quick variant.
-    pub quick: bool,
-    /// Model DOF.
-    pub dofs: usize,
-    /// Joint pairs.
-    pub pairs: usize,
-    /// Transient window, s.
-    pub end_time: f64,
-    /// w threshold of the a-priori choice.
-    pub threshold: f64,
-    /// The a-priori g (TVD, K-weighted POD).
-    pub g_chosen: usize,
-    /// w(g) of the K-weighted POD, g = 1, 2, ...
-    pub w: Vec<f64>,
-    /// w(g) of the plain POD.
-    pub w_plain: Vec<f64>,
-    /// The static study (summary per basis kind is in `study.json` as well).
-    pub study: study::Study,
-    /// The transient runs, full first.
-    pub runs: Vec<RunRecord>,
-    /// The paper's CPU ratios for this case (empty for other cases).
-    pub paper_anchors: Vec<PaperAnchor>,
-    /// Files written (relative to the report folder).
-    pub files: Vec<String>,
-    /// Whole job, s.
-    pub total_s: f64,
-    /// Further fields given by the caller (model summary, modes, linear statics).
-    #[serde(flatten)]
-    pub extra: serde_json::Map<String, serde_json::Value>,
-}
-
-/// The paper's g values and CPU ratios (Sections 4.1.5 and 4.2.4).
-fn paper_anchors(case: &str) -> Vec<PaperAnchor> {
-    let a = |g, p| PaperAnchor { g, cpu_percent: p };
-    match case {
-        "friction_bar" => vec![a(0, 0.07), a(10, 0.12), a(25, 0.25)],
-        "multilayer_sheet" => vec![a(0, 0.42), a(20, 0.44), a(60, 0.49)],
-        _ => Vec::new(),
-    }
-}
-
-/// One planned reduced run.
-#[derive(Clone, Copy, Debug, PartialEq)]
-struct Plan {
-    kind: BasisKind,
-    g: usize,
-    functional: bool,
-}
-
-fn plans(case: &str, g_chosen: usize, pairs: usize, quick: bool) -> Vec<Plan> {
-    let paper: Vec<usize> = match case {
-        "multilayer_sheet" => vec![20, 60],
-        _ => vec![10, 25],
-    };
-    let mut tvd_g = vec![0, g_chosen];
-    tvd_g.extend(&paper);
-    if !quick {
-        tvd_g.extend([5, 40, pairs.saturating_sub(6)]);
-    }
-    tvd_g.retain(|&g| g <= pairs);
-    tvd_g.sort_unstable();
-    tvd_g.dedup();
-    let mut out: Vec<Plan> = tvd_g
-        .iter()
-        .map(|&g| Plan {
-            kind: BasisKind::Tvd,
-            g,
-            functional: false,
-        })
-        .collect();
-    let competitor_g: Vec<usize> = if quick { vec![paper[0]] } else { paper.clone() };
-    for kind in [BasisKind::TvdPlain, BasisKind::Modes, BasisKind::Jim] {
-        for &g in &competitor_g {
-            out.push(Plan {
-                kind,
-                g,
-                functional: false,
-            });
-        }
-    }
-    out.push(Plan {
-        kind: BasisKind::AllDof,
-        g: pairs,
-        functional: false,
-    });
-    let functional_g: Vec<usize> = if quick {
-        vec![g_chosen]
-    } else {
-        vec![0, g_chosen]
-    };
-    for g in functional_g {
-        out.push(Plan {
-            kind: BasisKind::Tvd,
-            g,
-            functional: true,
-        });
-    }
-    out
-}
-
-fn record(
-    model: &str,
-    g: Option<usize>,
-    size: usize,
-    functional: bool,
-    build_s: f64,
-    o: Outcome,
-) -> RunRecord {
-    RunRecord {
-        model: model.into(),
-        g,
-        size,
-        iteration: if functional { "functional" } else { "newton" }.into(),
-        status: o.status,
-        message: o.message,
-        t_reached: o.t_reached,
-        build_s,
-        wall_s: o.wall_s,
-        cpu_s: o.cpu_s,
-        stats: o.stats,
-        error_fc: None,
-        error_uy: None,
-        error_fr: None,
-        speedup: None,
-        cpu_percent: None,
-        pareto: false,
-        t: o.t,
-        fc: o.fc,
-        fr: o.fr,
-        uy: o.uy,
-    }
-}
-
-/// One run of the report through the driver, from rest over `span` = (end, output step) s,
-/// under a wall-clock budget (s); a system that could not be built is the run's status.
-fn budgeted<S: SecondOrderSystem>(
-    sys: Result<S, Error>,
-    model: &Model,
-    problem: &ProblemOptions,
-    ode: OdeOptions,
-    span: (f64, f64),
-    budget_s: f64,
-) -> Outcome {
-    let opts = TransientOptions {
-        ode,
-        problem: *problem,
-        output_step: span.1,
-        end_time: Some(span.0),
-        budget_s: Some(budget_s),
-    };
-    Outcome::of_run(match sys {
-        Ok(s) => integrate(s, &Scene::of(model), &opts, |_, _| {}),
-        Err(e) => Run::failed(e),
-    })
-}
-
-fn ode_options(functional: bool) -> OdeOptions {
-    let mut ode = TransientOptions::default().ode;
-    if functional {
-        ode.iteration = Iteration::Functional { anderson: 0 };
-    }
-    ode
-}
-
-/// Where the main job stands, as [`run_report_observed`] reports it: the stage now running, the
-/// steps done and the steps in all (known once the static study has chosen g; 1 before).
-#[derive(Clone, Debug, Default, PartialEq, Eq)]
-pub struct Progress {
-    /// What runs now (e.g. `full FE model, Newton`).
-    pub stage: String,
-    /// Steps done.
-    pub position: u64,
-    /// Steps in all.
-    pub total: u64,
-    /// The runs are over (a progress bar is cleared).
-    pub finished: bool,
-}
-
-/// Sends every change of a [`Progress`] to an observer (nothing when `on` is false).
-struct Tracker<'a> {
-    on: bool,
-    state: Progress,
-    observer: &'a mut dyn FnMut(&Progress),
-}
-
-impl Tracker<'_> {
-    fn notify(&mut self) {
-        if self.on {
-            (self.observer)(&self.state);
-        }
-    }
-
-    fn set_message(&mut self, stage: impl Into<String>) {
-        self.state.stage = stage.into();
-        self.notify();
-    }
-
-    fn set_length(&mut self, total: u64) {
-        self.state.total = total;
-        self.notify();
-    }
-
-    fn inc(&mut self, steps: u64) {
-        self.state.position += steps;
-        self.notify();
-    }
-
-    fn finish_and_clear(&mut self) {
-        self.state.finished = true;
-        self.notify();
-    }
-}
+use crate::studies::convergence as study;
+use crate::studies::main_job::{run_main_job, Progress, Report, ReportOptions, RunRecord};
 
 /// Runs the main job on `model` and writes the report into `dir` (created if missing);
 /// `extra` fields are added to `results.json`. No progress is reported (see
@@ -394,194 +44,39 @@ pub fn run_report_observed(
         file: dir.to_path_buf(),
         source: e,
     })?;
-    let case = model.name.clone();
-    let end_time = if opts.quick {
-        model.end_time.min(0.02)
-    } else {
-        model.end_time
-    };
-    let output_step = 1e-4;
-    let problem = ProblemOptions::default();
+    let mut report = run_main_job(model, opts, extra, observer)?;
+    write_report(model, dir, opts, &mut report, t_all)?;
+    Ok(report)
+}
 
-    let mut bar = Tracker {
-        on: opts.progress,
-        state: Progress {
-            total: 1,
-            ..Progress::default()
-        },
-        observer,
-    };
-
-    // 1. Static study and the a-priori g.
-    bar.set_message("static convergence study");
-    let study_opts = StudyOptions {
-        max_g: if opts.quick { 20 } else { 60 },
-        ..StudyOptions::default()
-    };
-    let st = study::run_study(model, &study_opts)?;
-    let energy = |name: &str| st.energy.iter().find(|e| e.name == name);
-    let tvd_energy = energy("tvd")
-        .ok_or_else(|| Error::Invalid("the study has no K-weighted TVD energy curve".into()))?;
-    let g_chosen = tvd_energy.g_threshold;
-    let w = tvd_energy.w.clone();
-    let w_plain = energy("tvd-plain").map(|e| e.w.clone()).unwrap_or_default();
-    let mut files = Vec::new();
+/// Writes the report of a finished main job into `dir`: the charts, the joint modes, the stored
+/// stability map, `results.json` and `report.md`; adds the files written to `report.files` and
+/// sets `report.total_s` from `t_all` (the job's start).
+///
+/// # Errors
+/// Charts or files that cannot be written.
+pub fn write_report(
+    model: &Model,
+    dir: &Path,
+    opts: &ReportOptions,
+    report: &mut Report,
+    t_all: Instant,
+) -> Result<(), Error> {
+    let case = report.case.clone();
+    // The static study's charts.
     let study_dir = dir.join("study");
     std::fs::create_dir_all(&study_dir).map_err(|e| Error::Io {
         file: study_dir.clone(),
         source: e,
     })?;
-    for f in crate::report::convergence::write_charts(&st, &study_dir)? {
-        files.push(relative(dir, &f));
-    }
-
-    let pairs = model.joint.pairs();
-    let plan = plans(&case, g_chosen, pairs, opts.quick);
-    bar.set_length(plan.len() as u64 + 3);
-    bar.inc(1);
-
-    // 2. The full reference.
-    bar.set_message("full FE model, Newton");
-    let t0 = Instant::now();
-    let full_sys = FullSystem::new(model);
-    let build_full = t0.elapsed().as_secs_f64();
-    let full = budgeted(
-        full_sys,
-        model,
-        &problem,
-        ode_options(false),
-        (end_time, output_step),
-        opts.full_budget_s,
-    );
-    if !full.ok() {
-        return Err(Error::Invalid(format!(
-            "the full FE reference run failed at t = {} s ({}): {}",
-            full.t_reached,
-            full.status,
-            full.message.clone().unwrap_or_default()
-        )));
-    }
-    let mut runs = vec![record("full", None, model.dofs(), false, build_full, full)];
-    bar.inc(1);
-    bar.set_message("full FE model, functional iteration");
-    let full_fun = budgeted(
-        FullSystem::new(model),
-        model,
-        &problem,
-        ode_options(true),
-        (end_time, output_step),
-        if opts.quick {
-            opts.full_functional_budget_s.min(2.0)
-        } else {
-            opts.full_functional_budget_s
-        },
-    );
-    runs.push(record(
-        "full",
-        None,
-        model.dofs(),
-        true,
-        build_full,
-        full_fun,
-    ));
-    bar.inc(1);
-
-    // 3. Reduced runs.
-    for p in &plan {
-        bar.set_message(format!(
-            "{} g = {} ({})",
-            p.kind.name(),
-            p.g,
-            if p.functional { "functional" } else { "Newton" }
-        ));
-        let t0 = Instant::now();
-        let basis = build_basis(
-            model,
-            p.kind,
-            &BasisOptions {
-                g: Some(p.g),
-                ..BasisOptions::default()
-            },
-        )?;
-        let g_used = basis.g;
-        let rm = ReducedSystem::new(model, basis.phi)?;
-        let build_s = t0.elapsed().as_secs_f64();
-        let dim = rm.dim();
-        let o = budgeted(
-            Ok(rm),
-            model,
-            &problem,
-            ode_options(p.functional),
-            (end_time, output_step),
-            opts.rom_budget_s,
-        );
-        runs.push(record(
-            p.kind.name(),
-            Some(g_used),
-            dim,
-            p.functional,
-            build_s,
-            o,
-        ));
-        bar.inc(1);
-    }
-    bar.finish_and_clear();
-
-    // Errors, speed-ups, Pareto front.
-    let (t_ref, fc_ref, fr_ref, uy_ref, cpu_ref) = {
-        let f = &runs[0];
-        (
-            f.t.clone(),
-            f.fc.clone(),
-            f.fr.clone(),
-            f.uy.clone(),
-            f.cpu_s,
-        )
-    };
-    for r in runs.iter_mut().skip(1) {
-        if !r.status.finished() {
-            continue;
-        }
-        r.error_fc = relative_l2(&r.t, &r.fc, &t_ref, &fc_ref);
-        r.error_uy = relative_l2(&r.t, &r.uy, &t_ref, &uy_ref);
-        r.error_fr = relative_l2(&r.t, &r.fr, &t_ref, &fr_ref);
-        if r.cpu_s > 0.0 && cpu_ref.is_finite() {
-            r.speedup = Some(cpu_ref / r.cpu_s);
-            r.cpu_percent = Some(100.0 * r.cpu_s / cpu_ref);
-        }
-    }
-    mark_pareto(&mut runs);
-
-    let anchors = paper_anchors(&case);
-    let mut report = Report {
-        case: case.clone(),
-        source: model
-            .source
-            .strip_prefix("builtin:")
-            .unwrap_or(&model.source)
-            .to_string(),
-        command_line: std::env::args().collect(),
-        quick: opts.quick,
-        dofs: model.dofs(),
-        pairs,
-        end_time,
-        threshold: st.threshold,
-        g_chosen,
-        w,
-        w_plain,
-        study: st,
-        runs,
-        paper_anchors: anchors,
-        files,
-        total_s: 0.0,
-        extra,
-    };
-
-    // 4. Charts.
-    for f in time_charts(&report, dir)? {
+    for f in crate::report::convergence::write_charts(&report.study, &study_dir)? {
         report.files.push(relative(dir, &f));
     }
-    for f in speed_chart(&report, dir)? {
+    // 4. Charts.
+    for f in time_charts(report, dir)? {
+        report.files.push(relative(dir, &f));
+    }
+    for f in speed_chart(report, dir)? {
         report.files.push(relative(dir, &f));
     }
     // Joint modes: VTU for ParaView and the picture of the first four.
@@ -613,13 +108,13 @@ pub fn run_report_observed(
     let json = dir.join("results.json");
     write(
         &json,
-        &serde_json::to_string_pretty(&report).expect("the report serialises"),
+        &serde_json::to_string_pretty(report).expect("the report serialises"),
     )?;
     let md = dir.join("report.md");
-    write(&md, &markdown(&report, &stab, !stability_files.is_empty()))?;
+    write(&md, &markdown(report, &stab, !stability_files.is_empty()))?;
     report.files.push("results.json".into());
     report.files.push("report.md".into());
-    Ok(report)
+    Ok(())
 }
 
 fn write(path: &Path, text: &str) -> Result<(), Error> {
@@ -631,25 +126,6 @@ fn write(path: &Path, text: &str) -> Result<(), Error> {
 
 fn relative(dir: &Path, f: &Path) -> String {
     f.strip_prefix(dir).unwrap_or(f).display().to_string()
-}
-
-/// Marks the runs no other run beats in both CPU time and ‖f_c‖ error (finished runs with an
-/// error only).
-fn mark_pareto(runs: &mut [RunRecord]) {
-    let pts: Vec<Option<(f64, f64)>> = runs
-        .iter()
-        .map(|r| match (r.status.finished(), r.error_fc) {
-            (true, Some(e)) if r.cpu_s.is_finite() && e.is_finite() => Some((r.cpu_s, e)),
-            _ => None,
-        })
-        .collect();
-    for i in 0..runs.len() {
-        let Some((ci, ei)) = pts[i] else { continue };
-        let dominated = pts.iter().enumerate().any(|(j, p)| {
-            j != i && p.is_some_and(|(cj, ej)| cj <= ci && ej <= ei && (cj < ci || ej < ei))
-        });
-        runs[i].pareto = !dominated;
-    }
 }
 
 /// Selects one output curve of a run.

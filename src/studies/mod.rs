@@ -2,5 +2,6 @@
 //! stability map ([`stability`]) and parameter sweeps on one reduced model ([`sweep`]).
 
 pub mod convergence;
+pub mod main_job;
 pub mod stability;
 pub mod sweep;

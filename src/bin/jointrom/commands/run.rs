@@ -8,7 +8,8 @@ use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use serde_json::json;
 
-use jointrom::report::main_job::{self as report, Progress};
+use jointrom::report::main_job as report;
+use jointrom::studies::main_job::{Progress, Report, ReportOptions};
 use jointrom::{Error, Interface, Model};
 
 use super::info::info_json;
@@ -59,7 +60,7 @@ pub fn run(a: RunArgs) -> Result<(), Error> {
         json!({"assembly": t_assembly, "modes": t_modes}),
     );
     let dir = a.out.join(&model.name);
-    let opts = report::ReportOptions {
+    let opts = ReportOptions {
         quick: a.quick,
         stability_dir: a.stability_dir,
         ..Default::default()
@@ -100,7 +101,7 @@ fn show_progress(bar: &ProgressBar, p: &Progress) {
     bar.set_message(p.stage.clone());
 }
 
-fn print_report(rep: &report::Report, dir: &Path) {
+fn print_report(rep: &Report, dir: &Path) {
     println!(
         "{} — {} DOF, {} joint pairs; a-priori g = {} (w ≥ {}); window {} s; job {:.1} s",
         rep.case, rep.dofs, rep.pairs, rep.g_chosen, rep.threshold, rep.end_time, rep.total_s
