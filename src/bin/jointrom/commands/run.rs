@@ -96,9 +96,9 @@ fn show_progress(bar: &ProgressBar, p: &Progress) {
         bar.finish_and_clear();
         return;
     }
+    bar.set_message(p.stage.clone());
     bar.set_length(p.total);
     bar.set_position(p.position);
-    bar.set_message(p.stage.clone());
 }
 
 fn print_report(rep: &Report, dir: &Path) {
