@@ -10,7 +10,8 @@ use serde_json::{json, Value};
 use jointrom::integrate::problem::{Iteration, NewtonLinear};
 use jointrom::integrate::{self as driver, integrate, Curves, Run, TransientOptions};
 use jointrom::reduction::rom_file as export;
-use jointrom::reduction::{build_basis, snapshot_basis, BasisKind, BasisOptions};
+use jointrom::reduction::{build_basis, BasisKind, BasisOptions};
+use jointrom::studies::training::train_snapshot_basis;
 use jointrom::system::{FullSystem, ReducedSystem, Scene, SecondOrderSystem};
 use jointrom::{Error, Model};
 
@@ -286,52 +287,18 @@ fn run_pod(
         Some(t) => positive("train-end", t)?,
         None => opts.end_time.unwrap_or(model.end_time),
     };
-    if a.snapshots < 2 {
-        return Err(Error::Invalid(format!(
-            "--snapshots must be at least 2, got {}",
-            a.snapshots
-        )));
-    }
-    let train_opts = TransientOptions {
-        end_time: Some(train_end),
-        ..opts.clone()
-    };
-    let outputs = (train_end / opts.output_step).ceil().max(1.0) as usize + 1;
-    let every = (outputs / a.snapshots).max(1);
-    let mut states: Vec<Vec<f64>> = Vec::new();
-    let mut k = 0usize;
-    let train = integrate(
-        FullSystem::new(model)?,
-        &Scene::of(model),
-        &train_opts,
-        |_, q| {
-            if k % every == 0 {
-                states.push(q.to_vec());
-            }
-            k += 1;
-        },
-    )
-    .finished()?;
-    let n = model.dofs();
-    let y = faer::Mat::from_fn(n, states.len(), |r, c| states[c][r]);
-    let basis = snapshot_basis(
+    let (basis, training) = train_snapshot_basis(
         model,
-        y.as_ref(),
-        None,
+        opts,
+        train_end,
+        a.snapshots,
         &BasisOptions {
             g: a.g,
             nu: a.nu,
             ..Default::default()
         },
     )?;
-    let training = json!({
-        "end_time": train_end,
-        "snapshots": states.len(),
-        "wall_s": train.wall_s,
-        "cpu_s": train.cpu_s,
-        "steps": train.stats.steps,
-        "w": basis.w,
-    });
+    let training = serde_json::to_value(&training).expect("the training record serialises");
     run_reduced(model, basis.phi, basis.g, Some(training), opts, vtu_every)
 }
 
