@@ -43,7 +43,7 @@
 //! (tolerance 1e-6), cells with unknown nodes; the contact law, load and end time as in a case.
 //! An indefinite K (unsupported structure) is reported by the first factorization.
 //!
-//! [`write`] goes the other way: any model to `K.mtx`, `M.mtx` (symmetric, shortest round-trip
+//! [`write()`] goes the other way: any model to `K.mtx`, `M.mtx` (symmetric, shortest round-trip
 //! decimal, so the numbers come back bit for bit) and `model.json`. `tests/matrices.rs` exports
 //! the friction bar, reads it back and gets identical matrices, bases, statics and transients.
 

@@ -1,4 +1,4 @@
-//! Joint Interface Modes (Witteveen & Irschik 2009, reference [10] of the paper; the competitor
+//! Joint Interface Modes (Witteveen & Irschik 2009, reference \[10\] of the paper; the competitor
 //! of Witteveen & Pichler 2014, Section 5.3).
 //!
 //! "The structure is statically condensed to the DOF of the joints. This condensation leads to a
