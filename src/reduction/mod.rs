@@ -21,9 +21,9 @@
 //!    approximate the deformation energy of the TVD space) or plain, with the energy ratio
 //!    `w(g)` (eq. 26) to choose the number g of joint modes `Φ̃_T` (eq. 23 scaling).
 //!    For TVD, [`pod_tvd`] computes the same POD from the factor form `Y = K⁻¹ B_uᵀ C` as an
-//!    SVD (no `Yᵀ K Y`), resolving eigenvalues far below the Gram's round-off (≈ 1e-10 λ_max):
-//!    with all 54 (friction bar) / 92 (multilayer) POMs the reduced contact force matches the
-//!    full one to 5e-10 / 8e-11 (the Gram route with its 1e-12 cut stalled at 2e-2).
+//!    SVD (no `Yᵀ K Y`), resolving eigenvalues far below the Gram's round-off, so that with all
+//!    POMs the reduced contact force converges to the full one (the measured errors are in
+//!    `docs/measurements.md`, section `reduction`).
 //! 4. [`final_basis`]: the parts concatenated and M-orthonormalized (so `M̃ = I`), dependent
 //!    directions dropped; [`build_basis`] then rotates Φ to the reduced eigenbasis
 //!    ([`modal_rotation`]: `K̃ = diag(ω²)`, same span) unless `BasisOptions::modal` is false.

@@ -48,8 +48,9 @@
 //! double-double residuals (so `B_u Z = Zᵀ K Z` to working precision), `G = B_u Z`, C the
 //! K-normalized coefficients. [`super::pod_tvd`] computes the K-weighted POD as the SVD of
 //! `D^½ Vᵀ C` (`G = V D Vᵀ`) instead of the eigenproblem of `Yᵀ K Y`, which squares the
-//! condition number: on the friction bar the Gram route's round-off is ≈ 1e-10 λ_max, and the
-//! directions carrying the last per cent of the contact force have λ = 1e-12 … 1e-20 λ_max.
+//! condition number: the directions carrying the last per cent of the contact force have POD
+//! eigenvalues below the Gram route's round-off (measured in `docs/measurements.md`, section
+//! `reduction::tvd`).
 
 use faer::linalg::solvers::Solve;
 use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
@@ -71,7 +72,7 @@ use crate::linalg::compensated::solve_refined_steps;
 pub struct TvdOptions {
     /// Relative zero of a gap: under trial vector φ_j a pair gap with
     /// `|g_z| ≤ tol · max_pairs |g|` counts as exactly zero (eigen-solver noise is ~1e-8–1e-7
-    /// of a mode's size, NOTES). Also the relative zero of a pseudoforce column (see
+    /// of a mode's size, see [`active_pairs`]). Also the relative zero of a pseudoforce column (see
     /// [`Tvd::negligible_columns`]).
     pub tol: f64,
     /// Whether an exactly-zero gap (in the sense of `tol`) is active. `true` is the paper's
@@ -168,13 +169,9 @@ impl Tvd {
 /// exactly zero (`max |g| = 0`, e.g. an in-plane constraint mode) every gap is zero and the same
 /// rule applies: all pairs are active for both signs if `zero_gap_active`, none otherwise.
 ///
-/// What "zero" catches on the built-in cases (Craig–Bampton, ν = 10, `tol = 1e-6`): in the
-/// friction bar 136 of 16 × 54 gaps, 126 of them ≤ 1e-10 relative — the centre-line pairs under
-/// the vectors antisymmetric in z (symmetry zeros) — and the rest the weld pairs' true but tiny
-/// gaps (~1e-7 relative, the welds are very stiff); in the multilayer sheet 52 of 16 × 92, most
-/// in the 1e-8–1e-6 band. No base vector has all gaps exactly zero on either case, and the rule
-/// changes no column count (every candidate keeps some active penetrating pair); it changes the
-/// K-weighted `g(0.999)` of the friction bar from 12 (`true`) to 13 (`false`).
+/// On the built-in cases "zero" catches symmetry zeros (centre-line pairs under the vectors
+/// antisymmetric in z) and the weld pairs' true but tiny gaps; the counts, and what the rule
+/// changes, are in `docs/measurements.md`, section `reduction::tvd`.
 pub fn active_pairs(gaps: &[f64], k: f64, opts: &TvdOptions) -> Vec<bool> {
     let scale = gaps.iter().fold(0.0f64, |a, g| a.max(g.abs()));
     let zero = opts.tol * scale;
