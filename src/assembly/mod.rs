@@ -221,7 +221,7 @@ struct Scatter {
     dofs: Vec<usize>,
     /// `T_e`: element DOF × `dofs` (None when it is the identity map onto `dofs` in order).
     te: Option<Mat<f64>>,
-    /// Position in `values` of entry (dofs[a], dofs[b]) at `a * len + b`.
+    /// Position in `values` of entry `(dofs[a], dofs[b])` at `a * len + b`.
     positions: Vec<usize>,
 }
 

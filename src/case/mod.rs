@@ -108,7 +108,7 @@ pub struct Case {
     pub source: String,
 }
 
-/// Linear elastic isotropic material (see [`Material`]).
+/// Linear elastic isotropic material (see [`crate::mesh::Material`]).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct MaterialSpec {

@@ -21,8 +21,9 @@
 //!
 //! A CVODE right-hand side must be a pure function of `(t, y)`, so `s` is integrated from a rate
 //! law. The consistency form of rate-independent plasticity (`ṡ = λ e/|e|` with `λ` from
-//! `d|p_t|/dt = 0`) makes implicit steps that cross onto the cone unsolvable (measured, see
-//! `shared/NOTES.md`). Instead `s` relaxes back to the cone (Perzyna-type regularisation):
+//! `d|p_t|/dt = 0`) makes implicit steps that cross onto the cone unsolvable (measured: the step
+//! size collapses to round-off; `docs/measurements.md`, section `joint::law`). Instead `s`
+//! relaxes back to the cone (Perzyna-type regularisation):
 //!
 //! ```text
 //! ṡ = (|e| − c)₊ · e/|e| / τ ,     τ = 1e-6 s by default ([`DEFAULT_TAU`])
@@ -31,10 +32,11 @@
 //! while the force is capped exactly at `μ|p_n|`. In steady sliding at tangential speed `V` the
 //! state lags outside the cone by `|e| − c ≈ τ V` (1e-5 mm at 10 mm/s), which changes nothing in
 //! the force (it is capped) and only delays the stick→slip transition by ~τ. The dissipation per
-//! cycle of the exact Coulomb loop `4 μ p_n (A − c)` is reproduced to ~1e-5 relative for τ = 1e-6 s
-//! (NOTES; `tests/friction.rs` checks 1 % and measures 0.8–1.2e-6 at 200 Hz, A = 3–40 c). The price is a stiff eigenvalue `−1/τ` per sliding or
-//! open pair: fine for BDF with Newton (the structured solve of [`crate::integrate::mechanical`] treats it
-//! exactly), prohibitive for functional iteration (step ≲ τ) whenever friction is on.
+//! cycle of the exact Coulomb loop `4 μ p_n (A − c)` is reproduced closely for τ = 1e-6 s
+//! (`tests/friction.rs` checks 1 %; measured errors in `docs/measurements.md`, section
+//! `joint::law`). The price is a stiff eigenvalue `−1/τ` per sliding or open pair: fine for BDF
+//! with Newton (the structured solve of [`crate::integrate::mechanical`] treats it exactly),
+//! prohibitive for functional iteration (step ≲ τ) whenever friction is on.
 //!
 //! When a pair is open, `c = 0` and the memory relaxes to `s = u_t` with time constant τ: a pair
 //! that closes again starts without elastic tangential stretch.
@@ -43,8 +45,8 @@
 //! energy is `½ k_t min(|e|, c)²` ([`PairLaw::stored_energy`]); the power balance
 //! `p · (ġ, u̇_t) = dψ/dt + d` holds up to `k_t c · d(|e| − c)/dt`: the capped law has no exact
 //! potential, and the mismatch is of the order of the lag `τ V` above (or `τ ċ` when the normal
-//! force falls while sliding). Measured on the friction bar ROM (0.02 s, atol 1e-8) the balance
-//! closes to 2e-6 of the external work (see [`crate::integrate::mechanical`]).
+//! force falls while sliding). The balance is checked in [`crate::integrate::mechanical`]; how
+//! closely it closes on the friction bar ROM is in `docs/measurements.md`, section `joint::law`.
 
 /// Default relaxation time τ of the slip memory, s.
 pub const DEFAULT_TAU: f64 = 1e-6;

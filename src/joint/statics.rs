@@ -41,7 +41,7 @@
 //!
 //! ## Full and reduced models
 //!
-//! - [`contact_static_full`] / [`contact_static_sparse`]: the sparse `K` of the model. The
+//! - [`crate::model::contact_static_full`] / [`contact_static_sparse`]: the sparse `K` of the model. The
 //!   matrix `K + K_c` changes values but not pattern, so the union pattern of `K` and every
 //!   pair's coupling `b_iᵀ b_i` and its symbolic Cholesky factorization (AMD ordering) are built
 //!   once; each iteration refills the values and refactors numerically.

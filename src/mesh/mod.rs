@@ -1,6 +1,6 @@
 //! The discretised structure: nodes, `Shell4` sheets, `Beam2` weld spots, clamps, the rigid tie
-//! to the master node, and the joint node pairs. Built from a validated [`crate::case::Case`] by
-//! [`crate::case::Case::build_mesh`].
+//! to the master node, and the joint node pairs. Built from a [`crate::case::Case`] by
+//! [`Mesh::from_case`], which validates the case while it generates the mesh (`build`).
 //!
 //! Axes: x along the length, y normal to the sheets, z across the width (mm).
 
@@ -128,7 +128,8 @@ impl Material {
 
 impl Mesh {
     /// Validates a case and generates its mesh (see the numbering in [`crate::case`]). Errors are
-    /// those of [`Case::from_json_str`], labelled with [`Case::source`].
+    /// the checks listed in [`crate::case`] (those of [`Case::from_json_str`] and those that need
+    /// the node grids), labelled with [`Case::source`].
     pub fn from_case(case: &Case) -> Result<Mesh, Error> {
         build::build(case)
     }

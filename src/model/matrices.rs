@@ -43,7 +43,7 @@
 //! (tolerance 1e-6), cells with unknown nodes; the contact law, load and end time as in a case.
 //! An indefinite K (unsupported structure) is reported by the first factorization.
 //!
-//! [`write`] goes the other way: any model to `K.mtx`, `M.mtx` (symmetric, shortest round-trip
+//! [`write()`] goes the other way: any model to `K.mtx`, `M.mtx` (symmetric, shortest round-trip
 //! decimal, so the numbers come back bit for bit) and `model.json`. `tests/matrices.rs` exports
 //! the friction bar, reads it back and gets identical matrices, bases, statics and transients.
 
@@ -323,29 +323,7 @@ fn frame_check(file: &str, path: &str, f: &FrameSpec) -> Result<(), Error> {
 /// Reads a map and its matrices into a [`Model`] (see the module docs).
 pub fn load(map_path: &Path) -> Result<Model, Error> {
     let file = map_path.display().to_string();
-    let text = std::fs::read_to_string(map_path).map_err(|source| Error::Io {
-        file: map_path.to_path_buf(),
-        source,
-    })?;
-    let map: MatrixMap = crate::case::parse_object(&text, &file, "a matrix map")?;
-    if map.schema != SCHEMA {
-        return Err(field_err(
-            &file,
-            "schema",
-            format!("must be \"{SCHEMA}\", got \"{}\"", map.schema),
-        ));
-    }
-    if map.version != VERSION {
-        return Err(field_err(
-            &file,
-            "version",
-            format!("this build reads version {VERSION}, got {}", map.version),
-        ));
-    }
-    if map.name.trim().is_empty() {
-        return Err(field_err(&file, "name", "must not be empty"));
-    }
-    crate::case::check_contact_load(&map.contact, &map.load, map.end_time, &file)?;
+    let map = read_map(map_path, &file)?;
     let dir = map_path.parent().unwrap_or(Path::new("."));
     let k_path = dir.join(&map.stiffness);
     let m_path = dir.join(&map.mass);
@@ -361,107 +339,21 @@ pub fn load(map_path: &Path) -> Result<Model, Error> {
     let rows = nk;
 
     // Nodes and rows.
-    let mut index_of: HashMap<u64, usize> = HashMap::with_capacity(map.nodes.len());
-    let mut owner: Vec<Option<(usize, usize)>> = vec![None; rows];
-    let mut fixed = vec![false; rows];
-    for (k, &r) in map.fixed_rows.iter().enumerate() {
-        if r == 0 || r > rows {
-            return Err(field_err(
-                &file,
-                format!("fixed_rows[{k}]"),
-                format!("row {r} is outside 1..={rows}"),
-            ));
-        }
-        if std::mem::replace(&mut fixed[r - 1], true) {
-            return Err(field_err(
-                &file,
-                format!("fixed_rows[{k}]"),
-                format!("row {r} is listed twice"),
-            ));
-        }
-    }
-    for (i, node) in map.nodes.iter().enumerate() {
-        if index_of.insert(node.id, i).is_some() {
-            return Err(field_err(
-                &file,
-                format!("nodes[{i}].id"),
-                format!("node id {} is used twice", node.id),
-            ));
-        }
-        if node.xyz.iter().any(|x| !x.is_finite()) {
-            return Err(field_err(
-                &file,
-                format!("nodes[{i}].xyz"),
-                "coordinates must be finite numbers",
-            ));
-        }
-        for (c, r) in node.rows.iter().enumerate() {
-            let Some(r) = *r else { continue };
-            let path = format!("nodes[{i}].rows[{c}]");
-            if r == 0 || r > rows {
-                return Err(field_err(
-                    &file,
-                    path,
-                    format!("row {r} is outside 1..={rows} (K and M are {rows} × {rows})"),
-                ));
-            }
-            if fixed[r - 1] {
-                return Err(field_err(
-                    &file,
-                    path,
-                    format!("row {r} is also in fixed_rows"),
-                ));
-            }
-            if let Some((j, d)) = owner[r - 1] {
-                return Err(field_err(
-                    &file,
-                    path,
-                    format!("row {r} is already nodes[{j}].rows[{d}]"),
-                ));
-            }
-            owner[r - 1] = Some((i, c));
-        }
-    }
-    let node = |id: u64, path: &str| -> Result<usize, Error> {
-        index_of
-            .get(&id)
-            .copied()
-            .ok_or_else(|| field_err(&file, path, format!("no node has id {id}")))
+    let fixed = fixed_rows(&file, &map, rows)?;
+    let reader = MapReader {
+        file: &file,
+        map: &map,
+        index_of: node_index(&file, &map, &fixed)?,
     };
-    let master_node = node(map.master_node, "master_node")?;
-    let mut master_rows = [0usize; 6];
-    for (c, r) in map.nodes[master_node].rows.iter().enumerate() {
-        master_rows[c] = r.ok_or_else(|| {
-            field_err(
-                &file,
-                "master_node",
-                format!(
-                    "node {} has no row for {}; the master node needs all six DOF \
-                     (ux, uy, uz, rx, ry, rz) in the matrices",
-                    map.master_node,
-                    ["ux", "uy", "uz", "rx", "ry", "rz"][c]
-                ),
-            )
-        })? - 1;
-    }
+    let master_node = reader.node(map.master_node, "master_node")?;
+    let master_rows = reader.master_rows(master_node)?;
 
     // Renumbering: kept rows ascending, the master's six last.
-    let mut is_master = vec![false; rows];
-    for &r in &master_rows {
-        is_master[r] = true;
-    }
-    let mut new_index: Vec<Option<usize>> = vec![None; rows];
-    let mut next = 0;
-    for r in 0..rows {
-        if !fixed[r] && !is_master[r] {
-            new_index[r] = Some(next);
-            next += 1;
-        }
-    }
-    let n = next + 6;
-    for (c, &r) in master_rows.iter().enumerate() {
-        new_index[r] = Some(next + c);
-    }
+    let Renumbering {
+        new_index,
+        n,
+        master,
+    } = Renumbering::new(&fixed, &master_rows);
     if n <= 6 {
         return Err(field_err(
             &file,
@@ -469,172 +361,19 @@ pub fn load(map_path: &Path) -> Result<Model, Error> {
             format!("the model has {n} DOF; it needs DOF besides the master node's six"),
         ));
     }
-    let master = [0, 1, 2, 3, 4, 5].map(|c| next + c);
     let (stiffness, mass) = union_pattern(n, &new_index, &k_trip, &m_trip);
-    for (name, a, path) in [("K", &stiffness, &k_path), ("M", &mass, &m_path)] {
-        for (r, idx) in new_index.iter().enumerate() {
-            let Some(j) = *idx else { continue };
-            let d = a.get(j, j);
-            if d.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
-                return Err(field_err(
-                    &path.display().to_string(),
-                    format!("entry ({0}, {0})", r + 1),
-                    format!(
-                        "{name} has diagonal {d:e} at row {}: every kept DOF needs positive \
-                         stiffness and mass (unsupported DOF? put it in fixed_rows)",
-                        r + 1
-                    ),
-                ));
-            }
-        }
-    }
+    check_diagonals(
+        &new_index,
+        [("K", &stiffness, &k_path), ("M", &mass, &m_path)],
+    )?;
 
-    // DOF map: own rows, rigid followers, fixed.
-    let mut nodes_dep: Vec<[DofDep; 6]> = map
-        .nodes
-        .iter()
-        .map(|nd| {
-            nd.rows.map(|r| match r {
-                Some(r) => DofDep::single(new_index[r - 1].expect("named rows are kept")),
-                None => DofDep::FIXED,
-            })
-        })
-        .collect();
-    let mut followers = Vec::with_capacity(map.rigid_followers.len());
-    let xm = map.nodes[master_node].xyz;
-    for (k, &id) in map.rigid_followers.iter().enumerate() {
-        let path = format!("rigid_followers[{k}]");
-        let i = node(id, &path)?;
-        if i == master_node || map.nodes[i].rows.iter().any(Option::is_some) {
-            return Err(field_err(
-                &file,
-                path,
-                format!(
-                    "node {id} has rows of its own (or is the master); a rigid follower has none"
-                ),
-            ));
-        }
-        let xs = map.nodes[i].xyz;
-        nodes_dep[i] =
-            DofDep::rigid_follower(master, [xs[0] - xm[0], xs[1] - xm[1], xs[2] - xm[2]]);
-        followers.push(i);
-    }
-    let dof_map = DofMap {
-        nodes: nodes_dep,
-        n,
-        master,
-    };
-
-    // Pairs.
-    if map.pairs.is_empty() {
-        return Err(field_err(
-            &file,
-            "pairs",
-            "no joint pairs: the model needs at least one",
-        ));
-    }
-    if let Some(f) = &map.pair_frame {
-        frame_check(&file, "pair_frame", f)?;
-    }
-    let mut pairs = Vec::with_capacity(map.pairs.len());
-    for (k, p) in map.pairs.iter().enumerate() {
-        let path = format!("pairs[{k}]");
-        let lower = node(p.lower, &format!("{path}.lower"))?;
-        let upper = node(p.upper, &format!("{path}.upper"))?;
-        if lower == upper {
-            return Err(field_err(&file, path, "lower and upper are the same node"));
-        }
-        let default = map.pair_frame;
-        let pick = |own: Option<[f64; 3]>, d: Option<[f64; 3]>, name: &str| {
-            own.or(d).ok_or_else(|| {
-                field_err(
-                    &file,
-                    format!("{path}.{name}"),
-                    "missing, and the map has no `pair_frame` default",
-                )
-            })
-        };
-        let frame = FrameSpec {
-            normal: pick(p.normal, default.map(|f| f.normal), "normal")?,
-            t1: pick(p.t1, default.map(|f| f.t1), "t1")?,
-            t2: pick(p.t2, default.map(|f| f.t2), "t2")?,
-        };
-        if p.normal.is_some() || p.t1.is_some() || p.t2.is_some() {
-            frame_check(&file, &path, &frame)?;
-        }
-        for (which, i, id) in [("lower", lower, p.lower), ("upper", upper, p.upper)] {
-            for (axis, _) in [frame.normal, frame.t1, frame.t2]
-                .iter()
-                .flat_map(|d| d.iter().enumerate())
-                .filter(|(_, w)| **w != 0.0)
-            {
-                if dof_map.nodes[i][axis].terms().next().is_none() {
-                    return Err(field_err(
-                        &file,
-                        format!("{path}.{which}"),
-                        format!(
-                            "node {id} has no row for u{}; a joint node must move along its \
-                             pair frame",
-                            ["x", "y", "z"][axis]
-                        ),
-                    ));
-                }
-            }
-        }
-        pairs.push(PairFrame {
-            lower,
-            upper,
-            normal: frame.normal,
-            t1: frame.t1,
-            t2: frame.t2,
-        });
-    }
+    let (dof_map, followers) = reader.dof_map(master_node, &new_index, n, master)?;
+    let pairs = reader.pairs(&dof_map)?;
     let joint = JointOperator::new(&pairs, &dof_map)?;
-
-    // Display cells.
-    let mut cells = Vec::with_capacity(map.cells.len());
-    for (k, c) in map.cells.iter().enumerate() {
-        let path = format!("cells[{k}].nodes");
-        let want = match c.kind {
-            MapCellKind::Quad4 => 4,
-            MapCellKind::Line2 => 2,
-        };
-        if c.nodes.len() != want {
-            return Err(field_err(
-                &file,
-                path,
-                format!(
-                    "a {:?} cell has {want} nodes, got {}",
-                    c.kind,
-                    c.nodes.len()
-                ),
-            ));
-        }
-        let idx: Vec<usize> = c
-            .nodes
-            .iter()
-            .map(|&id| node(id, &path))
-            .collect::<Result<_, _>>()?;
-        if !c.size.is_finite() || c.size < 0.0 {
-            return Err(field_err(
-                &file,
-                format!("cells[{k}].size"),
-                format!("must be finite and ≥ 0 mm, got {}", c.size),
-            ));
-        }
-        cells.push(Cell {
-            nodes: match c.kind {
-                MapCellKind::Quad4 => CellNodes::Quad4([idx[0], idx[1], idx[2], idx[3]]),
-                MapCellKind::Line2 => CellNodes::Line2([idx[0], idx[1]]),
-            },
-            group: c.group,
-            size: c.size,
-        });
-    }
     let geometry = Geometry {
+        cells: reader.cells()?,
         nodes: map.nodes.iter().map(|nd| nd.xyz).collect(),
         node_ids: map.nodes.iter().map(|nd| nd.id).collect(),
-        cells,
         followers,
     };
     Ok(Model {
@@ -655,6 +394,379 @@ pub fn load(map_path: &Path) -> Result<Model, Error> {
         contact: map.contact,
         end_time: map.end_time,
     })
+}
+
+/// Reads the map at `map_path` (named `file` in messages) and checks its schema, version, name,
+/// contact law, load and end time.
+fn read_map(map_path: &Path, file: &str) -> Result<MatrixMap, Error> {
+    let text = std::fs::read_to_string(map_path).map_err(|source| Error::Io {
+        file: map_path.to_path_buf(),
+        source,
+    })?;
+    let map: MatrixMap = crate::case::parse_object(&text, file, "a matrix map")?;
+    if map.schema != SCHEMA {
+        return Err(field_err(
+            file,
+            "schema",
+            format!("must be \"{SCHEMA}\", got \"{}\"", map.schema),
+        ));
+    }
+    if map.version != VERSION {
+        return Err(field_err(
+            file,
+            "version",
+            format!("this build reads version {VERSION}, got {}", map.version),
+        ));
+    }
+    if map.name.trim().is_empty() {
+        return Err(field_err(file, "name", "must not be empty"));
+    }
+    crate::case::check_contact_load(&map.contact, &map.load, map.end_time, file)?;
+    Ok(map)
+}
+
+/// Which of the `rows` matrix rows are fixed (`fixed_rows`, each in range and listed once).
+fn fixed_rows(file: &str, map: &MatrixMap, rows: usize) -> Result<Vec<bool>, Error> {
+    let mut fixed = vec![false; rows];
+    for (k, &r) in map.fixed_rows.iter().enumerate() {
+        if r == 0 || r > rows {
+            return Err(field_err(
+                file,
+                format!("fixed_rows[{k}]"),
+                format!("row {r} is outside 1..={rows}"),
+            ));
+        }
+        if std::mem::replace(&mut fixed[r - 1], true) {
+            return Err(field_err(
+                file,
+                format!("fixed_rows[{k}]"),
+                format!("row {r} is listed twice"),
+            ));
+        }
+    }
+    Ok(fixed)
+}
+
+/// The index of each node id into `map.nodes`, checking the nodes: ids used once, finite
+/// coordinates, and rows in range, not fixed and named by one node DOF only.
+fn node_index(file: &str, map: &MatrixMap, fixed: &[bool]) -> Result<HashMap<u64, usize>, Error> {
+    let rows = fixed.len();
+    let mut index_of: HashMap<u64, usize> = HashMap::with_capacity(map.nodes.len());
+    let mut owner: Vec<Option<(usize, usize)>> = vec![None; rows];
+    for (i, node) in map.nodes.iter().enumerate() {
+        if index_of.insert(node.id, i).is_some() {
+            return Err(field_err(
+                file,
+                format!("nodes[{i}].id"),
+                format!("node id {} is used twice", node.id),
+            ));
+        }
+        if node.xyz.iter().any(|x| !x.is_finite()) {
+            return Err(field_err(
+                file,
+                format!("nodes[{i}].xyz"),
+                "coordinates must be finite numbers",
+            ));
+        }
+        for (c, r) in node.rows.iter().enumerate() {
+            let Some(r) = *r else { continue };
+            let path = format!("nodes[{i}].rows[{c}]");
+            if r == 0 || r > rows {
+                return Err(field_err(
+                    file,
+                    path,
+                    format!("row {r} is outside 1..={rows} (K and M are {rows} × {rows})"),
+                ));
+            }
+            if fixed[r - 1] {
+                return Err(field_err(
+                    file,
+                    path,
+                    format!("row {r} is also in fixed_rows"),
+                ));
+            }
+            if let Some((j, d)) = owner[r - 1] {
+                return Err(field_err(
+                    file,
+                    path,
+                    format!("row {r} is already nodes[{j}].rows[{d}]"),
+                ));
+            }
+            owner[r - 1] = Some((i, c));
+        }
+    }
+    Ok(index_of)
+}
+
+/// The model's DOF numbering: the kept rows ascending, the master node's six last.
+struct Renumbering {
+    /// The new index of each matrix row (0-based); `None` for a fixed row.
+    new_index: Vec<Option<usize>>,
+    /// DOF count.
+    n: usize,
+    /// The master node's DOF, the last six.
+    master: [usize; 6],
+}
+
+impl Renumbering {
+    /// Numbers the rows not `fixed`, with the 0-based `master_rows` last.
+    fn new(fixed: &[bool], master_rows: &[usize; 6]) -> Self {
+        let rows = fixed.len();
+        let mut is_master = vec![false; rows];
+        for &r in master_rows {
+            is_master[r] = true;
+        }
+        let mut new_index: Vec<Option<usize>> = vec![None; rows];
+        let mut next = 0;
+        for r in 0..rows {
+            if !fixed[r] && !is_master[r] {
+                new_index[r] = Some(next);
+                next += 1;
+            }
+        }
+        let n = next + 6;
+        for (c, &r) in master_rows.iter().enumerate() {
+            new_index[r] = Some(next + c);
+        }
+        let master = [0, 1, 2, 3, 4, 5].map(|c| next + c);
+        Renumbering {
+            new_index,
+            n,
+            master,
+        }
+    }
+}
+
+/// Checks that every kept DOF has a positive diagonal in each of the `(name, matrix, file)`.
+fn check_diagonals(
+    new_index: &[Option<usize>],
+    matrices: [(&str, &SymCsc, &PathBuf); 2],
+) -> Result<(), Error> {
+    for (name, a, path) in matrices {
+        for (r, idx) in new_index.iter().enumerate() {
+            let Some(j) = *idx else { continue };
+            let d = a.get(j, j);
+            if d.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+                return Err(field_err(
+                    &path.display().to_string(),
+                    format!("entry ({0}, {0})", r + 1),
+                    format!(
+                        "{name} has diagonal {d:e} at row {}: every kept DOF needs positive \
+                         stiffness and mass (unsupported DOF? put it in fixed_rows)",
+                        r + 1
+                    ),
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// A map being read, its nodes checked: the parts of [`load`] that refer to nodes by id.
+struct MapReader<'a> {
+    /// The map's file, for messages.
+    file: &'a str,
+    map: &'a MatrixMap,
+    /// The index of each node id into `map.nodes`.
+    index_of: HashMap<u64, usize>,
+}
+
+impl MapReader<'_> {
+    /// The index of node `id`, or an error at `path`.
+    fn node(&self, id: u64, path: &str) -> Result<usize, Error> {
+        self.index_of
+            .get(&id)
+            .copied()
+            .ok_or_else(|| field_err(self.file, path, format!("no node has id {id}")))
+    }
+
+    /// The master node's six rows, 0-based; an error if one is missing.
+    fn master_rows(&self, master_node: usize) -> Result<[usize; 6], Error> {
+        let map = self.map;
+        let mut master_rows = [0usize; 6];
+        for (c, r) in map.nodes[master_node].rows.iter().enumerate() {
+            master_rows[c] = r.ok_or_else(|| {
+                field_err(
+                    self.file,
+                    "master_node",
+                    format!(
+                        "node {} has no row for {}; the master node needs all six DOF \
+                         (ux, uy, uz, rx, ry, rz) in the matrices",
+                        map.master_node,
+                        ["ux", "uy", "uz", "rx", "ry", "rz"][c]
+                    ),
+                )
+            })? - 1;
+        }
+        Ok(master_rows)
+    }
+
+    /// The DOF map (own rows, rigid followers, fixed) and the followers' node indices.
+    fn dof_map(
+        &self,
+        master_node: usize,
+        new_index: &[Option<usize>],
+        n: usize,
+        master: [usize; 6],
+    ) -> Result<(DofMap, Vec<usize>), Error> {
+        let map = self.map;
+        let mut nodes_dep: Vec<[DofDep; 6]> = map
+            .nodes
+            .iter()
+            .map(|nd| {
+                nd.rows.map(|r| match r {
+                    Some(r) => DofDep::single(new_index[r - 1].expect("named rows are kept")),
+                    None => DofDep::FIXED,
+                })
+            })
+            .collect();
+        let mut followers = Vec::with_capacity(map.rigid_followers.len());
+        let xm = map.nodes[master_node].xyz;
+        for (k, &id) in map.rigid_followers.iter().enumerate() {
+            let path = format!("rigid_followers[{k}]");
+            let i = self.node(id, &path)?;
+            if i == master_node || map.nodes[i].rows.iter().any(Option::is_some) {
+                return Err(field_err(
+                    self.file,
+                    path,
+                    format!(
+                        "node {id} has rows of its own (or is the master); a rigid follower has \
+                         none"
+                    ),
+                ));
+            }
+            let xs = map.nodes[i].xyz;
+            nodes_dep[i] =
+                DofDep::rigid_follower(master, [xs[0] - xm[0], xs[1] - xm[1], xs[2] - xm[2]]);
+            followers.push(i);
+        }
+        let dof_map = DofMap {
+            nodes: nodes_dep,
+            n,
+            master,
+        };
+        Ok((dof_map, followers))
+    }
+
+    /// The joint pairs with their frames.
+    fn pairs(&self, dof_map: &DofMap) -> Result<Vec<PairFrame>, Error> {
+        let map = self.map;
+        if map.pairs.is_empty() {
+            return Err(field_err(
+                self.file,
+                "pairs",
+                "no joint pairs: the model needs at least one",
+            ));
+        }
+        if let Some(f) = &map.pair_frame {
+            frame_check(self.file, "pair_frame", f)?;
+        }
+        let mut pairs = Vec::with_capacity(map.pairs.len());
+        for (k, p) in map.pairs.iter().enumerate() {
+            pairs.push(self.pair(&format!("pairs[{k}]"), p, dof_map)?);
+        }
+        Ok(pairs)
+    }
+
+    /// One joint pair (at `path`): two distinct nodes, an orthonormal frame (its own or the
+    /// default), and rows along the frame at both nodes.
+    fn pair(&self, path: &str, p: &MapPair, dof_map: &DofMap) -> Result<PairFrame, Error> {
+        let file = self.file;
+        let lower = self.node(p.lower, &format!("{path}.lower"))?;
+        let upper = self.node(p.upper, &format!("{path}.upper"))?;
+        if lower == upper {
+            return Err(field_err(file, path, "lower and upper are the same node"));
+        }
+        let default = self.map.pair_frame;
+        let pick = |own: Option<[f64; 3]>, d: Option<[f64; 3]>, name: &str| {
+            own.or(d).ok_or_else(|| {
+                field_err(
+                    file,
+                    format!("{path}.{name}"),
+                    "missing, and the map has no `pair_frame` default",
+                )
+            })
+        };
+        let frame = FrameSpec {
+            normal: pick(p.normal, default.map(|f| f.normal), "normal")?,
+            t1: pick(p.t1, default.map(|f| f.t1), "t1")?,
+            t2: pick(p.t2, default.map(|f| f.t2), "t2")?,
+        };
+        if p.normal.is_some() || p.t1.is_some() || p.t2.is_some() {
+            frame_check(file, path, &frame)?;
+        }
+        for (which, i, id) in [("lower", lower, p.lower), ("upper", upper, p.upper)] {
+            for (axis, _) in [frame.normal, frame.t1, frame.t2]
+                .iter()
+                .flat_map(|d| d.iter().enumerate())
+                .filter(|(_, w)| **w != 0.0)
+            {
+                if dof_map.nodes[i][axis].terms().next().is_none() {
+                    return Err(field_err(
+                        file,
+                        format!("{path}.{which}"),
+                        format!(
+                            "node {id} has no row for u{}; a joint node must move along its \
+                             pair frame",
+                            ["x", "y", "z"][axis]
+                        ),
+                    ));
+                }
+            }
+        }
+        Ok(PairFrame {
+            lower,
+            upper,
+            normal: frame.normal,
+            t1: frame.t1,
+            t2: frame.t2,
+        })
+    }
+
+    /// The display cells.
+    fn cells(&self) -> Result<Vec<Cell>, Error> {
+        let map = self.map;
+        let mut cells = Vec::with_capacity(map.cells.len());
+        for (k, c) in map.cells.iter().enumerate() {
+            let path = format!("cells[{k}].nodes");
+            let want = match c.kind {
+                MapCellKind::Quad4 => 4,
+                MapCellKind::Line2 => 2,
+            };
+            if c.nodes.len() != want {
+                return Err(field_err(
+                    self.file,
+                    path,
+                    format!(
+                        "a {:?} cell has {want} nodes, got {}",
+                        c.kind,
+                        c.nodes.len()
+                    ),
+                ));
+            }
+            let idx: Vec<usize> = c
+                .nodes
+                .iter()
+                .map(|&id| self.node(id, &path))
+                .collect::<Result<_, _>>()?;
+            if !c.size.is_finite() || c.size < 0.0 {
+                return Err(field_err(
+                    self.file,
+                    format!("cells[{k}].size"),
+                    format!("must be finite and ≥ 0 mm, got {}", c.size),
+                ));
+            }
+            cells.push(Cell {
+                nodes: match c.kind {
+                    MapCellKind::Quad4 => CellNodes::Quad4([idx[0], idx[1], idx[2], idx[3]]),
+                    MapCellKind::Line2 => CellNodes::Line2([idx[0], idx[1]]),
+                },
+                group: c.group,
+                size: c.size,
+            });
+        }
+        Ok(cells)
+    }
 }
 
 /// K and M renumbered by `new_index` (dropped rows: `None`) on the union of their patterns

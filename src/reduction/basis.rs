@@ -116,7 +116,7 @@ impl JimSet {
     }
 }
 
-/// Options of [`build_basis`]. Defaults: `nu = 10` (the paper), `g = None` (chosen by
+/// Options of [`super::build_basis`]. Defaults: `nu = 10` (the paper), `g = None` (chosen by
 /// `threshold`), `threshold =` [`DEFAULT_THRESHOLD`] (0.999), `tvd =` [`TvdOptions::default`]
 /// (tol 1e-6, zero gaps active, no tangential stiffness), `drop_tol =` [`DEFAULT_DROP_TOL`],
 /// `jim_set =` [`JimSet::Both`], `modal = true`. Construct with `..Default::default()`: fields
@@ -133,7 +133,7 @@ pub struct BasisOptions {
     pub tvd: TvdOptions,
     /// Relative drop tolerance of the final M-orthonormalization.
     pub drop_tol: f64,
-    /// The joint DOF set of [`BasisKind::Jim`].
+    /// The joint DOF set of [`super::BasisKind::Jim`].
     pub jim_set: JimSet,
     /// Rotate the M-orthonormal basis to the reduced eigenbasis (see [`modal_rotation`]).
     pub modal: bool,

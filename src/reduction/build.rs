@@ -24,11 +24,11 @@ pub enum BasisKind {
     Modes,
     /// Craig–Bampton plus the g lowest Joint Interface Modes (Witteveen & Irschik 2009; the
     /// paper's Section 5.3 and Figure 19), of the set [`BasisOptions::jim_set`]; see
-    /// [`super::jim`].
+    /// [`super::competitors::jim`].
     Jim,
     /// Craig–Bampton plus the static constraint modes of every joint pair's relative normal DOF
     /// (all joint DOF kept, the paper's Section 5.1); g is ignored and reported as the number of
-    /// pairs; see [`super::alldof`].
+    /// pairs; see [`super::competitors::alldof`].
     AllDof,
 }
 

@@ -6,23 +6,24 @@
 //! with `M̃ = ΦᵀMΦ`, `K̃ = ΦᵀKΦ` (eq. 7). The basis (eq. 9, Algorithm 2) is
 //! `Φ = [Φ_S Φ_V Φ̃_T]`:
 //!
-//! 1. [`craig_bampton`]: `Φ_S`, the s = 6 constraint modes of the master node, and `Φ_V`, ν
+//! 1. [`craig_bampton()`]: `Φ_S`, the s = 6 constraint modes of the master node, and `Φ_V`, ν
 //!    fixed-interface normal modes (Section 4: both at the undeformed state, no joint stiffness).
 //! 2. [`trial_vector_derivatives`]: for each trial vector φ_j and each sign k = ±1 (eqs. 27–28:
 //!    the contact stiffness is one-sided, so `∂K/∂q_j ≠ −∂K/∂(−q_j)`), the pairs whose normal
 //!    gap under `k φ_j` is ≤ 0 get the penalty stiffness `k_n` (and optionally `k_t`):
 //!    `∂K/∂q_{k,j} = Σ_active k_n b_nᵀ b_n`. The TVD `φ_{i,k,j} = K⁻¹ ∂K/∂q_{k,j} φ_i`
-//!    (eqs. 16, 18: the static response to the pseudoforce of eq. 19; the inertia terms of eq. 15
-//!    are neglected, as in the paper's Algorithm 2) — `2 (v + s)²` candidates, each normalized
+//!    (eqs. 16, 18: the static response to the pseudoforce of eq. 19; by default the inertia
+//!    terms of eq. 15 are neglected, as in the paper's Algorithm 2, and [`TvdOptions::inertia`]
+//!    includes them for the fixed-interface modes) — `2 (v + s)²` candidates, each normalized
 //!    to `φᵀKφ = 1`. Gaps are compared with zero relative to φ_j's own scale (see
 //!    [`active_pairs`]) because eigen-solver noise makes some "zero" gaps 1e-8 of a mode.
 //! 3. [`pod()`]: the POD of the TVD (eqs. 20–25), K-weighted (the paper's choice: the POMs
 //!    approximate the deformation energy of the TVD space) or plain, with the energy ratio
 //!    `w(g)` (eq. 26) to choose the number g of joint modes `Φ̃_T` (eq. 23 scaling).
 //!    For TVD, [`pod_tvd`] computes the same POD from the factor form `Y = K⁻¹ B_uᵀ C` as an
-//!    SVD (no `Yᵀ K Y`), resolving eigenvalues far below the Gram's round-off (≈ 1e-10 λ_max):
-//!    with all 54 (friction bar) / 92 (multilayer) POMs the reduced contact force matches the
-//!    full one to 5e-10 / 8e-11 (the Gram route with its 1e-12 cut stalled at 2e-2).
+//!    SVD (no `Yᵀ K Y`), resolving eigenvalues far below the Gram's round-off, so that with all
+//!    POMs the reduced contact force converges to the full one (the measured errors are in
+//!    `docs/measurements.md`, section `reduction`).
 //! 4. [`final_basis`]: the parts concatenated and M-orthonormalized (so `M̃ = I`), dependent
 //!    directions dropped; [`build_basis`] then rotates Φ to the reduced eigenbasis
 //!    ([`modal_rotation`]: `K̃ = diag(ω²)`, same span) unless `BasisOptions::modal` is false.
@@ -31,15 +32,19 @@
 //!    the reduced joint operator `B Φ` and the reduced load.
 //!
 //! The competitors of the paper's Section 5, behind the same [`build_basis`] ([`BasisKind`]):
-//! modes only (more fixed-interface modes), [`jim`] (Joint Interface Modes, Section 5.3),
-//! [`alldof`] (constraint modes of all joint normal DOF, Section 5.1) and, with its own builder
-//! because it needs full-FE results, [`snapshots`] (POD of transient snapshots, Section 5.2).
+//! modes only (more fixed-interface modes), [`competitors::jim`] (Joint Interface Modes,
+//! Section 5.3), [`competitors::alldof`] (constraint modes of all joint normal DOF,
+//! Section 5.1) and, with its own builder because it needs full-FE results,
+//! [`competitors::snapshots`] (POD of transient snapshots, Section 5.2).
 //!
 //! Without `k_t` every TVD lies in `span(K⁻¹ B_nᵀ)`, so the TVD space has at most one dimension
 //! per pair and `w(g) = 1` by g = w (number of pairs).
 //!
-//! Not implemented: the inertia-corrected TVD of eq. (15) for vibration modes (it needs a
-//! factorization of the indefinite `K − Ω_i² M` per mode).
+//! The inertia-corrected TVD of eq. (15) for the fixed-interface vibration modes is implemented:
+//! [`TvdOptions::inertia`] (off by default, as in Algorithm 2) factors the indefinite
+//! `K − Ω_i² M` of each mode by sparse LU (see [`tvd`]). The static convergence study runs it as
+//! its `tvd-inertia` variant (`jointrom study`); the other commands' TVD bases use eq. (16), and
+//! a library caller selects eq. (15) through `BasisOptions::tvd`.
 
 pub mod basis;
 mod build;

@@ -48,8 +48,9 @@
 //! double-double residuals (so `B_u Z = Zᵀ K Z` to working precision), `G = B_u Z`, C the
 //! K-normalized coefficients. [`super::pod_tvd`] computes the K-weighted POD as the SVD of
 //! `D^½ Vᵀ C` (`G = V D Vᵀ`) instead of the eigenproblem of `Yᵀ K Y`, which squares the
-//! condition number: on the friction bar the Gram route's round-off is ≈ 1e-10 λ_max, and the
-//! directions carrying the last per cent of the contact force have λ = 1e-12 … 1e-20 λ_max.
+//! condition number: the directions carrying the last per cent of the contact force have POD
+//! eigenvalues below the Gram route's round-off (measured in `docs/measurements.md`, section
+//! `reduction::tvd`).
 
 use faer::linalg::solvers::Solve;
 use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
@@ -71,7 +72,7 @@ use crate::linalg::compensated::solve_refined_steps;
 pub struct TvdOptions {
     /// Relative zero of a gap: under trial vector φ_j a pair gap with
     /// `|g_z| ≤ tol · max_pairs |g|` counts as exactly zero (eigen-solver noise is ~1e-8–1e-7
-    /// of a mode's size, NOTES). Also the relative zero of a pseudoforce column (see
+    /// of a mode's size, see [`active_pairs`]). Also the relative zero of a pseudoforce column (see
     /// [`Tvd::negligible_columns`]).
     pub tol: f64,
     /// Whether an exactly-zero gap (in the sense of `tol`) is active. `true` is the paper's
@@ -168,13 +169,9 @@ impl Tvd {
 /// exactly zero (`max |g| = 0`, e.g. an in-plane constraint mode) every gap is zero and the same
 /// rule applies: all pairs are active for both signs if `zero_gap_active`, none otherwise.
 ///
-/// What "zero" catches on the built-in cases (Craig–Bampton, ν = 10, `tol = 1e-6`): in the
-/// friction bar 136 of 16 × 54 gaps, 126 of them ≤ 1e-10 relative — the centre-line pairs under
-/// the vectors antisymmetric in z (symmetry zeros) — and the rest the weld pairs' true but tiny
-/// gaps (~1e-7 relative, the welds are very stiff); in the multilayer sheet 52 of 16 × 92, most
-/// in the 1e-8–1e-6 band. No base vector has all gaps exactly zero on either case, and the rule
-/// changes no column count (every candidate keeps some active penetrating pair); it changes the
-/// K-weighted `g(0.999)` of the friction bar from 12 (`true`) to 13 (`false`).
+/// On the built-in cases "zero" catches symmetry zeros (centre-line pairs under the vectors
+/// antisymmetric in z) and the weld pairs' true but tiny gaps; the counts, and what the rule
+/// changes, are in `docs/measurements.md`, section `reduction::tvd`.
 pub fn active_pairs(gaps: &[f64], k: f64, opts: &TvdOptions) -> Vec<bool> {
     let scale = gaps.iter().fold(0.0f64, |a, g| a.max(g.abs()));
     let zero = opts.tol * scale;
@@ -217,68 +214,11 @@ pub fn trial_vector_derivatives(
             opts.tol
         )));
     }
-    let joint = &model.joint;
-    let w = joint.pairs();
-    let kn = model.contact.normal_stiffness;
-    let kt = model.contact.stick_stiffness;
+    let run = TvdRun::new(model, base, opts);
     let nb = base.ncols();
-    let bphi = joint.reduce(base); // 3w × nb
-                                   // Joint rows that receive stiffness, B_u (m of them), and each one's stiffness.
-    let per_pair: &[usize] = if opts.tangential {
-        &[NORMAL, T1, T2]
-    } else {
-        &[NORMAL]
-    };
-    let used: Vec<usize> = (0..w)
-        .flat_map(|z| per_pair.iter().map(move |&r| 3 * z + r))
-        .collect();
-    let m = used.len();
-    let stiff = |r: usize| if r % 3 == NORMAL { kn } else { kt };
-    // Joint scale of each φ_i over the rows that receive stiffness.
-    let joint_scale: Vec<f64> = (0..nb)
-        .map(|i| used.iter().fold(0.0f64, |a, &r| a.max(bphi[(r, i)].abs())))
-        .collect();
-    let max_stiff = if opts.tangential { kn.max(kt) } else { kn };
-
-    // Pseudoforces p_u (m × cols, column-major) of the kept candidates.
     let total = 2 * nb * nb;
-    let mut coef: Vec<f64> = Vec::new();
-    let mut index = Vec::new();
-    let mut active_all = Vec::with_capacity(nb);
-    let mut zero_columns = 0;
-    let mut negligible_columns = 0;
-    let mut p = vec![0.0; m];
-    for j in 0..nb {
-        let gaps: Vec<f64> = (0..w).map(|z| bphi[(3 * z + NORMAL, j)]).collect();
-        let act = [
-            active_pairs(&gaps, -1.0, opts),
-            active_pairs(&gaps, 1.0, opts),
-        ];
-        for (ki, k) in [-1i8, 1].into_iter().enumerate() {
-            for i in 0..nb {
-                for (pa, &r) in p.iter_mut().zip(&used) {
-                    *pa = if act[ki][r / 3] {
-                        stiff(r) * bphi[(r, i)]
-                    } else {
-                        0.0
-                    };
-                }
-                let pmax = p.iter().fold(0.0f64, |a, v| a.max(v.abs()));
-                if pmax == 0.0 {
-                    zero_columns += 1;
-                    continue;
-                }
-                if pmax <= opts.tol * max_stiff * joint_scale[i] {
-                    negligible_columns += 1;
-                    continue;
-                }
-                coef.extend_from_slice(&p);
-                index.push(TvdIndex { i, k, j });
-            }
-        }
-        active_all.push(act);
-    }
-    let cols = index.len();
+    let cand = run.candidates(opts);
+    let cols = cand.index.len();
     let omega2 = if opts.inertia {
         mode_eigenvalues(model, base)?
     } else {
@@ -292,84 +232,234 @@ pub fn trial_vector_derivatives(
     };
     let mut k_norms = vec![0.0; cols];
     let mut factor = None;
-    let coef_col = |c: usize| &coef[c * m..(c + 1) * m];
     // Static columns (Ω_i = 0): Z = K⁻¹ B_uᵀ, φᵀKφ = p_uᵀ G p_u with G = B_u Z.
-    let static_cols: Vec<usize> = (0..cols).filter(|&c| omega2[index[c].i] == 0.0).collect();
+    let static_cols: Vec<usize> = (0..cols)
+        .filter(|&c| omega2[cand.index[c].i] == 0.0)
+        .collect();
     if !static_cols.is_empty() {
-        let chol = SparseCholesky::new(&model.stiffness)?;
-        let bt = joint_rows_transposed(joint, &used, n);
-        let z = solve_refined_steps(&model.stiffness, &chol, &bt, 1);
-        let g = symmetric(&rows_times(joint, &used, z.as_ref()));
-        let pc = Mat::from_fn(m, static_cols.len(), |r, c| coef_col(static_cols[c])[r]);
-        let scaled = normalize(&g, pc, &static_cols, &index, &mut k_norms)?;
-        let xs = &z * &scaled;
+        let (xs, static_factor) = run.static_columns(&cand, &static_cols, &mut k_norms)?;
         if static_cols.len() == cols {
             // All columns static (the default): the product is the whole TVD matrix.
             x = xs;
+            factor = Some(static_factor);
         } else {
             for (a, &c) in static_cols.iter().enumerate() {
                 x.col_mut(c).copy_from(xs.col(a));
             }
         }
-        if static_cols.len() == cols {
-            factor = Some(TvdFactor {
-                flexibility: z,
-                joint_flexibility: g,
-                coefficients: scaled,
-            });
+    }
+    run.inertia_columns(&cand, &omega2, &mut x, &mut k_norms)?;
+    Ok(Tvd {
+        vectors: x,
+        index: cand.index,
+        k_norms,
+        total,
+        zero_columns: cand.zero_columns,
+        negligible_columns: cand.negligible_columns,
+        active: cand.active,
+        omega2,
+        factor,
+    })
+}
+
+/// One [`trial_vector_derivatives`] run: the model, the base, its joint displacements and the
+/// joint rows that receive stiffness.
+struct TvdRun<'a> {
+    model: &'a Model,
+    base: MatRef<'a, f64>,
+    /// `B φ` of every base vector (3w × nb).
+    bphi: Mat<f64>,
+    /// The joint rows that receive stiffness, B_u (m of them): each pair's normal row, or all
+    /// three with [`TvdOptions::tangential`].
+    used: Vec<usize>,
+}
+
+/// The kept candidates of a [`TvdRun`] and the counts of the dropped ones.
+struct Candidates {
+    /// Pseudoforces p_u of the kept candidates (m × cols, column-major).
+    coef: Vec<f64>,
+    /// Which `(i, k, j)` each kept column is.
+    index: Vec<TvdIndex>,
+    /// For each base vector j, the active pairs for `k = −1` and `k = +1`.
+    active: Vec<[Vec<bool>; 2]>,
+    zero_columns: usize,
+    negligible_columns: usize,
+}
+
+impl Candidates {
+    /// The pseudoforce p_u of kept column `c` (m values).
+    fn col(&self, c: usize, m: usize) -> &[f64] {
+        &self.coef[c * m..(c + 1) * m]
+    }
+}
+
+impl<'a> TvdRun<'a> {
+    fn new(model: &'a Model, base: MatRef<'a, f64>, opts: &TvdOptions) -> Self {
+        let joint = &model.joint;
+        let w = joint.pairs();
+        let bphi = joint.reduce(base); // 3w × nb
+        let per_pair: &[usize] = if opts.tangential {
+            &[NORMAL, T1, T2]
+        } else {
+            &[NORMAL]
+        };
+        let used: Vec<usize> = (0..w)
+            .flat_map(|z| per_pair.iter().map(move |&r| 3 * z + r))
+            .collect();
+        TvdRun {
+            model,
+            base,
+            bphi,
+            used,
         }
     }
-    // Eq. (15) per vibration mode: (K − Ω_i² M) φ = f − ∂Ω_i²/∂q M φ_i, sparse LU.
-    let mut lu_symbolic: Option<SymbolicLu<usize>> = None;
-    for i in 0..nb {
-        let om2 = omega2[i];
-        if om2 == 0.0 {
-            continue;
+
+    /// The pseudoforces `p_u = D_{k,j} B_u φ_i` of all `2 nb²` candidates, columns ordered j,
+    /// then k = −1, +1, then i; zero and negligible ones dropped and counted.
+    fn candidates(&self, opts: &TvdOptions) -> Candidates {
+        let (bphi, used) = (&self.bphi, &self.used);
+        let w = self.model.joint.pairs();
+        let kn = self.model.contact.normal_stiffness;
+        let kt = self.model.contact.stick_stiffness;
+        let nb = self.base.ncols();
+        let stiff = |r: usize| if r % 3 == NORMAL { kn } else { kt };
+        // Joint scale of each φ_i over the rows that receive stiffness.
+        let joint_scale: Vec<f64> = (0..nb)
+            .map(|i| used.iter().fold(0.0f64, |a, &r| a.max(bphi[(r, i)].abs())))
+            .collect();
+        let max_stiff = if opts.tangential { kn.max(kt) } else { kn };
+
+        let mut out = Candidates {
+            coef: Vec::new(),
+            index: Vec::new(),
+            active: Vec::with_capacity(nb),
+            zero_columns: 0,
+            negligible_columns: 0,
+        };
+        let mut p = vec![0.0; used.len()];
+        for j in 0..nb {
+            let gaps: Vec<f64> = (0..w).map(|z| bphi[(3 * z + NORMAL, j)]).collect();
+            let act = [
+                active_pairs(&gaps, -1.0, opts),
+                active_pairs(&gaps, 1.0, opts),
+            ];
+            for (ki, k) in [-1i8, 1].into_iter().enumerate() {
+                for i in 0..nb {
+                    for (pa, &r) in p.iter_mut().zip(used) {
+                        *pa = if act[ki][r / 3] {
+                            stiff(r) * bphi[(r, i)]
+                        } else {
+                            0.0
+                        };
+                    }
+                    let pmax = p.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+                    if pmax == 0.0 {
+                        out.zero_columns += 1;
+                        continue;
+                    }
+                    if pmax <= opts.tol * max_stiff * joint_scale[i] {
+                        out.negligible_columns += 1;
+                        continue;
+                    }
+                    out.coef.extend_from_slice(&p);
+                    out.index.push(TvdIndex { i, k, j });
+                }
+            }
+            out.active.push(act);
         }
-        let mode_cols: Vec<usize> = (0..cols).filter(|&c| index[c].i == i).collect();
-        if mode_cols.is_empty() {
-            continue;
+        out
+    }
+
+    /// The static columns `static_cols` (eqs. 16/18) through one Cholesky of K: their
+    /// K-normalized vectors `Z C` (n × static_cols.len()) and the factor form Z, G, C; the
+    /// K-norms go to `k_norms`.
+    fn static_columns(
+        &self,
+        cand: &Candidates,
+        static_cols: &[usize],
+        k_norms: &mut [f64],
+    ) -> Result<(Mat<f64>, TvdFactor), Error> {
+        let (model, used) = (self.model, &self.used);
+        let m = used.len();
+        let chol = SparseCholesky::new(&model.stiffness)?;
+        let bt = joint_rows_transposed(&model.joint, used, model.dofs());
+        let z = solve_refined_steps(&model.stiffness, &chol, &bt, 1);
+        let g = symmetric(&rows_times(&model.joint, used, z.as_ref()));
+        let pc = Mat::from_fn(m, static_cols.len(), |r, c| cand.col(static_cols[c], m)[r]);
+        let scaled = normalize(&g, pc, static_cols, &cand.index, k_norms)?;
+        let xs = &z * &scaled;
+        let factor = TvdFactor {
+            flexibility: z,
+            joint_flexibility: g,
+            coefficients: scaled,
+        };
+        Ok((xs, factor))
+    }
+
+    /// Eq. (15) per vibration mode (`omega2[i] ≠ 0`): `(K − Ω_i² M) φ = f − ∂Ω_i²/∂q M φ_i`,
+    /// sparse LU; the K-normalized columns go to `x`, their K-norms to `k_norms`.
+    fn inertia_columns(
+        &self,
+        cand: &Candidates,
+        omega2: &[f64],
+        x: &mut Mat<f64>,
+        k_norms: &mut [f64],
+    ) -> Result<(), Error> {
+        let model = self.model;
+        let cols = cand.index.len();
+        let mut lu_symbolic: Option<SymbolicLu<usize>> = None;
+        for (i, &om2) in omega2.iter().enumerate() {
+            if om2 == 0.0 {
+                continue;
+            }
+            let mode_cols: Vec<usize> = (0..cols).filter(|&c| cand.index[c].i == i).collect();
+            if mode_cols.is_empty() {
+                continue;
+            }
+            let rhs = self.mode_rhs(cand, i, &mode_cols);
+            let mut z = shifted_solve(model, om2, &rhs, &mut lu_symbolic, i)?;
+            let kz = sym_mul_mat(&model.stiffness, z.as_ref());
+            scale_to_unit_energy(&mut z, &kz, &mode_cols, &cand.index, k_norms)?;
+            for (a, &c) in mode_cols.iter().enumerate() {
+                x.col_mut(c).copy_from(z.col(a));
+            }
         }
-        let phi: Vec<f64> = base.col(i).iter().copied().collect();
+        Ok(())
+    }
+
+    /// The right-hand sides `f − ∂Ω²/∂q M φ_i` of mode i's columns `mode_cols` (n × len), to be
+    /// solved directly (`Z_i = (K − Ω²M)⁻¹ B_uᵀ` would be dominated by the near-resonant
+    /// direction and cancel in the combinations).
+    fn mode_rhs(&self, cand: &Candidates, i: usize, mode_cols: &[usize]) -> Mat<f64> {
+        let (model, used) = (self.model, &self.used);
+        let n = model.dofs();
+        let m = used.len();
+        let phi: Vec<f64> = self.base.col(i).iter().copied().collect();
         let mut mphi = vec![0.0; n];
         sym_mul_vec_into(&model.mass, &phi, &mut mphi);
         let phi_m_phi: f64 = phi.iter().zip(&mphi).map(|(a, b)| a * b).sum();
-        // Right-hand sides f − ∂Ω²/∂q M φ_i, solved directly (Z_i = (K − Ω²M)⁻¹ B_uᵀ would
-        // be dominated by the near-resonant direction and cancel in the combinations).
         let mut rhs = Mat::<f64>::zeros(n, mode_cols.len());
-        let mut full = vec![0.0; 3 * w];
+        let mut full = vec![0.0; 3 * model.joint.pairs()];
         for (a, &c) in mode_cols.iter().enumerate() {
-            let pu = coef_col(c);
+            let pu = cand.col(c, m);
             full.iter_mut().for_each(|v| *v = 0.0);
             for (&u, v) in used.iter().zip(pu) {
                 full[u] = *v;
             }
             let mut f = vec![0.0; n];
-            joint.apply_transpose_add(&full, &mut f);
-            let phi_f: f64 = used.iter().zip(pu).map(|(&u, v)| bphi[(u, i)] * v).sum();
+            model.joint.apply_transpose_add(&full, &mut f);
+            let phi_f: f64 = used
+                .iter()
+                .zip(pu)
+                .map(|(&u, v)| self.bphi[(u, i)] * v)
+                .sum();
             let dom2 = phi_f / phi_m_phi;
             for r in 0..n {
                 rhs[(r, a)] = f[r] - dom2 * mphi[r];
             }
         }
-        let mut z = shifted_solve(model, om2, &rhs, &mut lu_symbolic, i)?;
-        let kz = sym_mul_mat(&model.stiffness, z.as_ref());
-        scale_to_unit_energy(&mut z, &kz, &mode_cols, &index, &mut k_norms)?;
-        for (a, &c) in mode_cols.iter().enumerate() {
-            x.col_mut(c).copy_from(z.col(a));
-        }
+        rhs
     }
-    Ok(Tvd {
-        vectors: x,
-        index,
-        k_norms,
-        total,
-        zero_columns,
-        negligible_columns,
-        active: active_all,
-        omega2,
-        factor,
-    })
 }
 
 /// `Ω_i²` of each base column for eq. (15): the Rayleigh quotient of the columns that vanish

@@ -209,152 +209,192 @@ impl<P: OdeProblem> Cvode<P> {
             roots_found: 0,
             saved_y: Vec::with_capacity(n),
         };
-        // Per-component absolute tolerances (CVODE copies the vector).
-        let mut scale = vec![0.0; n];
-        let atol_vector = if cvode.shared.get().problem.atol_scale(&mut scale) {
-            if let Some((i, s)) = scale
-                .iter()
-                .enumerate()
-                .find(|(_, s)| !(s.is_finite() && **s > 0.0))
-            {
-                return Err(Error::Invalid(format!(
-                    "the problem's absolute-tolerance scale[{i}] = {s} is not finite and > 0"
-                )));
-            }
-            scale.iter_mut().for_each(|s| *s *= opts.atol);
-            Some(SerialVector::from_slice(&context, &scale)?)
-        } else {
-            None
-        };
-        let m = cvode.mem.as_raw();
-        let user_data = cvode.shared.as_user_data();
-        // SAFETY: (also for the blocks below that say "see above") `m` is live CVODE memory
-        // owned by `cvode`; `user_data` points to the boxed Shared<P> that `cvode` frees only
-        // after CVodeFree; vectors, matrices and solvers passed are owned by `cvode` and
-        // outlive the memory (field order). The trampolines' type parameter is this problem
-        // type.
+        let atol_vector = cvode.atol_vector(&context, opts.atol)?;
+        cvode.init(t0, opts, atol_vector.as_ref())?;
+        match opts.iteration {
+            Iteration::Functional { anderson } => cvode.attach_fixed_point(&context, anderson)?,
+            Iteration::Newton {
+                linear: NewtonLinear::DenseDq,
+            } => cvode.attach_dense_dq(&context)?,
+            Iteration::Newton {
+                linear: NewtonLinear::Problem,
+            } => cvode.attach_problem_solver(&context)?,
+        }
+        cvode.set_step_options(opts)?;
+        Ok(cvode)
+    }
+
+    /// Per-component absolute tolerances `atol · scale` if the problem gives a scale
+    /// ([`OdeProblem::atol_scale`]), checked finite and positive; `None` for a scalar `atol`.
+    fn atol_vector(&self, context: &Context, atol: f64) -> Result<Option<SerialVector>, Error> {
+        let mut scale = vec![0.0; self.shared.get().n];
+        if !self.shared.get().problem.atol_scale(&mut scale) {
+            return Ok(None);
+        }
+        if let Some((i, s)) = scale
+            .iter()
+            .enumerate()
+            .find(|(_, s)| !(s.is_finite() && **s > 0.0))
+        {
+            return Err(Error::Invalid(format!(
+                "the problem's absolute-tolerance scale[{i}] = {s} is not finite and > 0"
+            )));
+        }
+        scale.iter_mut().for_each(|s| *s *= atol);
+        Ok(Some(SerialVector::from_slice(context, &scale)?))
+    }
+
+    /// Initializes the CVODE memory: error handler, right-hand side and `y(t0)`, tolerances
+    /// (per component with `atol_vector`, which CVODE copies), user data.
+    fn init(
+        &mut self,
+        t0: f64,
+        opts: &OdeOptions,
+        atol_vector: Option<&SerialVector>,
+    ) -> Result<(), Error> {
+        let m = self.mem.as_raw();
+        let user_data = self.shared.as_user_data();
+        // SAFETY: (also for the blocks of the other attach/set methods called by `new` that say
+        // "as in `init`") `m` is live CVODE memory owned by `self`; `user_data` points to the
+        // boxed Shared<P> that `self` frees only after CVodeFree; vectors, matrices and solvers
+        // passed are owned by `self` and outlive the memory (field order). The trampolines'
+        // type parameter is this problem type.
         unsafe {
-            cvode.check_cv(
+            self.check_cv(
                 "CVodeSetErrHandlerFn",
                 CVodeSetErrHandlerFn(m, Some(callbacks::error_handler::<P>), user_data),
             )?;
-            cvode.check_cv(
+            self.check_cv(
                 "CVodeInit",
-                CVodeInit(m, Some(callbacks::rhs::<P>), t0, cvode.y.as_raw()),
+                CVodeInit(m, Some(callbacks::rhs::<P>), t0, self.y.as_raw()),
             )?;
-            match &atol_vector {
-                Some(v) => cvode.check_cv(
+            match atol_vector {
+                Some(v) => self.check_cv(
                     "CVodeSVtolerances",
                     CVodeSVtolerances(m, opts.rtol, v.as_raw()),
                 )?,
-                None => cvode.check_cv(
+                None => self.check_cv(
                     "CVodeSStolerances",
                     CVodeSStolerances(m, opts.rtol, opts.atol),
                 )?,
             }
             // Before the linear solver: CVLS copies user_data as the preconditioner's data.
-            cvode.check_cv("CVodeSetUserData", CVodeSetUserData(m, user_data))?;
+            self.check_cv("CVodeSetUserData", CVodeSetUserData(m, user_data))?;
         }
-        match opts.iteration {
-            Iteration::Functional { anderson } => {
-                let depth = c_int::try_from(anderson).map_err(|_| {
-                    Error::Invalid(format!("iteration.anderson = {anderson} is too large"))
-                })?;
-                // SAFETY: `y` is a live template vector and the context is live; the new solver
-                // (or null) is owned by `nls` alone.
-                let nls = unsafe {
-                    let raw = SUNNonlinSol_FixedPoint(cvode.y.as_raw(), depth, context.as_raw());
-                    Owned::<NonlinearSolver>::new(raw, "SUNNonlinSol_FixedPoint", &context)
-                }?;
-                let raw = nls.as_raw();
-                cvode.nls = Some(nls);
-                // SAFETY: see above; `cvode.nls` owns the solver and frees it after CVodeFree.
-                unsafe {
-                    cvode.check_cv("CVodeSetNonlinearSolver", CVodeSetNonlinearSolver(m, raw))?;
-                }
-            }
-            Iteration::Newton {
-                linear: NewtonLinear::DenseDq,
-            } => {
-                // n ≤ i64::MAX: SerialVector::from_slice checked it.
-                let nn = n as i64;
-                // SAFETY: the context is live; SUNDenseMatrix returns a new matrix (or null),
-                // owned by `a` alone.
-                let a = unsafe {
-                    let raw = SUNDenseMatrix(nn, nn, context.as_raw());
-                    Owned::<Matrix>::new(raw, "SUNDenseMatrix", &context)
-                }?;
-                // SAFETY: `y` and `a` are live and compatible (n × n, length n); the new solver
-                // (or null) is owned by `ls` alone.
-                let ls = unsafe {
-                    let raw = SUNLinSol_Dense(cvode.y.as_raw(), a.as_raw(), context.as_raw());
-                    Owned::<LinearSolver>::new(raw, "SUNLinSol_Dense", &context)
-                }?;
-                let (ls_raw, a_raw) = (ls.as_raw(), a.as_raw());
-                cvode.matrix = Some(a);
-                cvode.ls = Some(ls);
-                cvode.linear = Linear::DenseDq;
-                // SAFETY: see above. No Jacobian function: CVODE's difference quotients.
-                unsafe {
-                    cvode.check_ls(
-                        "CVodeSetLinearSolver",
-                        CVodeSetLinearSolver(m, ls_raw, a_raw),
-                    )?;
-                }
-            }
-            Iteration::Newton {
-                linear: NewtonLinear::Problem,
-            } => {
-                let ls = problem_ls::new(&context)?;
-                let ls_raw = ls.as_raw();
-                cvode.ls = Some(ls);
-                cvode.linear = Linear::Problem;
-                // SAFETY: see above; the solver is matrix-free (NULL matrix).
-                unsafe {
-                    cvode.check_ls(
-                        "CVodeSetLinearSolver",
-                        CVodeSetLinearSolver(m, ls_raw, std::ptr::null_mut()),
-                    )?;
-                    cvode.check_ls(
-                        "CVodeSetPreconditioner",
-                        CVodeSetPreconditioner(
-                            m,
-                            Some(callbacks::newton_setup::<P>),
-                            Some(callbacks::newton_solve::<P>),
-                        ),
-                    )?;
-                    cvode.check_ls("CVodeSetEpsLin", CVodeSetEpsLin(m, PROBLEM_EPS_LIN))?;
-                }
-            }
+        Ok(())
+    }
+
+    /// Functional iteration: attaches a fixed-point solver with Anderson depth `anderson`.
+    fn attach_fixed_point(&mut self, context: &Context, anderson: usize) -> Result<(), Error> {
+        let m = self.mem.as_raw();
+        let depth = c_int::try_from(anderson)
+            .map_err(|_| Error::Invalid(format!("iteration.anderson = {anderson} is too large")))?;
+        // SAFETY: `y` is a live template vector and the context is live; the new solver
+        // (or null) is owned by `nls` alone.
+        let nls = unsafe {
+            let raw = SUNNonlinSol_FixedPoint(self.y.as_raw(), depth, context.as_raw());
+            Owned::<NonlinearSolver>::new(raw, "SUNNonlinSol_FixedPoint", context)
+        }?;
+        let raw = nls.as_raw();
+        self.nls = Some(nls);
+        // SAFETY: as in `init`; `self.nls` owns the solver and frees it after CVodeFree.
+        unsafe {
+            self.check_cv("CVodeSetNonlinearSolver", CVodeSetNonlinearSolver(m, raw))?;
         }
+        Ok(())
+    }
+
+    /// Newton with a dense LU and CVODE's difference-quotient Jacobian.
+    fn attach_dense_dq(&mut self, context: &Context) -> Result<(), Error> {
+        let m = self.mem.as_raw();
+        // n ≤ i64::MAX: SerialVector::from_slice checked it.
+        let nn = self.shared.get().n as i64;
+        // SAFETY: the context is live; SUNDenseMatrix returns a new matrix (or null),
+        // owned by `a` alone.
+        let a = unsafe {
+            let raw = SUNDenseMatrix(nn, nn, context.as_raw());
+            Owned::<Matrix>::new(raw, "SUNDenseMatrix", context)
+        }?;
+        // SAFETY: `y` and `a` are live and compatible (n × n, length n); the new solver
+        // (or null) is owned by `ls` alone.
+        let ls = unsafe {
+            let raw = SUNLinSol_Dense(self.y.as_raw(), a.as_raw(), context.as_raw());
+            Owned::<LinearSolver>::new(raw, "SUNLinSol_Dense", context)
+        }?;
+        let (ls_raw, a_raw) = (ls.as_raw(), a.as_raw());
+        self.matrix = Some(a);
+        self.ls = Some(ls);
+        self.linear = Linear::DenseDq;
+        // SAFETY: as in `init`. No Jacobian function: CVODE's difference quotients.
+        unsafe {
+            self.check_ls(
+                "CVodeSetLinearSolver",
+                CVodeSetLinearSolver(m, ls_raw, a_raw),
+            )?;
+        }
+        Ok(())
+    }
+
+    /// Newton with the problem's own solver through [`problem_ls`] (matrix-free, as a
+    /// preconditioner).
+    fn attach_problem_solver(&mut self, context: &Context) -> Result<(), Error> {
+        let m = self.mem.as_raw();
+        let ls = problem_ls::new(context)?;
+        let ls_raw = ls.as_raw();
+        self.ls = Some(ls);
+        self.linear = Linear::Problem;
+        // SAFETY: as in `init`; the solver is matrix-free (NULL matrix).
+        unsafe {
+            self.check_ls(
+                "CVodeSetLinearSolver",
+                CVodeSetLinearSolver(m, ls_raw, std::ptr::null_mut()),
+            )?;
+            self.check_ls(
+                "CVodeSetPreconditioner",
+                CVodeSetPreconditioner(
+                    m,
+                    Some(callbacks::newton_setup::<P>),
+                    Some(callbacks::newton_solve::<P>),
+                ),
+            )?;
+            self.check_ls("CVodeSetEpsLin", CVodeSetEpsLin(m, PROBLEM_EPS_LIN))?;
+        }
+        Ok(())
+    }
+
+    /// The step options (maximum order, steps and step size, initial step, stability-limit
+    /// detection) and the event functions.
+    fn set_step_options(&mut self, opts: &OdeOptions) -> Result<(), Error> {
+        let m = self.mem.as_raw();
+        let nroots = self.shared.get().nroots;
         let max_order = opts.max_order as c_int; // validated ≤ 12
         let max_steps = c_long::try_from(opts.max_steps).unwrap_or(c_long::MAX);
-        // SAFETY: see above.
+        // SAFETY: as in `init`.
         unsafe {
-            cvode.check_cv("CVodeSetMaxOrd", CVodeSetMaxOrd(m, max_order))?;
-            cvode.check_cv("CVodeSetMaxNumSteps", CVodeSetMaxNumSteps(m, max_steps))?;
+            self.check_cv("CVodeSetMaxOrd", CVodeSetMaxOrd(m, max_order))?;
+            self.check_cv("CVodeSetMaxNumSteps", CVodeSetMaxNumSteps(m, max_steps))?;
             if opts.max_step > 0.0 {
-                cvode.check_cv("CVodeSetMaxStep", CVodeSetMaxStep(m, opts.max_step))?;
+                self.check_cv("CVodeSetMaxStep", CVodeSetMaxStep(m, opts.max_step))?;
             }
             if opts.init_step > 0.0 {
-                cvode.check_cv("CVodeSetInitStep", CVodeSetInitStep(m, opts.init_step))?;
+                self.check_cv("CVodeSetInitStep", CVodeSetInitStep(m, opts.init_step))?;
             }
             if opts.stab_lim_det {
-                cvode.check_cv("CVodeSetStabLimDet", CVodeSetStabLimDet(m, 1))?;
+                self.check_cv("CVodeSetStabLimDet", CVodeSetStabLimDet(m, 1))?;
             }
             if nroots > 0 {
                 let nr = c_int::try_from(nroots)
                     .map_err(|_| Error::Invalid(format!("num_roots() = {nroots} is too large")))?;
-                cvode.check_cv(
+                self.check_cv(
                     "CVodeRootInit",
                     CVodeRootInit(m, nr, Some(callbacks::roots::<P>)),
                 )?;
                 // Event functions that are identically zero at the start (e.g. the gap of an
                 // open contact at rest) are legitimate: no warning.
-                cvode.check_cv("CVodeSetNoInactiveRootWarn", CVodeSetNoInactiveRootWarn(m))?;
+                self.check_cv("CVodeSetNoInactiveRootWarn", CVodeSetNoInactiveRootWarn(m))?;
             }
         }
-        Ok(cvode)
+        Ok(())
     }
 
     /// Integrates to `tout` (CVODE's `CV_NORMAL` task: internal steps past `tout`, then

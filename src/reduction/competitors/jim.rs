@@ -1,4 +1,4 @@
-//! Joint Interface Modes (Witteveen & Irschik 2009, reference [10] of the paper; the competitor
+//! Joint Interface Modes (Witteveen & Irschik 2009, reference \[10\] of the paper; the competitor
 //! of Witteveen & Pichler 2014, Section 5.3).
 //!
 //! "The structure is statically condensed to the DOF of the joints. This condensation leads to a
@@ -51,11 +51,9 @@
 //! Only the lowest modes are resolved: μ below `1e-12 μ_max` (a numerically infinite frequency;
 //! the friction bar's in-plane set reaches ~1e5 Hz by its 30th mode) is an error if requested.
 //!
-//! [`JimSet::Both`] merges the two sets' modes by eigenvalue, ascending.
-//!
-//! Measured (ν = 10 Craig–Bampton, `tests/competitors.rs`): the friction bar's lowest JIM are
-//! 87 Hz (normal) and 244 Hz (in-plane), the first 30 of `Both` are 25 normal + 5 in-plane; the
-//! multilayer's 186 Hz and 366 Hz, 26 + 4.
+//! [`JimSet::Both`] merges the two sets' modes by eigenvalue, ascending. The built-in cases'
+//! lowest JIM frequencies and how `Both` mixes the sets are in `docs/measurements.md`, section
+//! `reduction::competitors::jim`.
 
 use faer::linalg::triangular_solve::{
     solve_lower_triangular_in_place, solve_upper_triangular_in_place,

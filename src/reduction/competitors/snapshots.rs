@@ -2,7 +2,7 @@
 //!
 //! The snapshot matrix `Y = [x(t_0) x(t_1) … x(t_{z−1})]` (n × z, mm and rad) holds displacement
 //! states of a time integration of the full nonlinear system (eq. 2). Its POD is the same
-//! computation as the POD of the TVD (eqs. 20–26, [`super::pod()`]): the eigenproblem
+//! computation as the POD of the TVD (eqs. 20–26, [`crate::reduction::pod()`]): the eigenproblem
 //! `Yᵀ A Y û_i = λ_i û_i` of the z × z correlation matrix (the "method of snapshots"), the
 //! proper orthogonal modes `u_i = Y û_i / √λ_i`, A-orthonormal, and the captured-energy ratio
 //! `w(g) = Σ_{i≤g} λ_i / Σ_i λ_i` (eq. 26). The paper's Section 5.2 uses the Euclidean
