@@ -1,11 +1,13 @@
 #!/usr/bin/env bash
-# Runs the CVODE wrapper's tests (tests/cvode.rs) under valgrind's memcheck: fails on any
-# invalid access, use of uninitialised memory or *definite* leak (e.g. a SUNDIALS object not
-# freed, a custom linear solver's content leaked by a missing ops.free).
+# Runs the CVODE wrapper's tests (tests/integrate/cvode.rs, i.e. the `cvode::` tests of the
+# `integrate` test binary) under valgrind's memcheck: fails on any invalid access, use of
+# uninitialised memory or *definite* leak (e.g. a SUNDIALS object not freed, a custom linear
+# solver's content leaked by a missing ops.free).
 #
 # "Possibly lost" and "still reachable" blocks are reported but not errors: the Rust test
-# harness keeps its threads' state alive at exit. Extra arguments go to the test binary
-# (e.g. a test name filter).
+# harness keeps its threads' state alive at exit. Extra arguments go to the test binary instead
+# of the default filter `cvode::` (e.g. `cvode::stop_time_and_reinit`; a filter matching tests of
+# other modules of the binary runs those too).
 #
 # Usage: scripts/valgrind.sh [TEST_FILTER...]
 set -euo pipefail
@@ -18,12 +20,17 @@ if ! command -v valgrind >/dev/null; then
 fi
 
 # The test binary's path, from cargo's JSON messages (no jq needed).
-binary=$(cargo test --release --test cvode --no-run --message-format=json 2>/dev/null |
-    grep '"executable":"' | grep '"name":"cvode"' | tail -n 1 |
+binary=$(cargo test --release --test integrate --no-run --message-format=json 2>/dev/null |
+    grep '"executable":"' | grep '"name":"integrate"' | tail -n 1 |
     sed -E 's/.*"executable":"([^"]+)".*/\1/')
 if [[ -z "$binary" || ! -x "$binary" ]]; then
-    echo "could not build or find the tests/cvode.rs binary" >&2
+    echo "could not build or find the tests/integrate/ binary" >&2
     exit 2
+fi
+
+args=("$@")
+if [[ ${#args[@]} -eq 0 ]]; then
+    args=(cvode::)
 fi
 
 start=$(date +%s)
@@ -34,9 +41,9 @@ RUST_BACKTRACE=0 valgrind \
     --errors-for-leak-kinds=definite \
     --show-leak-kinds=definite,possible \
     --error-exitcode=1 \
-    "$binary" --test-threads=1 "$@" || {
+    "$binary" --test-threads=1 "${args[@]}" || {
     status=$?
-    echo "valgrind: tests/cvode.rs FAILED (exit $status: memory errors, definite leaks or a failing test)" >&2
+    echo "valgrind: tests/integrate/ ${args[*]} FAILED (exit $status: memory errors, definite leaks or a failing test)" >&2
     exit "$status"
 }
-echo "valgrind: tests/cvode.rs clean (no memory errors, no definite leaks) in $(($(date +%s) - start)) s"
+echo "valgrind: tests/integrate/ ${args[*]} clean (no memory errors, no definite leaks) in $(($(date +%s) - start)) s"

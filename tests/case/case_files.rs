@@ -1,21 +1,23 @@
 //! Loading cases from files and by name: `Case::from_file`, `Case::load`, and the errors that
 //! name the file.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use jointrom::case::Case;
 use jointrom::Error;
 
+use crate::common;
+
 /// A scratch file under Cargo's per-target temporary directory.
 fn scratch(name: &str, text: &str) -> PathBuf {
-    let path = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("case_files_{name}"));
+    let path = common::tmp_path(&format!("case_files_{name}"));
     std::fs::write(&path, text).expect("write scratch case");
     path
 }
 
 #[test]
 fn a_missing_file_is_an_io_error_naming_it() {
-    let path = Path::new(env!("CARGO_TARGET_TMPDIR")).join("no_such_dir/no_such_case.json");
+    let path = common::tmp_path("no_such_dir/no_such_case.json");
     match Case::from_file(&path) {
         Err(err @ Error::Io { .. }) => {
             let Error::Io { file, source } = &err else {
@@ -31,16 +33,13 @@ fn a_missing_file_is_an_io_error_naming_it() {
 
 #[test]
 fn a_file_loads_and_is_labelled_by_its_path() {
-    let path = scratch(
-        "friction_bar.json",
-        include_str!("../cases/friction_bar.json"),
-    );
+    let path = scratch("friction_bar.json", &common::case_text("friction_bar"));
     let label = path.display().to_string();
     let from_file = Case::from_file(&path).expect("valid file");
     assert_eq!(from_file.source, label);
     let loaded = Case::load(&label).expect("load by path");
     assert_eq!(loaded.source, label);
-    let builtin = Case::builtin("friction_bar").unwrap().unwrap();
+    let builtin = common::builtin_case("friction_bar");
     assert_eq!(
         Case {
             source: builtin.source.clone(),
@@ -52,8 +51,8 @@ fn a_file_loads_and_is_labelled_by_its_path() {
 
 #[test]
 fn errors_in_a_file_name_the_file() {
-    let text = include_str!("../cases/friction_bar.json")
-        .replace("\"thickness\": 0.5", "\"thickness\": -0.5");
+    let text =
+        common::case_text("friction_bar").replace("\"thickness\": 0.5", "\"thickness\": -0.5");
     let path = scratch("bad_thickness.json", &text);
     match Case::load(&path.display().to_string()) {
         Err(Error::Case { file, path: at, .. }) => {

@@ -12,8 +12,8 @@
 use jointrom::integrate::mechanical::{run, Curves, TransientOptions};
 use jointrom::reduction::{build_basis, BasisKind, BasisOptions, ReducedModel};
 use jointrom::system::{FullSystem, ReducedSystem};
-use jointrom::Model;
-use serde_json::Value;
+
+use crate::common::{self, rel_l2};
 
 struct Reference {
     t: Vec<f64>,
@@ -23,12 +23,10 @@ struct Reference {
 }
 
 fn reference(name: &str) -> Reference {
-    let path = format!("{}/cases/reference/{name}.json", env!("CARGO_MANIFEST_DIR"));
-    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{path}: {e}"));
-    let v: Value = serde_json::from_str(&text).unwrap();
+    let (path, v) = common::reference_json(name);
     let arr = |k: &str| -> Vec<f64> {
         v[k].as_array()
-            .unwrap_or_else(|| panic!("{path}: no array {k}"))
+            .unwrap_or_else(|| panic!("{}: no array {k}", path.display()))
             .iter()
             .map(|x| x.as_f64().unwrap())
             .collect()
@@ -39,13 +37,6 @@ fn reference(name: &str) -> Reference {
         friction_force_norm: arr("friction_force_norm"),
         master_uy: arr("master_uy"),
     }
-}
-
-/// Relative L2 difference over the first `n` samples: `‖a − b‖₂ / ‖b‖₂`.
-fn rel_l2(a: &[f64], b: &[f64], n: usize) -> f64 {
-    let num: f64 = (0..n).map(|i| (a[i] - b[i]).powi(2)).sum();
-    let den: f64 = (0..n).map(|i| b[i].powi(2)).sum();
-    (num / den).sqrt()
 }
 
 /// (‖f_c‖, master uy, ‖f_R‖) relative L2 differences of a run against a reference over the
@@ -82,7 +73,7 @@ fn options(friction: bool, end: Option<f64>) -> TransientOptions {
 }
 
 fn rom_errors(friction: bool, g: Option<usize>, r: &Reference) -> (usize, f64, f64, f64) {
-    let model = Model::from_case_name("friction_bar").unwrap();
+    let model = common::model("friction_bar");
     let basis = build_basis(
         &model,
         BasisKind::Tvd,
@@ -115,7 +106,7 @@ fn rom_errors(friction: bool, g: Option<usize>, r: &Reference) -> (usize, f64, f
 /// default-vs-tight difference of the reference over this window bounds the tolerance.
 #[test]
 fn full_model_short_window_reproduces_the_stored_reference() {
-    let model = Model::from_case_name("friction_bar").unwrap();
+    let model = common::model("friction_bar");
     for (friction, name) in [
         (false, "friction_bar_full_friction_off"),
         (true, "friction_bar_full_friction_on"),

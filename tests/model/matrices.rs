@@ -4,9 +4,8 @@
 //! maps and matrices are rejected naming the file and the field.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
-use jointrom::integrate::mechanical::{self as transient, TransientOptions};
+use jointrom::integrate::mechanical as transient;
 use jointrom::joint::statics::ContactOptions;
 use jointrom::model::contact_static_full;
 use jointrom::reduction::{build_basis, BasisKind, BasisOptions, ReducedModel};
@@ -14,15 +13,14 @@ use jointrom::system::{FullSystem, ReducedSystem};
 use jointrom::Model;
 use serde_json::Value;
 
+use crate::common::{self, jointrom_err, jointrom_ok};
+
 fn tmp_dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("jointrom-matrices-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+    common::tmp_dir(&format!("matrices_{name}"))
 }
 
 fn exported(name: &str) -> (Model, PathBuf) {
-    let model = Model::from_case_name("friction_bar").unwrap();
+    let model = common::model("friction_bar");
     let dir = tmp_dir(name);
     let files = jointrom::model::matrices::write(&model, &dir).unwrap();
     assert_eq!(files.len(), 3);
@@ -30,7 +28,7 @@ fn exported(name: &str) -> (Model, PathBuf) {
 }
 
 fn load(path: &Path) -> Model {
-    Model::from_case_name(path.to_str().unwrap()).unwrap()
+    common::model(path.to_str().unwrap())
 }
 
 fn assert_same_model(a: &Model, b: &Model) {
@@ -90,10 +88,7 @@ fn friction_bar_round_trip_is_identical() {
     assert_eq!(ba.phi, bb.phi, "basis bit for bit");
 
     // Reduced transient with friction, 0–0.02 s, and the full model, 0–2 ms.
-    let ropts = TransientOptions {
-        end_time: Some(0.02),
-        ..TransientOptions::default()
-    };
+    let ropts = common::until(0.02);
     let ra = transient::run(
         ReducedSystem::new(&case, &ReducedModel::new(&case, ba.phi).unwrap()).unwrap(),
         &ropts,
@@ -107,10 +102,7 @@ fn friction_bar_round_trip_is_identical() {
     assert_eq!(ra.curves, rb.curves, "ROM curves identical");
     assert_eq!(ra.stats.steps, rb.stats.steps);
     assert!(ra.curves.contact_force_norm.iter().any(|&f| f > 0.0));
-    let fopts = TransientOptions {
-        end_time: Some(2e-3),
-        ..TransientOptions::default()
-    };
+    let fopts = common::until(2e-3);
     let fa = transient::run(FullSystem::new(&case).unwrap(), &fopts).unwrap();
     let fb = transient::run(FullSystem::new(&back).unwrap(), &fopts).unwrap();
     assert_eq!(fa.curves, fb.curves, "full-model curves identical");
@@ -199,30 +191,11 @@ fn rows_in_another_order_with_spc_rows_give_the_same_model() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-/// Runs the jointrom binary with `args`; its output.
-fn jointrom<S: AsRef<std::ffi::OsStr>>(args: &[S]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_jointrom"))
-        .args(args)
-        .output()
-        .unwrap()
-}
-
-/// Runs the jointrom binary with `args`, asserting success; its standard output.
-fn jointrom_ok<S: AsRef<std::ffi::OsStr>>(args: &[S]) -> Vec<u8> {
-    let out = jointrom(args);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    out.stdout
-}
-
 #[test]
 fn cli_info_and_quick_report_on_a_matrix_model() {
     let dir = tmp_dir("cli");
     let out_arg = dir.to_str().unwrap();
-    jointrom_ok(&[
+    jointrom_ok([
         "export-matrices",
         "friction_bar",
         "--json",
@@ -232,7 +205,7 @@ fn cli_info_and_quick_report_on_a_matrix_model() {
     let map = dir.join("model.json");
     let map_arg = map.to_str().unwrap();
     let info = |arg: &str| -> Value {
-        serde_json::from_slice(&jointrom_ok(&["info", "--json", arg])).unwrap()
+        serde_json::from_slice(&jointrom_ok(["info", "--json", arg])).unwrap()
     };
     let a = info("friction_bar");
     let b = info(map_arg);
@@ -256,7 +229,7 @@ fn cli_info_and_quick_report_on_a_matrix_model() {
     // The transient displacement field of a ROM run on the matrices, as a VTU series.
     let vtu = dir.join("vtu");
     let vtu_arg = vtu.to_str().unwrap();
-    jointrom_ok(&[
+    jointrom_ok([
         "transient",
         map_arg,
         "--end-time",
@@ -271,14 +244,13 @@ fn cli_info_and_quick_report_on_a_matrix_model() {
     assert!((5..=7).contains(&frames), "{frames} frames");
     let last = std::fs::read_to_string(vtu.join(format!("u_{:04}.vtu", frames - 1))).unwrap();
     assert!(last.contains(r#"Name="u_u""#));
-    let out = jointrom(&["transient", map_arg, "--vtu-frames", "0", "--vtu", vtu_arg]);
-    assert!(!out.status.success());
-    assert!(String::from_utf8_lossy(&out.stderr).contains("--vtu-frames"));
+    let err = jointrom_err(["transient", map_arg, "--vtu-frames", "0", "--vtu", vtu_arg]);
+    assert!(err.contains("--vtu-frames"));
 
     // The main job's quick report on the matrices: same accuracy figures as on the case.
     let report = |arg: &str, sub: &str| -> Value {
         let out_dir = dir.join(sub);
-        jointrom_ok(&[
+        jointrom_ok([
             "run",
             arg,
             "--quick",

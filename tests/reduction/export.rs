@@ -3,31 +3,21 @@
 //! is rejected naming the file and the field.
 
 use std::path::PathBuf;
-use std::process::Command;
 
-use jointrom::integrate::mechanical::{self as transient, TransientOptions};
+use jointrom::integrate::mechanical as transient;
 use jointrom::reduction::rom_file::{BasisInfo, RomFile};
 use jointrom::reduction::{build_basis, BasisKind, BasisOptions, ReducedModel};
 use jointrom::system::ReducedSystem;
-use jointrom::Model;
+
+use crate::common::{self, jointrom_json, jointrom_ok};
 
 fn tmp(name: &str) -> PathBuf {
-    std::env::temp_dir().join(format!(
-        "jointrom-export-{name}-{}.json",
-        std::process::id()
-    ))
-}
-
-fn options() -> TransientOptions {
-    TransientOptions {
-        end_time: Some(5e-3),
-        ..TransientOptions::default()
-    }
+    common::tmp_path(&format!("export_{name}.json"))
 }
 
 #[test]
 fn exported_rom_reintegrates_to_identical_curves() {
-    let model = Model::from_case_name("friction_bar").unwrap();
+    let model = common::model("friction_bar");
     let b = build_basis(&model, BasisKind::Tvd, &BasisOptions::default()).unwrap();
     let info = BasisInfo {
         kind: "tvd".into(),
@@ -53,8 +43,12 @@ fn exported_rom_reintegrates_to_identical_curves() {
             assert!((back.mass[i][j] - id).abs() < 1e-12);
         }
     }
-    let direct = transient::run(ReducedSystem::new(&model, &rom).unwrap(), &options()).unwrap();
-    let again = transient::run(back.system().unwrap(), &options()).unwrap();
+    let direct = transient::run(
+        ReducedSystem::new(&model, &rom).unwrap(),
+        &common::until(5e-3),
+    )
+    .unwrap();
+    let again = transient::run(back.system().unwrap(), &common::until(5e-3)).unwrap();
     assert_eq!(direct.curves, again.curves, "identical curves");
     assert_eq!(direct.stats.steps, again.stats.steps);
     assert!(direct.curves.contact_force_norm.last().unwrap() > &0.0);
@@ -66,7 +60,7 @@ type Damage = dyn Fn(&mut serde_json::Value);
 
 #[test]
 fn damaged_files_are_rejected_naming_the_field() {
-    let model = Model::from_case_name("friction_bar").unwrap();
+    let model = common::model("friction_bar");
     let b = build_basis(
         &model,
         BasisKind::Tvd,
@@ -139,38 +133,29 @@ fn damaged_files_are_rejected_naming_the_field() {
 
 #[test]
 fn cli_export_then_transient_from_the_file_matches_the_direct_run() {
-    let exe = env!("CARGO_BIN_EXE_jointrom");
     let path = tmp("cli");
-    let st = Command::new(exe)
-        .args(["export", "friction_bar", "--g", "5", "--out"])
-        .arg(&path)
-        .status()
-        .unwrap();
-    assert!(st.success());
+    jointrom_ok([
+        "export",
+        "friction_bar",
+        "--g",
+        "5",
+        "--out",
+        path.to_str().unwrap(),
+    ]);
     let run = |model: &str| {
-        let out = Command::new(exe)
-            .args([
-                "transient",
-                "friction_bar",
-                "--model",
-                model,
-                "--end-time",
-                "3e-3",
-                "--json",
-            ])
-            .args(if model == "tvd" {
-                vec!["--g", "5"]
-            } else {
-                vec![]
-            })
-            .output()
-            .unwrap();
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        let mut args = vec![
+            "transient",
+            "friction_bar",
+            "--model",
+            model,
+            "--end-time",
+            "3e-3",
+            "--json",
+        ];
+        if model == "tvd" {
+            args.extend(["--g", "5"]);
+        }
+        let v = jointrom_json(args);
         v["curves"].clone()
     };
     let from_file = run(&format!("file:{}", path.display()));

@@ -6,10 +6,10 @@ use std::collections::BTreeSet;
 use jointrom::case::Case;
 use jointrom::mesh::{Material, Mesh};
 
+use crate::common;
+
 fn builtin(name: &str) -> (Case, Mesh) {
-    let case = Case::builtin(name)
-        .unwrap_or_else(|| panic!("`{name}` is not a built-in case"))
-        .unwrap_or_else(|e| panic!("built-in `{name}` does not load: {e}"));
+    let case = common::builtin_case(name);
     let mesh = Mesh::from_case(&case).expect("built-in mesh");
     (case, mesh)
 }

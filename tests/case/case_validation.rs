@@ -6,6 +6,8 @@ use jointrom::mesh::Mesh;
 use jointrom::Error;
 use serde_json::{json, Value};
 
+use crate::common;
+
 const FILE: &str = "edited_friction_bar.json";
 
 /// Parses and validates a case as every command does: the fields when the file is read, the
@@ -17,7 +19,7 @@ fn validated(text: &str, file: &str) -> Result<Case, Error> {
 }
 
 fn friction_bar() -> Value {
-    serde_json::from_str(include_str!("../cases/friction_bar.json")).expect("builtin is JSON")
+    serde_json::from_str(&common::case_text("friction_bar")).expect("builtin is JSON")
 }
 
 /// Parses `text` and checks the error's file, path and that the reason contains `word`
@@ -54,7 +56,7 @@ fn edited(edit: impl FnOnce(&mut Value), path: &str, word: &str) {
 
 /// `build_mesh` on a case edited in code (for values JSON cannot hold).
 fn expect_mesh_err(edit: impl FnOnce(&mut Case), path: &str, word: &str) {
-    let mut case = Case::builtin("friction_bar").unwrap().unwrap();
+    let mut case = common::builtin_case("friction_bar");
     edit(&mut case);
     match Mesh::from_case(&case) {
         Err(Error::Case {
@@ -614,7 +616,7 @@ fn no_node_may_be_both_clamped_and_tied() {
 
 #[test]
 fn build_mesh_labels_errors_with_the_source() {
-    let mut case = Case::builtin("friction_bar").unwrap().unwrap();
+    let mut case = common::builtin_case("friction_bar");
     case.sheets[0].thickness = -1.0;
     let Err(err) = Mesh::from_case(&case) else {
         panic!("negative thickness accepted by build_mesh");

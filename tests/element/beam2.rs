@@ -4,7 +4,11 @@ use faer::linalg::solvers::Solve;
 use faer::{Mat, Side};
 use jointrom::element::{Beam2, Material};
 use jointrom::Error;
+use rand::rngs::StdRng;
 use std::f64::consts::PI;
+
+use crate::common;
+use crate::common::v3::{add, cross, dot, norm, scale, sub};
 
 const STEEL: Material = Material::STEEL;
 
@@ -15,20 +19,21 @@ const SLENDER: (f64, f64) = (200.0, 5.0);
 /// In between: 10 mm long, 5 mm thick (Φ ≈ 0.55).
 const MEDIUM: (f64, f64) = (10.0, 5.0);
 
-/// Deterministic pseudo-random numbers in [-1, 1) (64-bit LCG, Knuth's MMIX constants).
-struct Lcg(u64);
+/// Random 3-vectors from a seeded generator (the same on every run).
+trait RandomV3 {
+    /// Each component uniform in [-1, 1).
+    fn vec3(&mut self) -> [f64; 3];
+    /// A random unit vector.
+    fn unit(&mut self) -> [f64; 3];
+}
 
-impl Lcg {
-    fn next(&mut self) -> f64 {
-        self.0 = self
-            .0
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        ((self.0 >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
-    }
-
+impl RandomV3 for StdRng {
     fn vec3(&mut self) -> [f64; 3] {
-        [self.next(), self.next(), self.next()]
+        [
+            common::uniform(self),
+            common::uniform(self),
+            common::uniform(self),
+        ]
     }
 
     fn unit(&mut self) -> [f64; 3] {
@@ -42,36 +47,8 @@ impl Lcg {
     }
 }
 
-fn norm(v: [f64; 3]) -> f64 {
-    dot(v, v).sqrt()
-}
-
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-
-fn scale(v: [f64; 3], s: f64) -> [f64; 3] {
-    [v[0] * s, v[1] * s, v[2] * s]
-}
-
-fn add(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
-}
-
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
 /// A unit vector perpendicular to `e`, otherwise arbitrary.
-fn perpendicular(e: [f64; 3], rng: &mut Lcg) -> [f64; 3] {
+fn perpendicular(e: [f64; 3], rng: &mut StdRng) -> [f64; 3] {
     loop {
         let v = rng.unit();
         let p = sub(v, scale(e, dot(v, e)));
@@ -82,7 +59,7 @@ fn perpendicular(e: [f64; 3], rng: &mut Lcg) -> [f64; 3] {
 }
 
 /// Directions to test: the global axes (both signs), diagonals and random ones.
-fn directions(rng: &mut Lcg) -> Vec<[f64; 3]> {
+fn directions(rng: &mut StdRng) -> Vec<[f64; 3]> {
     let s = 1.0 / 3f64.sqrt();
     let mut d = vec![
         [1.0, 0.0, 0.0],
@@ -102,7 +79,7 @@ fn directions(rng: &mut Lcg) -> Vec<[f64; 3]> {
 }
 
 /// A beam of the given (length, diameter) along `e` from an arbitrary start point.
-fn beam_along(e: [f64; 3], (length, diameter): (f64, f64), rng: &mut Lcg) -> (Beam2, [f64; 3]) {
+fn beam_along(e: [f64; 3], (length, diameter): (f64, f64), rng: &mut StdRng) -> (Beam2, [f64; 3]) {
     let a = scale(rng.vec3(), 100.0);
     let b = add(a, scale(e, length));
     (Beam2::circular(a, b, diameter, STEEL).unwrap(), a)
@@ -123,10 +100,6 @@ fn mat_vec(m: &Mat<f64>, v: &[f64; 12]) -> [f64; 12] {
 fn quad(m: &Mat<f64>, v: &[f64; 12]) -> f64 {
     let mv = mat_vec(m, v);
     (0..12).map(|i| v[i] * mv[i]).sum()
-}
-
-fn vnorm(v: &[f64]) -> f64 {
-    v.iter().map(|x| x * x).sum::<f64>().sqrt()
 }
 
 /// Rigid motion u = t + θ × (x − p), rotation DOF = θ, at nodes `a`, `b`.
@@ -158,7 +131,7 @@ fn assert_close(what: &str, computed: f64, expected: f64, rtol: f64) {
 
 #[test]
 fn stiffness_and_mass_are_symmetric() {
-    let mut rng = Lcg(1);
+    let mut rng = common::rng(1);
     for e in directions(&mut rng) {
         for shape in [WELD, MEDIUM, SLENDER] {
             let (beam, _) = beam_along(e, shape, &mut rng);
@@ -179,7 +152,7 @@ fn stiffness_and_mass_are_symmetric() {
 
 #[test]
 fn mass_is_positive_definite() {
-    let mut rng = Lcg(2);
+    let mut rng = common::rng(2);
     for e in directions(&mut rng) {
         for shape in [WELD, MEDIUM, SLENDER] {
             let (beam, _) = beam_along(e, shape, &mut rng);
@@ -196,7 +169,7 @@ fn mass_is_positive_definite() {
 
 #[test]
 fn six_rigid_body_modes_give_zero_force() {
-    let mut rng = Lcg(3);
+    let mut rng = common::rng(3);
     for e in directions(&mut rng) {
         for shape in [WELD, MEDIUM, SLENDER] {
             let (beam, a) = beam_along(e, shape, &mut rng);
@@ -216,7 +189,7 @@ fn six_rigid_body_modes_give_zero_force() {
             modes.push(rigid(rng.vec3(), rng.vec3(), p, a, b));
             for r in &modes {
                 let f = mat_vec(&k, r);
-                let rel = vnorm(&f) / (knorm * vnorm(r));
+                let rel = common::norm(&f) / (knorm * common::norm(r));
                 assert!(
                     rel <= 1e-9,
                     "|K r| / (|K| |r|) = {rel:e} for rigid mode {r:?}, e = {e:?}, shape {shape:?}"
@@ -228,7 +201,7 @@ fn six_rigid_body_modes_give_zero_force() {
 
 #[test]
 fn stiffness_has_rank_six() {
-    let mut rng = Lcg(4);
+    let mut rng = common::rng(4);
     for e in directions(&mut rng) {
         for shape in [WELD, MEDIUM, SLENDER] {
             let (beam, _) = beam_along(e, shape, &mut rng);
@@ -282,7 +255,7 @@ fn assert_vec_close(what: &str, computed: [f64; 3], expected: [f64; 3], scale: f
 
 #[test]
 fn cantilever_matches_timoshenko_closed_form() {
-    let mut rng = Lcg(5);
+    let mut rng = common::rng(5);
     let ee = STEEL.youngs_modulus;
     let g = STEEL.shear_modulus();
     let rtol = 1e-10;
@@ -400,7 +373,7 @@ fn weld_is_shear_dominated() {
 
 #[test]
 fn lumped_mass_totals() {
-    let mut rng = Lcg(6);
+    let mut rng = common::rng(6);
     let rho = STEEL.density;
     for e in directions(&mut rng) {
         for shape in [WELD, MEDIUM, SLENDER] {
@@ -457,7 +430,7 @@ fn lumped_mass_totals() {
 /// Global matrices must rotate with the beam, whatever local y', z' the element picks.
 #[test]
 fn matrices_are_objective() {
-    let mut rng = Lcg(7);
+    let mut rng = common::rng(7);
     for shape in [WELD, MEDIUM] {
         for _ in 0..20 {
             let e = rng.unit();
@@ -501,7 +474,7 @@ fn matrices_are_objective() {
 /// Swapping the nodes gives the same element with the node blocks swapped.
 #[test]
 fn node_order_does_not_matter() {
-    let mut rng = Lcg(8);
+    let mut rng = common::rng(8);
     for _ in 0..10 {
         let e = rng.unit();
         let (beam, a) = beam_along(e, MEDIUM, &mut rng);

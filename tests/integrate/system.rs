@@ -10,21 +10,9 @@ use jointrom::joint::law::{PairLaw, PairState};
 use jointrom::reduction::ReducedModel;
 use jointrom::system::{FullSystem, ReducedSystem, SecondOrderSystem};
 use jointrom::Model;
+use rand::rngs::StdRng;
 
-struct Rng(u64);
-impl Rng {
-    /// Uniform in [−1, 1).
-    fn next(&mut self) -> f64 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        (self.0 >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
-    }
-}
-
-fn inf_norm(x: &[f64]) -> f64 {
-    x.iter().fold(0.0, |m, v| m.max(v.abs()))
-}
+use crate::common::{self, inf_norm};
 
 fn opts(friction: bool) -> ProblemOptions {
     ProblemOptions {
@@ -38,7 +26,7 @@ fn opts(friction: bool) -> ProblemOptions {
 /// (all closed pairs stick) or, for `slip`, |e| = 2c on closed pairs (they slide).
 fn state<S: SecondOrderSystem>(
     ode: &MechanicalOde<S>,
-    rng: &mut Rng,
+    rng: &mut StdRng,
     qs: f64,
     slip: bool,
     t_load: f64,
@@ -48,10 +36,10 @@ fn state<S: SecondOrderSystem>(
     let w = ode.system().pairs();
     let mut y = vec![0.0; ode.dim()];
     for v in &mut y[..n] {
-        *v = qs * rng.next();
+        *v = qs * common::uniform(rng);
     }
     for v in &mut y[n..2 * n] {
-        *v = rng.next();
+        *v = common::uniform(rng);
     }
     let mut u = vec![0.0; 3 * w];
     ode.system().joint_apply_into(&y[..n], &mut u);
@@ -60,7 +48,7 @@ fn state<S: SecondOrderSystem>(
         for k in 0..w {
             let c = law.mu * law.k_n * (-u[3 * k]).max(0.0) / law.k_t;
             let (e1, e2) = if slip && c > 0.0 {
-                let th = std::f64::consts::PI * rng.next();
+                let th = std::f64::consts::PI * common::uniform(rng);
                 (2.0 * c * th.cos(), 2.0 * c * th.sin())
             } else {
                 (0.0, 0.0)
@@ -229,11 +217,11 @@ fn newton_residual<S: SecondOrderSystem>(
     t: f64,
     y: &[f64],
     gamma: f64,
-    rng: &mut Rng,
+    rng: &mut StdRng,
     with_pt_g: bool,
 ) -> (f64, f64, f64) {
     let d = ode.dim();
-    let r: Vec<f64> = (0..d).map(|_| rng.next()).collect();
+    let r: Vec<f64> = (0..d).map(|_| common::uniform(rng)).collect();
     let mut fy = vec![0.0; d];
     ode.rhs(t, y, &mut fy).unwrap();
     assert!(ode.newton_setup(t, y, &fy, false, gamma).unwrap());
@@ -293,9 +281,9 @@ fn pair_forces_direct(law: &PairLaw, u: &[f64], s: &[f64]) -> Vec<f64> {
 
 #[test]
 fn full_rhs_matches_a_direct_computation() {
-    let model = Model::from_case_name("friction_bar").unwrap();
+    let model = common::model("friction_bar");
     let n = model.dofs();
-    let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
+    let mut rng = common::rng(0x9e37_79b9_7f4a_7c15);
     for (friction, slip) in [(false, false), (true, false), (true, true)] {
         let mut ode =
             MechanicalOde::new(FullSystem::new(&model).unwrap(), &opts(friction)).unwrap();
@@ -385,9 +373,9 @@ fn reduced_model(model: &Model, r: usize) -> ReducedModel {
 
 #[test]
 fn newton_solve_matches_i_minus_gamma_j() {
-    let model = Model::from_case_name("friction_bar").unwrap();
+    let model = common::model("friction_bar");
     let rom = reduced_model(&model, 30);
-    let mut rng = Rng(0x2545_f491_4f6c_dd1d);
+    let mut rng = common::rng(0x2545_f491_4f6c_dd1d);
     for gamma in [1e-6, 1e-5, 1e-4] {
         for friction in [false, true] {
             // Reduced (dense) system; q scale: reduced coordinates of a ~1e-3 mm deflection.
@@ -452,7 +440,7 @@ fn newton_solve_matches_i_minus_gamma_j() {
         // iteration does): measure the contraction rate (M̃ = I here, so the block operator is
         // exactly I − γJ).
         let d = ode.dim();
-        let r: Vec<f64> = (0..d).map(|_| rng.next()).collect();
+        let r: Vec<f64> = (0..d).map(|_| common::uniform(&mut rng)).collect();
         let mut z = vec![0.0; d];
         let mut steps = Vec::new();
         for _ in 0..4 {
@@ -475,10 +463,10 @@ fn newton_solve_matches_i_minus_gamma_j() {
 
 #[test]
 fn identity_reduction_agrees_with_the_full_system() {
-    let model = Model::from_case_name("friction_bar").unwrap();
+    let model = common::model("friction_bar");
     let n = model.dofs();
     let rom = ReducedModel::new(&model, Mat::identity(n, n)).unwrap();
-    let mut rng = Rng(0xdead_beef_cafe_f00d);
+    let mut rng = common::rng(0xdead_beef_cafe_f00d);
     for (friction, slip) in [(false, false), (true, true)] {
         let mut full =
             MechanicalOde::new(FullSystem::new(&model).unwrap(), &opts(friction)).unwrap();
@@ -519,7 +507,7 @@ fn identity_reduction_agrees_with_the_full_system() {
         let gamma = 1e-5;
         full.newton_setup(t, &y, &a, false, gamma).unwrap();
         red.newton_setup(t, &y, &b, false, gamma).unwrap();
-        let r: Vec<f64> = (0..d).map(|_| rng.next()).collect();
+        let r: Vec<f64> = (0..d).map(|_| common::uniform(&mut rng)).collect();
         let (mut za, mut zb) = (vec![0.0; d], vec![0.0; d]);
         full.newton_solve(t, &y, &r, &mut za, gamma).unwrap();
         red.newton_solve(t, &y, &r, &mut zb, gamma).unwrap();
@@ -534,7 +522,7 @@ fn identity_reduction_agrees_with_the_full_system() {
 /// run completes and the energy balance `E_kin + E_strain + E_pair + D − W` closes.
 #[test]
 fn friction_bar_rom_runs_and_balances_energy() {
-    let model = Model::from_case_name("friction_bar").unwrap();
+    let model = common::model("friction_bar");
     let basis = jointrom::reduction::build_basis(
         &model,
         jointrom::reduction::BasisKind::Tvd,
@@ -597,7 +585,7 @@ fn friction_bar_rom_runs_and_balances_energy() {
 /// Bad options are errors naming the field, not panics.
 #[test]
 fn bad_transient_options_are_errors() {
-    let model = Model::from_case_name("friction_bar").unwrap();
+    let model = common::model("friction_bar");
     let rom = ReducedModel::new(&model, Mat::identity(model.dofs(), 12)).unwrap();
     let bad = [
         (

@@ -3,6 +3,8 @@
 
 use jointrom::joint::law::{PairLaw, PairState, DEFAULT_TAU};
 
+use crate::common;
+
 fn law() -> PairLaw {
     PairLaw {
         k_n: 1e4,
@@ -109,13 +111,8 @@ fn cyclic_slip_dissipates_the_coulomb_loop_area() {
 #[test]
 fn dissipation_is_never_negative() {
     let law = law();
-    let mut seed = 0x1234_5678_9abc_def0u64;
-    let mut rnd = || {
-        seed ^= seed << 13;
-        seed ^= seed >> 7;
-        seed ^= seed << 17;
-        (seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
-    };
+    let mut rng = common::rng(0x1234_5678_9abc_def0);
+    let mut rnd = || common::uniform(&mut rng);
     for _ in 0..100_000 {
         let u = [1e-4 * rnd(), 1e-4 * rnd(), 1e-4 * rnd()];
         let s = [1e-4 * rnd(), 1e-4 * rnd()];

@@ -20,19 +20,7 @@ use jointrom::reduction::{
 };
 use jointrom::{Error, Model};
 
-fn mul(a: &SymCsc, x: &[f64]) -> Vec<f64> {
-    let mut y = vec![0.0; a.n];
-    a.mul_vec(x, &mut y);
-    y
-}
-
-fn col(a: MatRef<'_, f64>, c: usize) -> Vec<f64> {
-    a.col(c).iter().copied().collect()
-}
-
-fn norm(v: &[f64]) -> f64 {
-    v.iter().map(|x| x * x).sum::<f64>().sqrt()
-}
+use crate::common::{self, col, mul, norm};
 
 /// `Xᵀ A X` for sparse symmetric A.
 fn gram(a: &SymCsc, x: MatRef<'_, f64>) -> Mat<f64> {
@@ -123,7 +111,7 @@ fn rel_master(a: &[f64; 6], b: &[f64; 6]) -> f64 {
 #[test]
 fn jim_and_alldof_build_for_both_scenes_m_orthonormal() {
     for name in Case::BUILTIN {
-        let model = Model::from_case_name(name).unwrap();
+        let model = common::model(name);
         let w = model.joint.pairs();
         for (kind, g) in [
             (BasisKind::Jim, Some(20)),
@@ -274,7 +262,7 @@ fn check_condensed_eigenproblem(model: &Model, set: JimSet, count: usize) -> Vec
 #[test]
 fn jim_vectors_satisfy_the_condensed_eigenproblem() {
     for name in Case::BUILTIN {
-        let model = Model::from_case_name(name).unwrap();
+        let model = common::model(name);
         let count = 30;
         let ln = check_condensed_eigenproblem(&model, JimSet::Normal, count);
         let lt = check_condensed_eigenproblem(&model, JimSet::InPlane, count);
@@ -304,7 +292,7 @@ fn jim_vectors_satisfy_the_condensed_eigenproblem() {
 
 #[test]
 fn jim_bad_count_is_an_error() {
-    let model = Model::from_case_name("friction_bar").unwrap();
+    let model = common::model("friction_bar");
     let nn = jim_dofs(&model, JimSet::Normal).unwrap().len();
     let err = joint_interface_modes(&model, nn + 1, JimSet::Normal).unwrap_err();
     assert!(
@@ -334,7 +322,7 @@ fn jim_bad_count_is_an_error() {
 #[test]
 fn alldof_reproduces_the_full_contact_statics() {
     for name in Case::BUILTIN {
-        let model = Model::from_case_name(name).unwrap();
+        let model = common::model(name);
         let n = model.dofs();
         let psi = alldof_vectors(&model).unwrap();
         assert_eq!(psi.ncols(), model.joint.pairs());
@@ -390,7 +378,7 @@ fn alldof_reproduces_the_full_contact_statics() {
 #[test]
 fn tvd_contact_force_converges_as_g_grows() {
     for name in Case::BUILTIN {
-        let model = Model::from_case_name(name).unwrap();
+        let model = common::model(name);
         let load = model.master_load();
         let full = contact_static_full(&model, load, &ContactOptions::default()).unwrap();
         let fc = full.state.contact_force_norm;
@@ -482,19 +470,14 @@ fn tvd_contact_force_converges_as_g_grows() {
 
 #[test]
 fn snapshot_pod_recovers_a_synthetic_span() {
-    let model = Model::from_case_name("friction_bar").unwrap();
+    let model = common::model("friction_bar");
     let n = model.dofs();
     // Three known shapes outside the Craig–Bampton span: pair constraint modes.
     let psi = alldof_vectors(&model).unwrap();
     let known = Mat::from_fn(n, 3, |r, c| psi[(r, [3, 20, 41][c])] * 1e3);
     let z = 200;
-    let mut seed = 0x2545_f491_4f6c_dd1du64;
-    let mut rnd = move || {
-        seed ^= seed << 13;
-        seed ^= seed >> 7;
-        seed ^= seed << 17;
-        (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-    };
+    let mut rng = common::rng(0x2545_f491_4f6c_dd1d);
+    let mut rnd = move || 0.5 * common::uniform(&mut rng); // in [-0.5, 0.5)
     let scale = (0..3)
         .map(|c| norm(&col(known.as_ref(), c)))
         .fold(0.0f64, f64::max);

@@ -6,6 +6,8 @@ use jointrom::studies::stability::{
     relative_l2, run_sweep, write_outputs, IterKind, ModelKind, SweepOptions,
 };
 
+use crate::common;
+
 #[test]
 fn relative_l2_matches_hand_computation() {
     // Cell at t = 0, 1, 2; reference on a finer grid (0, 0.5, ..., 2).
@@ -64,7 +66,7 @@ fn tiny_sweep_reports_failures_as_cells() {
         let e = n.error.unwrap();
         assert!(e < 1e-2, "Newton cell error {e}");
     }
-    let dir = std::env::temp_dir().join(format!("jointrom-stability-{}", std::process::id()));
+    let dir = common::tmp_path("stability_outputs");
     let files = write_outputs(&sweep, &dir, true).unwrap();
     for name in [
         "stability.json",
@@ -88,8 +90,8 @@ fn tiny_sweep_reports_failures_as_cells() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
-/// The whole map of the issue (minutes): `STABILITY_OUT=dir cargo test --release --test stability
-/// -- --ignored full_map` (until `jointrom stability` is wired into the CLI). Optional
+/// The whole map of the issue (minutes): `STABILITY_OUT=dir cargo test --release --test studies
+/// -- --ignored stability::full_map` (until `jointrom stability` is wired into the CLI). Optional
 /// `STABILITY_BUDGET` (s per cell) and `STABILITY_FULL_END` (s).
 #[test]
 #[ignore]

@@ -2,37 +2,36 @@
 //! snapshots come from `transient::run_observed`, the basis from `snapshot_basis`, and the ROM
 //! on it reproduces the run it was trained on — far better than Craig–Bampton alone.
 
-use std::process::Command;
-
 use faer::Mat;
-use jointrom::integrate::mechanical::{self as transient, TransientOptions, TransientResult};
+use jointrom::integrate::mechanical::{self as transient, TransientResult};
 use jointrom::reduction::{build_basis, snapshot_basis, BasisKind, BasisOptions, ReducedModel};
 use jointrom::studies::stability::relative_l2;
 use jointrom::system::{FullSystem, ReducedSystem};
 use jointrom::Model;
 
-const END: f64 = 5e-3;
+use crate::common::{self, jointrom_err, jointrom_json};
 
-fn options() -> TransientOptions {
-    TransientOptions {
-        end_time: Some(END),
-        ..TransientOptions::default()
-    }
-}
+const END: f64 = 5e-3;
 
 fn rom_run(model: &Model, phi: Mat<f64>) -> TransientResult {
     let rom = ReducedModel::new(model, phi).unwrap();
-    transient::run(ReducedSystem::new(model, &rom).unwrap(), &options()).unwrap()
+    transient::run(
+        ReducedSystem::new(model, &rom).unwrap(),
+        &common::until(END),
+    )
+    .unwrap()
 }
 
 #[test]
 fn snapshot_pod_rom_reproduces_its_training_run() {
-    let model = Model::from_case_name("friction_bar").unwrap();
+    let model = common::model("friction_bar");
     let n = model.dofs();
     let mut states: Vec<(f64, Vec<f64>)> = Vec::new();
-    let full = transient::run_observed(FullSystem::new(&model).unwrap(), &options(), |t, q| {
-        states.push((t, q.to_vec()))
-    })
+    let full = transient::run_observed(
+        FullSystem::new(&model).unwrap(),
+        &common::until(END),
+        |t, q| states.push((t, q.to_vec())),
+    )
     .unwrap();
     // One observation at t = 0 (rest) and one per output, matching the curves.
     assert_eq!(states.len(), full.curves.t.len());
@@ -92,27 +91,17 @@ fn snapshot_pod_rom_reproduces_its_training_run() {
 
 #[test]
 fn cli_pod_model_reports_its_training_and_rejects_misplaced_flags() {
-    let exe = env!("CARGO_BIN_EXE_jointrom");
-    let out = Command::new(exe)
-        .args([
-            "transient",
-            "friction_bar",
-            "--model",
-            "pod",
-            "--end-time",
-            "2e-3",
-            "--snapshots",
-            "10",
-            "--json",
-        ])
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let v = jointrom_json([
+        "transient",
+        "friction_bar",
+        "--model",
+        "pod",
+        "--end-time",
+        "2e-3",
+        "--snapshots",
+        "10",
+        "--json",
+    ]);
     let tr = &v["training"];
     assert_eq!(tr["end_time"].as_f64(), Some(2e-3));
     let snaps = tr["snapshots"].as_u64().unwrap();
@@ -120,17 +109,13 @@ fn cli_pod_model_reports_its_training_and_rejects_misplaced_flags() {
     assert!(tr["cpu_s"].as_f64().unwrap() >= 0.0);
     assert_eq!(v["model"], "pod");
 
-    let bad = Command::new(exe)
-        .args([
-            "transient",
-            "friction_bar",
-            "--model",
-            "tvd",
-            "--train-end",
-            "1e-3",
-        ])
-        .output()
-        .unwrap();
-    assert!(!bad.status.success());
-    assert!(String::from_utf8_lossy(&bad.stderr).contains("--train-end"));
+    let bad = jointrom_err([
+        "transient",
+        "friction_bar",
+        "--model",
+        "tvd",
+        "--train-end",
+        "1e-3",
+    ]);
+    assert!(bad.contains("--train-end"));
 }

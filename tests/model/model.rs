@@ -1,22 +1,22 @@
 //! Whole-model tests on the two paper scenes: DOF counts, constraint elimination, rigid-body
 //! modes of the free structure, eigen-solver agreement, statics, and the CLI's JSON contract.
 
-use std::process::Command;
-
 use faer::Side;
 use jointrom::assembly::assemble_structure;
 use jointrom::case::Case;
 use jointrom::linalg::eigen::dense_modes;
 use jointrom::mesh::Mesh;
-use jointrom::{Interface, Model};
+use jointrom::Interface;
+
+use crate::common::{self, jointrom_err, jointrom_json};
 
 #[test]
 fn paper_dof_counts() {
-    let fb = Model::from_case_name("friction_bar").unwrap();
+    let fb = common::model("friction_bar");
     assert_eq!(fb.dofs(), 906);
     assert_eq!(fb.joint_dofs(), 648);
     assert_eq!(fb.pair_count(), 54);
-    let ml = Model::from_case_name("multilayer_sheet").unwrap();
+    let ml = common::model("multilayer_sheet");
     assert_eq!(ml.dofs(), 834);
     assert_eq!(ml.joint_dofs(), 828);
     assert_eq!(ml.pair_count(), 92);
@@ -40,7 +40,7 @@ fn free_structure_has_exactly_six_rigid_body_modes() {
 
 #[test]
 fn clamp_and_rigid_tie_are_exact() {
-    let model = Model::from_case_name("friction_bar").unwrap();
+    let model = common::model("friction_bar");
     let load = model.master_load();
     let sol = model.static_linear(&[load]).unwrap().remove(0);
     let u = model.dof_map.expand(&sol.displacement);
@@ -80,7 +80,7 @@ fn clamp_and_rigid_tie_are_exact() {
 #[test]
 fn lanczos_and_dense_agree_on_both_scenes_and_interfaces() {
     for name in Case::BUILTIN {
-        let model = Model::from_case_name(name).unwrap();
+        let model = common::model(name);
         for iface in [Interface::Fixed, Interface::Free] {
             let lanczos = model.modes(20, iface).unwrap();
             let (k, m) = match iface {
@@ -128,36 +128,22 @@ fn lanczos_and_dense_agree_on_both_scenes_and_interfaces() {
 
 #[test]
 fn too_many_modes_is_an_error_not_a_panic() {
-    let model = Model::from_case_name("multilayer_sheet").unwrap();
+    let model = common::model("multilayer_sheet");
     let err = model.modes(5000, Interface::Fixed).unwrap_err();
     assert!(err.to_string().contains("5000"), "{err}");
     assert!(model.modes(0, Interface::Free).is_err());
 }
 
-fn cli(args: &[&str]) -> (bool, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_jointrom"))
-        .args(args)
-        .output()
-        .expect("binary runs");
-    (
-        out.status.success(),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
-
 #[test]
 fn cli_json_contract() {
-    let (ok, out, err) = cli(&["info", "friction_bar", "--json"]);
-    assert!(ok, "{err}");
-    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let v = jointrom_json(["info", "friction_bar", "--json"]);
     assert_eq!(v["dofs"], 906);
     assert_eq!(v["joint_pairs"], 54);
     assert_eq!(v["joint_dofs"], 648);
     assert_eq!(v["nodes"], 157);
     assert_eq!(v["elements"], 102);
 
-    let (ok, out, err) = cli(&[
+    let v = jointrom_json([
         "modes",
         "multilayer_sheet",
         "--count",
@@ -166,18 +152,14 @@ fn cli_json_contract() {
         "free",
         "--json",
     ]);
-    assert!(ok, "{err}");
-    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
     let f = v["frequencies_hz"].as_array().unwrap();
     assert_eq!(f.len(), 5);
     assert!(f.windows(2).all(|w| w[0].as_f64() <= w[1].as_f64()));
 
-    let (ok, out, err) = cli(&["static", "friction_bar", "--linear", "--json"]);
-    assert!(ok, "{err}");
-    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let v = jointrom_json(["static", "friction_bar", "--linear", "--json"]);
     let u = v["master_displacement"].as_array().unwrap();
     assert_eq!(u.len(), 6);
-    let (ok, out2, _) = cli(&[
+    let v2 = jointrom_json([
         "static",
         "friction_bar",
         "--linear",
@@ -185,16 +167,12 @@ fn cli_json_contract() {
         "-2",
         "--json",
     ]);
-    assert!(ok);
-    let v2: serde_json::Value = serde_json::from_str(&out2).unwrap();
     let uy = u[1].as_f64().unwrap();
     let uy2 = v2["master_displacement"][1].as_f64().unwrap();
     assert!((uy2 + 2.0 * uy).abs() <= 1e-9 * uy.abs(), "{uy} {uy2}");
 
     // With contact (the default): the joint stiffens the bar, some but not all pairs close.
-    let (ok, out3, err) = cli(&["static", "friction_bar", "--json"]);
-    assert!(ok, "{err}");
-    let v3: serde_json::Value = serde_json::from_str(&out3).unwrap();
+    let v3 = jointrom_json(["static", "friction_bar", "--json"]);
     assert!(v3["contact_force_norm"].as_f64().unwrap() > 0.0);
     let n = v3["pairs_in_contact"].as_u64().unwrap();
     assert!(n > 0 && n < 54, "{n}");
@@ -207,17 +185,13 @@ fn cli_json_contract() {
 
 #[test]
 fn cli_errors_name_the_problem() {
-    let (ok, _, err) = cli(&["info", "no_such_case"]);
-    assert!(!ok);
+    let err = jointrom_err(["info", "no_such_case"]);
     assert!(err.contains("no_such_case"), "{err}");
-    let (ok, _, err) = cli(&["static", "friction_bar", "--scale", "nan"]);
-    assert!(!ok);
+    let err = jointrom_err(["static", "friction_bar", "--scale", "nan"]);
     assert!(err.contains("--scale"), "{err}");
-    let dir = std::env::temp_dir().join("jointrom-cli-test");
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = common::tmp_dir("model_cli_errors");
     let bad = dir.join("bad.json");
     std::fs::write(&bad, "{\"name\": 3}").unwrap();
-    let (ok, _, err) = cli(&["info", bad.to_str().unwrap()]);
-    assert!(!ok);
+    let err = jointrom_err(["info", bad.to_str().unwrap()]);
     assert!(err.contains("bad.json"), "{err}");
 }

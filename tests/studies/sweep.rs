@@ -1,11 +1,12 @@
 //! `jointrom sweep`: variants of one shared reduced model, run in parallel, give the same curves
 //! as run one by one and as a direct run of the case; the variant file is validated.
 
-use jointrom::integrate::mechanical::{self as transient, TransientOptions};
+use jointrom::integrate::mechanical as transient;
 use jointrom::reduction::{build_basis, BasisKind, BasisOptions, ReducedModel};
 use jointrom::studies::sweep::{read_variants, run_sweep, Variant};
 use jointrom::system::ReducedSystem;
-use jointrom::Model;
+
+use crate::common;
 
 fn variant(name: &str, mu: Option<f64>, scale: Option<f64>) -> Variant {
     Variant {
@@ -19,13 +20,10 @@ fn variant(name: &str, mu: Option<f64>, scale: Option<f64>) -> Variant {
 
 #[test]
 fn parallel_equals_sequential_and_the_case_variant_equals_a_direct_run() {
-    let model = Model::from_case_name("friction_bar").unwrap();
+    let model = common::model("friction_bar");
     let b = build_basis(&model, BasisKind::Tvd, &BasisOptions::default()).unwrap();
     let rom = ReducedModel::new(&model, b.phi).unwrap();
-    let opts = TransientOptions {
-        end_time: Some(0.01),
-        ..TransientOptions::default()
-    };
+    let opts = common::until(0.01);
     let vs = vec![
         variant("case", None, None),
         variant("mu 0", Some(0.0), None),
@@ -55,7 +53,6 @@ fn parallel_equals_sequential_and_the_case_variant_equals_a_direct_run() {
 
 #[test]
 fn bad_variant_files_name_the_field() {
-    let dir = std::env::temp_dir();
     for (name, text, field) in [
         (
             "unknown",
@@ -74,7 +71,7 @@ fn bad_variant_files_name_the_field() {
         ),
         ("empty", r#"{"variants": []}"#, "variants"),
     ] {
-        let path = dir.join(format!("jointrom-sweep-{name}-{}.json", std::process::id()));
+        let path = common::tmp_path(&format!("sweep_{name}.json"));
         std::fs::write(&path, text).unwrap();
         let e = read_variants(&path).unwrap_err().to_string();
         assert!(
@@ -83,10 +80,6 @@ fn bad_variant_files_name_the_field() {
         );
         let _ = std::fs::remove_file(&path);
     }
-    let ok = read_variants(std::path::Path::new(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/cases/sweeps/friction_bar_mu.json"
-    )))
-    .unwrap();
+    let ok = read_variants(&common::repo_path("cases/sweeps/friction_bar_mu.json")).unwrap();
     assert_eq!(ok.len(), 6);
 }

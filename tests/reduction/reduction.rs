@@ -17,25 +17,8 @@ use jointrom::reduction::{
     active_pairs, build_basis, craig_bampton, final_basis, pod, pod_tvd, trial_vector_derivatives,
     BasisKind, BasisOptions, ReducedModel, TvdOptions, DEFAULT_THRESHOLD,
 };
-use jointrom::Model;
 
-fn col(a: MatRef<'_, f64>, c: usize) -> Vec<f64> {
-    a.col(c).iter().copied().collect()
-}
-
-fn mul(a: &SymCsc, x: &[f64]) -> Vec<f64> {
-    let mut y = vec![0.0; a.n];
-    a.mul_vec(x, &mut y);
-    y
-}
-
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| x * y).sum()
-}
-
-fn inf(a: &[f64]) -> f64 {
-    a.iter().fold(0.0f64, |m, v| m.max(v.abs()))
-}
+use crate::common::{self, col, dot, inf_norm, mul};
 
 /// `Xᵀ A Y` for sparse symmetric A.
 fn gram(a: &SymCsc, x: MatRef<'_, f64>, y: MatRef<'_, f64>) -> Mat<f64> {
@@ -57,7 +40,7 @@ fn max_dev_from_identity(g: &Mat<f64>) -> f64 {
 #[test]
 fn craig_bampton_constraint_modes_and_k_orthogonality() {
     for name in Case::BUILTIN {
-        let model = Model::from_case_name(name).unwrap();
+        let model = common::model(name);
         let n = model.dofs();
         let master = model.master_dofs();
         let nu = 10;
@@ -75,8 +58,8 @@ fn craig_bampton_constraint_modes_and_k_orthogonality() {
         for c in 0..6 {
             let x = col(phi.as_ref(), c);
             let kx = mul(&model.stiffness, &x);
-            let interior = inf(&kx[..n - 6]);
-            let be = interior / (knorm * inf(&x));
+            let interior = inf_norm(&kx[..n - 6]);
+            let be = interior / (knorm * inf_norm(&x));
             assert!(
                 be < 1e-12,
                 "{name}: constraint mode {c}: interior residual {be:e}"
@@ -126,7 +109,7 @@ fn active_pairs_zero_rule() {
 
 #[test]
 fn tvd_count_residual_sign_flip_and_normalization() {
-    let model = Model::from_case_name("friction_bar").unwrap();
+    let model = common::model("friction_bar");
     let n = model.dofs();
     let w = model.joint.pairs();
     let kn = model.contact.normal_stiffness;
@@ -145,7 +128,7 @@ fn tvd_count_residual_sign_flip_and_normalization() {
     for j in 0..base.ncols() {
         let mut g = vec![0.0; w];
         model.joint.gaps(&col(base.as_ref(), j), &mut g);
-        let scale = inf(&g);
+        let scale = inf_norm(&g);
         for z in 0..w {
             let zero = g[z].abs() <= opts.tol * scale;
             let neg = tvd.active[j][0][z];
@@ -183,7 +166,7 @@ fn tvd_count_residual_sign_flip_and_normalization() {
             .collect();
         let kx = mul(&model.stiffness, &x);
         let res: Vec<f64> = kx.iter().zip(&f).map(|(a, b)| a - b).collect();
-        let be = inf(&res) / (knorm * inf(&x) + inf(&f));
+        let be = inf_norm(&res) / (knorm * inf_norm(&x) + inf_norm(&f));
         worst = worst.max(be);
         // K-normalization.
         let xn = col(tvd.vectors.as_ref(), c);
@@ -204,7 +187,7 @@ fn tvd_count_residual_sign_flip_and_normalization() {
 #[test]
 fn tvd_zero_gap_rule_counts() {
     for name in Case::BUILTIN {
-        let model = Model::from_case_name(name).unwrap();
+        let model = common::model(name);
         let base = craig_bampton(&model, 10).unwrap();
         let mut nonzero = [0usize; 2];
         for (a, zero_gap_active) in [true, false].into_iter().enumerate() {
@@ -217,7 +200,7 @@ fn tvd_zero_gap_rule_counts() {
                 .filter(|&j| {
                     let mut g = vec![0.0; model.joint.pairs()];
                     model.joint.gaps(&col(base.as_ref(), j), &mut g);
-                    inf(&g) == 0.0
+                    inf_norm(&g) == 0.0
                 })
                 .collect();
             if zero_gap_active {
@@ -240,7 +223,7 @@ fn tvd_zero_gap_rule_counts() {
                         let g: Vec<f64> = (0..model.joint.pairs())
                             .map(|z| bphi[(3 * z + NORMAL, j)])
                             .collect();
-                        let scale = inf(&g);
+                        let scale = inf_norm(&g);
                         g.iter().filter(|v| v.abs() <= 1e-6 * scale).count()
                     })
                     .sum();
@@ -275,7 +258,7 @@ fn tvd_zero_gap_rule_counts() {
 
 #[test]
 fn pod_optimality_and_orthonormality() {
-    let model = Model::from_case_name("friction_bar").unwrap();
+    let model = common::model("friction_bar");
     let base = craig_bampton(&model, 10).unwrap();
     let tvd = trial_vector_derivatives(&model, base.as_ref(), &TvdOptions::default()).unwrap();
     let y = tvd.vectors.as_ref();
@@ -364,7 +347,7 @@ fn pod_optimality_and_orthonormality() {
 #[test]
 fn energy_ratio_and_chosen_g_report() {
     for name in Case::BUILTIN {
-        let model = Model::from_case_name(name).unwrap();
+        let model = common::model(name);
         let base = craig_bampton(&model, 10).unwrap();
         let tvd = trial_vector_derivatives(&model, base.as_ref(), &TvdOptions::default()).unwrap();
         for weighted in [true, false] {
@@ -390,7 +373,7 @@ fn energy_ratio_and_chosen_g_report() {
 
 #[test]
 fn build_basis_and_reduced_model() {
-    let model = Model::from_case_name("friction_bar").unwrap();
+    let model = common::model("friction_bar");
     let t0 = Instant::now();
     let basis = build_basis(&model, BasisKind::Tvd, &BasisOptions::default()).unwrap();
     let elapsed = t0.elapsed();
@@ -448,7 +431,7 @@ fn build_basis_and_reduced_model() {
 
 #[test]
 fn tangential_stiffness_widens_the_tvd_space() {
-    let model = Model::from_case_name("friction_bar").unwrap();
+    let model = common::model("friction_bar");
     let w = model.joint.pairs();
     let base = craig_bampton(&model, 10).unwrap();
     let normal = trial_vector_derivatives(&model, base.as_ref(), &TvdOptions::default()).unwrap();
@@ -473,7 +456,7 @@ fn tangential_stiffness_widens_the_tvd_space() {
 
 #[test]
 fn final_basis_drops_dependent_directions_and_keeps_the_span() {
-    let model = Model::from_case_name("multilayer_sheet").unwrap();
+    let model = common::model("multilayer_sheet");
     let cb = craig_bampton(&model, 10).unwrap();
     let n = model.dofs();
     // Duplicates and a combination of earlier columns must be dropped.
@@ -497,7 +480,7 @@ fn final_basis_drops_dependent_directions_and_keeps_the_span() {
                 res[r] -= q[(r, k)] * qmc[(k, c)];
             }
         }
-        let rel = inf(&res) / inf(&x);
+        let rel = inf_norm(&res) / inf_norm(&x);
         assert!(rel < 1e-9, "column {c}: projection residual {rel:e}");
     }
 }
@@ -511,7 +494,7 @@ fn final_basis_drops_dependent_directions_and_keeps_the_span() {
 /// force matches the full one to 1e-6 (the Gram route stalled at 2e-2).
 #[test]
 fn weighted_pod_of_tvd_resolves_small_eigenvalues() {
-    let model = Model::from_case_name("friction_bar").unwrap();
+    let model = common::model("friction_bar");
     let base = craig_bampton(&model, 10).unwrap();
     let opts = TvdOptions::default();
     let tvd = trial_vector_derivatives(&model, base.as_ref(), &opts).unwrap();

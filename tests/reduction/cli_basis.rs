@@ -1,33 +1,9 @@
 //! CLI contract of `jointrom basis`, `jointrom static --basis` and `jointrom study`: JSON fields,
 //! values checked against the library, errors naming the flag.
 
-use std::path::PathBuf;
-use std::process::{Command, Output};
-
 use serde_json::Value;
 
-fn jointrom(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_jointrom"))
-        .args(args)
-        .output()
-        .expect("run jointrom")
-}
-
-fn json_of(args: &[&str]) -> Value {
-    let out = jointrom(args);
-    assert!(
-        out.status.success(),
-        "jointrom {args:?} failed: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    serde_json::from_slice(&out.stdout).expect("stdout is one JSON document")
-}
-
-fn stderr_of_failure(args: &[&str]) -> String {
-    let out = jointrom(args);
-    assert!(!out.status.success(), "jointrom {args:?} should fail");
-    String::from_utf8_lossy(&out.stderr).into_owned()
-}
+use crate::common::{self, jointrom_err, jointrom_json};
 
 fn floats(v: &Value) -> Vec<f64> {
     v.as_array()
@@ -39,7 +15,7 @@ fn floats(v: &Value) -> Vec<f64> {
 
 #[test]
 fn basis_json_contract() {
-    let v = json_of(&["basis", "friction_bar", "--json"]);
+    let v = jointrom_json(["basis", "friction_bar", "--json"]);
     assert_eq!(v["tvd_count"], 512);
     let nonzero = v["tvd_nonzero"].as_u64().unwrap() as usize;
     assert!(nonzero > 0 && nonzero <= 512);
@@ -64,7 +40,7 @@ fn basis_json_contract() {
     assert!(v["build_s"].as_f64().unwrap() > 0.0);
 
     // --kind tvd-plain chooses g from the plain POD; --g overrides.
-    let p = json_of(&["basis", "friction_bar", "--kind", "tvd-plain", "--json"]);
+    let p = jointrom_json(["basis", "friction_bar", "--kind", "tvd-plain", "--json"]);
     let wp = floats(&p["w_plain"]);
     let gp = p["g_chosen"].as_u64().unwrap() as usize;
     assert!(wp[gp - 1] >= threshold && (gp == 1 || wp[gp - 2] < threshold));
@@ -73,25 +49,25 @@ fn basis_json_contract() {
         w,
         "the K-weighted curve does not depend on --kind"
     );
-    let q = json_of(&["basis", "friction_bar", "--g", "5", "--nu", "4", "--json"]);
+    let q = jointrom_json(["basis", "friction_bar", "--g", "5", "--nu", "4", "--json"]);
     assert_eq!(q["g_chosen"], 5);
     assert_eq!(q["tvd_count"], 2 * 10 * 10);
 }
 
 #[test]
 fn basis_errors_name_the_flag() {
-    let e = stderr_of_failure(&["basis", "friction_bar", "--kind", "modes"]);
+    let e = jointrom_err(["basis", "friction_bar", "--kind", "modes"]);
     assert!(e.contains("--kind"), "{e}");
-    let e = stderr_of_failure(&["basis", "friction_bar", "--threshold", "1.5"]);
+    let e = jointrom_err(["basis", "friction_bar", "--threshold", "1.5"]);
     assert!(e.contains("--threshold"), "{e}");
-    let e = stderr_of_failure(&["basis", "friction_bar", "--g", "400"]);
+    let e = jointrom_err(["basis", "friction_bar", "--g", "400"]);
     assert!(e.contains("--g 400"), "{e}");
 }
 
 #[test]
 fn static_basis_json_contract() {
-    let full = json_of(&["static", "friction_bar", "--json"]);
-    let red = json_of(&[
+    let full = jointrom_json(["static", "friction_bar", "--json"]);
+    let red = jointrom_json([
         "static",
         "friction_bar",
         "--basis",
@@ -121,7 +97,7 @@ fn static_basis_json_contract() {
     assert!(red["pairs_in_contact"].as_u64().unwrap() > 0);
 
     // modes: g extra modes; --scale reverses the load.
-    let m = json_of(&[
+    let m = jointrom_json([
         "static",
         "friction_bar",
         "--basis",
@@ -144,7 +120,7 @@ fn static_basis_json_contract() {
 
 #[test]
 fn static_basis_errors_name_the_flag() {
-    let e = stderr_of_failure(&["static", "friction_bar", "--basis", "nope"]);
+    let e = jointrom_err(["static", "friction_bar", "--basis", "nope"]);
     assert!(
         e.contains("--basis")
             && e.contains("tvd")
@@ -152,20 +128,20 @@ fn static_basis_errors_name_the_flag() {
             && e.contains("modes"),
         "{e}"
     );
-    let e = stderr_of_failure(&["static", "friction_bar", "--basis", "tvd", "--g", "500"]);
+    let e = jointrom_err(["static", "friction_bar", "--basis", "tvd", "--g", "500"]);
     assert!(e.contains("--g 500"), "{e}");
-    let e = stderr_of_failure(&["static", "friction_bar", "--g", "5"]);
+    let e = jointrom_err(["static", "friction_bar", "--g", "5"]);
     assert!(e.contains("--g") && e.contains("--basis"), "{e}");
-    let e = stderr_of_failure(&["static", "friction_bar", "--basis", "tvd", "--linear"]);
+    let e = jointrom_err(["static", "friction_bar", "--basis", "tvd", "--linear"]);
     assert!(e.contains("--linear"), "{e}");
 }
 
 #[test]
 fn study_writes_json_and_charts() {
-    let out = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("cli_study");
+    let out = common::tmp_path("cli_study");
     let _ = std::fs::remove_dir_all(&out);
     let o = out.to_str().unwrap();
-    let v = json_of(&[
+    let v = jointrom_json([
         "study",
         "multilayer_sheet",
         "--out",
@@ -197,7 +173,7 @@ fn study_writes_json_and_charts() {
             "--json"
         ]
     );
-    let full = json_of(&["static", "multilayer_sheet", "--json"]);
+    let full = jointrom_json(["static", "multilayer_sheet", "--json"]);
     assert_eq!(v["full"]["contact_force_norm"], full["contact_force_norm"]);
     for s in v["series"].as_array().unwrap() {
         assert_eq!(s["g"].as_array().unwrap().len(), 5, "{}", s["name"]);

@@ -1,25 +1,18 @@
 //! The main job's report (`jointrom run --quick`): every chart and table is written, the numbers
 //! are consistent with each other and with the paper's qualitative claims on this window.
 
-use std::path::PathBuf;
-
 use jointrom::report::main_job::{run_report, ReportOptions};
-use jointrom::Model;
 
-fn tmp_dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("jointrom-report-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    d
-}
+use crate::common;
 
 #[test]
 fn quick_report_on_the_friction_bar() {
-    let model = Model::from_case_name("friction_bar").unwrap();
-    let dir = tmp_dir("quick");
+    let model = common::model("friction_bar");
+    let dir = common::tmp_dir("report_quick");
     let opts = ReportOptions {
         quick: true,
         progress: false,
-        stability_dir: PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("results/stability"),
+        stability_dir: common::repo_path("results/stability"),
         ..ReportOptions::default()
     };
     let mut extra = serde_json::Map::new();

@@ -13,16 +13,14 @@ use jointrom::joint::NORMAL;
 use jointrom::model::contact_static_full;
 use jointrom::{Error, Model};
 
+use crate::common::{self, norm};
+
 fn master_force(model: &Model, load: [f64; 6]) -> Vec<f64> {
     let mut f = vec![0.0; model.dofs()];
     for (k, &d) in model.master_dofs().iter().enumerate() {
         f[d] = load[k];
     }
     f
-}
-
-fn norm(v: &[f64]) -> f64 {
-    v.iter().map(|x| x * x).sum::<f64>().sqrt()
 }
 
 fn neg(load: [f64; 6]) -> [f64; 6] {
@@ -122,7 +120,7 @@ fn check_solution(model: &Model, load: [f64; 6], sol: &ContactSolution) {
 #[test]
 fn paper_loads_full_model_is_consistent_and_in_equilibrium() {
     for name in Case::BUILTIN {
-        let model = Model::from_case_name(name).unwrap();
+        let model = common::model(name);
         let load = model.master_load();
         let w = model.joint.pairs();
         for l in [load, neg(load)] {
@@ -142,7 +140,7 @@ fn paper_loads_full_model_is_consistent_and_in_equilibrium() {
 #[test]
 fn reversing_the_load_changes_the_contact_set() {
     for name in Case::BUILTIN {
-        let model = Model::from_case_name(name).unwrap();
+        let model = common::model(name);
         let load = model.master_load();
         let opts = ContactOptions::default();
         let a = contact_static_full(&model, load, &opts).unwrap();
@@ -167,7 +165,7 @@ fn reversing_the_load_changes_the_contact_set() {
 fn closed_start_gives_the_same_unique_solution() {
     // The energy is strictly convex, so both starts must end at the same state.
     for name in Case::BUILTIN {
-        let model = Model::from_case_name(name).unwrap();
+        let model = common::model(name);
         let load = model.master_load();
         let open = contact_static_full(&model, load, &ContactOptions::default()).unwrap();
         let closed = contact_static_full(
@@ -195,7 +193,7 @@ fn closed_start_gives_the_same_unique_solution() {
 #[test]
 fn reduced_with_identity_basis_reproduces_full_solution() {
     for name in Case::BUILTIN {
-        let model = Model::from_case_name(name).unwrap();
+        let model = common::model(name);
         let n = model.dofs();
         let w = model.joint.pairs();
         let k_n = model.contact.normal_stiffness;
@@ -297,7 +295,7 @@ fn two_dof_spring_pressed_onto_penalty_spring() {
 
 #[test]
 fn iteration_cap_is_an_error() {
-    let model = Model::from_case_name("friction_bar").unwrap();
+    let model = common::model("friction_bar");
     let opts = ContactOptions {
         max_iterations: 1,
         ..ContactOptions::default()
@@ -366,7 +364,7 @@ fn bad_input_is_an_error() {
 fn reduced_with_modal_basis_is_a_consistent_contact_solution() {
     // Φ = [20 free-interface modes | linear static response to the load] — any Φ works.
     for name in Case::BUILTIN {
-        let model = Model::from_case_name(name).unwrap();
+        let model = common::model(name);
         let (n, w) = (model.dofs(), model.joint.pairs());
         let k_n = model.contact.normal_stiffness;
         let load = model.master_load();

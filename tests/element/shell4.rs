@@ -8,6 +8,8 @@ use jointrom::linalg::cholesky::solve_spd;
 use jointrom::linalg::eigen::{dense_modes, lowest_modes};
 use jointrom::mesh::{Mesh, RigidTie, SheetGrid, ShellElem};
 
+use crate::common::v3::{cross, dot, normalize};
+
 const STEEL: Material = Material::STEEL;
 const STEEL_NU0: Material = Material {
     youngs_modulus: 210_000.0,
@@ -33,21 +35,6 @@ fn rotated_axes() -> ([f64; 3], [f64; 3]) {
     let d = dot(tmp, e1);
     let e2 = normalize([tmp[0] - d * e1[0], tmp[1] - d * e1[1], tmp[2] - d * e1[2]]);
     (e1, e2)
-}
-
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-fn normalize(a: [f64; 3]) -> [f64; 3] {
-    let n = dot(a, a).sqrt();
-    a.map(|v| v / n)
-}
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
 }
 
 fn max_abs(m: &Mat<f64>) -> f64 {

@@ -6,10 +6,11 @@ use std::path::PathBuf;
 
 use faer::Mat;
 use jointrom::report::vtu;
-use jointrom::Model;
+
+use crate::common::{self, jointrom_ok};
 
 fn tmp(name: &str) -> PathBuf {
-    std::env::temp_dir().join(format!("jointrom-vtu-{name}-{}", std::process::id()))
+    common::tmp_path(&format!("vtu_{name}"))
 }
 
 /// The numbers of the point array `name` (3 per node).
@@ -27,7 +28,7 @@ fn array(doc: &str, name: &str) -> Vec<f64> {
 
 #[test]
 fn a_shape_is_written_with_its_expansion_and_the_mesh() {
-    let model = Model::from_case_name("friction_bar").unwrap();
+    let model = common::model("friction_bar");
     let n = model.dofs();
     // The master's uy = 1 (all other DOF zero): a rigid motion of the tied end.
     let master = model.master_dofs();
@@ -94,7 +95,7 @@ fn a_shape_is_written_with_its_expansion_and_the_mesh() {
 
 #[test]
 fn a_series_has_one_file_per_time_and_a_collection() {
-    let model = Model::from_case_name("friction_bar").unwrap();
+    let model = common::model("friction_bar");
     let n = model.dofs();
     let dir = tmp("series");
     let states = vec![vec![0.0; n], vec![1e-3; n]];
@@ -108,14 +109,15 @@ fn a_series_has_one_file_per_time_and_a_collection() {
 
 #[test]
 fn shapes_command_writes_vtu_and_the_joint_mode_picture() {
-    let exe = env!("CARGO_BIN_EXE_jointrom");
     let dir = tmp("cli");
-    let st = std::process::Command::new(exe)
-        .args(["shapes", "friction_bar", "--count", "4", "--out"])
-        .arg(&dir)
-        .status()
-        .unwrap();
-    assert!(st.success());
+    jointrom_ok([
+        "shapes",
+        "friction_bar",
+        "--count",
+        "4",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
     for f in [
         "craig_bampton.vtu",
         "tvd.vtu",

@@ -20,11 +20,10 @@ use jointrom::studies::convergence::{
 };
 use jointrom::{Interface, Model};
 
+use crate::common;
+
 fn tmp(name: &str) -> PathBuf {
-    let d = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(format!("study_{name}"));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+    common::tmp_dir(&format!("study_{name}"))
 }
 
 /// The study's reduced pipeline (final_basis → ReducedModel → reduced contact solve) is exact
@@ -34,7 +33,7 @@ fn tmp(name: &str) -> PathBuf {
 #[test]
 fn reduced_statics_exact_with_the_whole_joint_space() {
     for case in ["friction_bar", "multilayer_sheet"] {
-        let model = Model::from_case_name(case).unwrap();
+        let model = common::model(case);
         let n = model.dofs();
         let w = model.joint.pairs();
         let cb = craig_bampton(&model, 10).unwrap();
@@ -101,7 +100,7 @@ fn sparse_fixed_interface_modes(
 /// (frequencies to 1e-8, same subspace) and are M-orthonormal.
 #[test]
 fn dense_modes_match_lanczos() {
-    let model = Model::from_case_name("friction_bar").unwrap();
+    let model = common::model("friction_bar");
     let lanczos = model.modes(12, Interface::Fixed).unwrap();
     let dense = sparse_fixed_interface_modes(&model, 0, 12).unwrap();
     let n = model.dofs();
@@ -155,7 +154,7 @@ fn within_first_and_stays() {
 /// full value is the full solver's, and its charts are written.
 #[test]
 fn friction_bar_study() {
-    let model = Model::from_case_name("friction_bar").unwrap();
+    let model = common::model("friction_bar");
     let opts = StudyOptions::default();
     let s = run_study(&model, &opts).unwrap();
     let full = contact_static_full(&model, model.master_load(), &opts.contact).unwrap();
@@ -305,7 +304,7 @@ fn assert_equilibrium(model: &Model, rm: &ReducedModel, scale: f64, eta: &[f64],
 /// on the friction bar), with a self-consistent active set and a zero residual.
 #[test]
 fn damped_reduced_contact() {
-    let model = Model::from_case_name("friction_bar").unwrap();
+    let model = common::model("friction_bar");
     let opts = ContactOptions::default();
     let basis = |kind, g| {
         let b = build_basis(

@@ -1,0 +1,10 @@
+//! Time integration (`jointrom::integrate`): the CVODE wrapper, the friction law, the mechanical
+//! ODE on full and reduced systems, runs against the stored full-FE reference.
+
+#[path = "../common/mod.rs"]
+mod common;
+
+mod cvode;
+mod friction;
+mod system;
+mod transient_reference;

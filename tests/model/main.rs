@@ -1,0 +1,9 @@
+//! Whole models (`jointrom::model`): DOF counts, constraints, modes, users' MatrixMarket models,
+//! contact statics, and the CLI's `info`/`modes`/`static` contract.
+
+#[path = "../common/mod.rs"]
+mod common;
+
+mod contact_statics;
+mod matrices;
+mod model;

@@ -1,0 +1,10 @@
+//! Studies (`jointrom::studies`): the static convergence study, the stability map, parameter
+//! sweeps, the POD-snapshot ROM.
+
+#[path = "../common/mod.rs"]
+mod common;
+
+mod pod_snapshots;
+mod stability;
+mod study;
+mod sweep;
