@@ -55,8 +55,8 @@
 //!   (x, z), or overlap without coinciding nodes; an explicit joint point that is not a node of
 //!   both sheets, is listed twice, or is clamped or tied; a joint left without pairs.
 //!
-//! [`Case::from_json_str`] checks the fields (material, contact, load, end time); the checks of
-//! the geometry above need the node grids and run while `crate::mesh::Mesh::from_case` generates
+//! [`Case::from_json_str`] checks the material and each sheet's own fields; the other checks above
+//! need the node grids and run while `crate::mesh::Mesh::from_case` generates
 //! the mesh, which re-runs the field checks too — so a `Case` edited in code cannot produce a
 //! broken mesh either, and the validator and the generator cannot disagree.
 
@@ -296,16 +296,17 @@ impl Case {
     /// Names of the built-in cases (files `cases/<name>.json` compiled into the crate).
     pub const BUILTIN: &'static [&'static str] = &["friction_bar", "multilayer_sheet"];
 
-    /// Parses a case from JSON text (unknown fields rejected) and validates its fields (material,
-    /// contact law, load, end time); the geometry (sheets, clamps, welds, joints) is validated
-    /// when the mesh is generated ([`crate::mesh::Mesh::from_case`]). `file` labels the text in
+    /// Parses a case from JSON text (unknown fields rejected) and validates the material and
+    /// every sheet's own fields; what needs the node grids (clamps, ties, welds, joints) and the
+    /// contact law, load and end time are validated, in the file's order, when the mesh is
+    /// generated ([`crate::mesh::Mesh::from_case`]), which every command does. `file` labels the text in
     /// errors and becomes [`Case::source`].
     pub fn from_json_str(text: &str, file: &str) -> Result<Case, Error> {
         let mut case = parse::parse(text, file)?;
         case.source = file.to_string();
         let ctx = validate::Ctx { file };
         validate::check_material(&case, &ctx)?;
-        validate::check_contact_and_load(&case, &ctx)?;
+        validate::check_sheets(&case, &ctx)?;
         Ok(case)
     }
 

@@ -1,8 +1,13 @@
 //! Validation helpers shared by the case file and the matrix map: an error context that names the
 //! file and JSON path, and the checks of the material, contact law, load and end time.
 
+use std::collections::HashMap;
+
 use super::{Case, ContactSpec, LoadSpec};
 use crate::error::Error;
+
+/// Largest number of nodes a case may generate (sheets and master node).
+pub(crate) const MAX_NODES: usize = 10_000_000;
 
 /// Where errors go: the file label.
 pub(crate) struct Ctx<'a> {
@@ -88,4 +93,71 @@ pub(crate) fn check_contact_load(
     }
     ctx.positive("load.ramp.duration", load.ramp.duration, " s")?;
     ctx.positive("end_time", end_time, " s")
+}
+
+/// Every sheet's own fields: a unique non-empty name, finite extents of positive length, a finite
+/// y, a positive thickness, element counts ≥ 1 and a node count within [`MAX_NODES`].
+pub(crate) fn check_sheets(case: &Case, ctx: &Ctx) -> Result<(), Error> {
+    if case.sheets.is_empty() {
+        return Err(ctx.err("sheets", "no sheets: a case needs at least one"));
+    }
+    let mut names: HashMap<&str, usize> = HashMap::new();
+    let mut first = 0usize;
+    for (s, sheet) in case.sheets.iter().enumerate() {
+        let p = format!("sheets[{s}]");
+        if sheet.name.is_empty() {
+            return Err(ctx.err(format!("{p}.name"), "empty sheet name"));
+        }
+        if let Some(prev) = names.insert(&sheet.name, s) {
+            return Err(ctx.err(
+                format!("{p}.name"),
+                format!(
+                    "duplicate sheet name `{}` (also sheets[{prev}])",
+                    sheet.name
+                ),
+            ));
+        }
+        for (axis, span) in [("x", sheet.x), ("z", sheet.z)] {
+            ctx.finite(&format!("{p}.{axis}[0]"), span[0], " mm")?;
+            ctx.finite(&format!("{p}.{axis}[1]"), span[1], " mm")?;
+            if span[1] <= span[0] {
+                return Err(ctx.err(
+                    format!("{p}.{axis}"),
+                    format!(
+                        "{axis}[1] must be greater than {axis}[0] (a positive length), got \
+                         [{}, {}] mm",
+                        span[0], span[1]
+                    ),
+                ));
+            }
+        }
+        ctx.finite(&format!("{p}.y"), sheet.y, " mm")?;
+        ctx.positive(&format!("{p}.thickness"), sheet.thickness, " mm")?;
+        for (a, &n) in sheet.elements.iter().enumerate() {
+            if n == 0 {
+                return Err(ctx.err(
+                    format!("{p}.elements[{a}]"),
+                    "element count must be positive (at least 1)",
+                ));
+            }
+        }
+        let [nx, nz] = sheet.elements;
+        // Sheet nodes so far, plus the master node, must stay within MAX_NODES.
+        let total = nx
+            .checked_add(1)
+            .zip(nz.checked_add(1))
+            .and_then(|(a, b)| a.checked_mul(b))
+            .and_then(|n| n.checked_add(first + 1));
+        if total.is_none_or(|n| n > MAX_NODES) {
+            return Err(ctx.err(
+                format!("{p}.elements"),
+                format!(
+                    "{nx} × {nz} elements: the mesh would have more than the {MAX_NODES} nodes \
+                     allowed"
+                ),
+            ));
+        }
+        first += (nx + 1) * (nz + 1);
+    }
+    Ok(())
 }

@@ -7,13 +7,12 @@ use std::collections::{HashMap, HashSet};
 
 use super::Material;
 use super::{BeamElem, JointPair, Mesh, RigidTie, SheetGrid, ShellElem};
-use crate::case::validate::{check_contact_and_load, check_material, Ctx};
+use crate::case::validate::{check_contact_and_load, check_material, check_sheets, Ctx};
 use crate::case::{Case, ClampSpec, JointSpec, RigidTieSpec, WeldSpec, NODE_TOLERANCE};
 use crate::error::Error;
 
 /// At most this many nodes in the whole mesh (keeps absurd element counts from overflowing or
 /// exhausting memory).
-const MAX_NODES: usize = 10_000_000;
 
 /// Relative tolerance of the zero-clearance test of a joint.
 const CLEARANCE_TOLERANCE: f64 = 1e-9;
@@ -274,66 +273,11 @@ fn pairs_at_points(
 
 /// Checks every sheet's own fields and numbers the nodes.
 fn sheet_grids<'a>(case: &'a Case, ctx: &Ctx) -> Result<Vec<Grid<'a>>, Error> {
-    if case.sheets.is_empty() {
-        return Err(ctx.err("sheets", "no sheets: a case needs at least one"));
-    }
-    let mut names: HashMap<&str, usize> = HashMap::new();
+    check_sheets(case, ctx)?;
     let mut grids = Vec::with_capacity(case.sheets.len());
     let mut first = 0usize;
-    for (s, sheet) in case.sheets.iter().enumerate() {
-        let p = format!("sheets[{s}]");
-        if sheet.name.is_empty() {
-            return Err(ctx.err(format!("{p}.name"), "empty sheet name"));
-        }
-        if let Some(prev) = names.insert(&sheet.name, s) {
-            return Err(ctx.err(
-                format!("{p}.name"),
-                format!(
-                    "duplicate sheet name `{}` (also sheets[{prev}])",
-                    sheet.name
-                ),
-            ));
-        }
-        for (axis, span) in [("x", sheet.x), ("z", sheet.z)] {
-            ctx.finite(&format!("{p}.{axis}[0]"), span[0], " mm")?;
-            ctx.finite(&format!("{p}.{axis}[1]"), span[1], " mm")?;
-            if span[1] <= span[0] {
-                return Err(ctx.err(
-                    format!("{p}.{axis}"),
-                    format!(
-                        "{axis}[1] must be greater than {axis}[0] (a positive length), got \
-                         [{}, {}] mm",
-                        span[0], span[1]
-                    ),
-                ));
-            }
-        }
-        ctx.finite(&format!("{p}.y"), sheet.y, " mm")?;
-        ctx.positive(&format!("{p}.thickness"), sheet.thickness, " mm")?;
-        for (a, &n) in sheet.elements.iter().enumerate() {
-            if n == 0 {
-                return Err(ctx.err(
-                    format!("{p}.elements[{a}]"),
-                    "element count must be positive (at least 1)",
-                ));
-            }
-        }
+    for sheet in &case.sheets {
         let [nx, nz] = sheet.elements;
-        // Sheet nodes so far, plus the master node, must stay within MAX_NODES.
-        let total = nx
-            .checked_add(1)
-            .zip(nz.checked_add(1))
-            .and_then(|(a, b)| a.checked_mul(b))
-            .and_then(|n| n.checked_add(first + 1));
-        if total.is_none_or(|n| n > MAX_NODES) {
-            return Err(ctx.err(
-                format!("{p}.elements"),
-                format!(
-                    "{nx} × {nz} elements: the mesh would have more than the {MAX_NODES} nodes \
-                     allowed"
-                ),
-            ));
-        }
         let grid = Grid {
             name: &sheet.name,
             lo: [sheet.x[0], sheet.z[0]],

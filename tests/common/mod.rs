@@ -10,7 +10,7 @@ use std::path::PathBuf;
 use std::process::{Command, Output};
 
 use jointrom::case::Case;
-use jointrom::integrate::mechanical::TransientOptions;
+use jointrom::integrate::TransientOptions;
 use jointrom::linalg::SymCsc;
 use jointrom::Model;
 use rand::rngs::StdRng;

@@ -3,12 +3,11 @@
 //! `I − γJ` by differences, and a Φ = I reduced system against the full one.
 
 use faer::Mat;
-use jointrom::integrate::mechanical::{run, MechanicalOde, ProblemOptions, TransientOptions};
 use jointrom::integrate::problem::OdeOptions;
 use jointrom::integrate::problem::OdeProblem;
+use jointrom::integrate::{run, MechanicalOde, ProblemOptions, TransientOptions};
 use jointrom::joint::law::{PairLaw, PairState};
-use jointrom::reduction::ReducedModel;
-use jointrom::system::{FullSystem, ReducedSystem, SecondOrderSystem};
+use jointrom::system::{FullSystem, ReducedSystem, Scene, SecondOrderSystem};
 use jointrom::Model;
 use rand::rngs::StdRng;
 
@@ -285,8 +284,12 @@ fn full_rhs_matches_a_direct_computation() {
     let n = model.dofs();
     let mut rng = common::rng(0x9e37_79b9_7f4a_7c15);
     for (friction, slip) in [(false, false), (true, false), (true, true)] {
-        let mut ode =
-            MechanicalOde::new(FullSystem::new(&model).unwrap(), &opts(friction)).unwrap();
+        let mut ode = MechanicalOde::new(
+            FullSystem::new(&model).unwrap(),
+            &model.contact,
+            &opts(friction),
+        )
+        .unwrap();
         let y = state(&ode, &mut rng, 1e-3, slip, 0.0);
         let t = 0.02; // inside the load ramp
         let mut ydot = vec![0.0; ode.dim()];
@@ -358,7 +361,7 @@ fn full_rhs_matches_a_direct_computation() {
     }
 }
 
-fn reduced_model(model: &Model, r: usize) -> ReducedModel {
+fn reduced_model(model: &Model, r: usize) -> ReducedSystem {
     let basis = jointrom::reduction::build_basis(
         model,
         jointrom::reduction::BasisKind::Tvd,
@@ -368,7 +371,7 @@ fn reduced_model(model: &Model, r: usize) -> ReducedModel {
         },
     )
     .unwrap();
-    ReducedModel::new(model, basis.phi).unwrap()
+    ReducedSystem::new(model, basis.phi).unwrap()
 }
 
 #[test]
@@ -379,9 +382,7 @@ fn newton_solve_matches_i_minus_gamma_j() {
     for gamma in [1e-6, 1e-5, 1e-4] {
         for friction in [false, true] {
             // Reduced (dense) system; q scale: reduced coordinates of a ~1e-3 mm deflection.
-            let mut ode =
-                MechanicalOde::new(ReducedSystem::new(&model, &rom).unwrap(), &opts(friction))
-                    .unwrap();
+            let mut ode = MechanicalOde::new(rom.clone(), &model.contact, &opts(friction)).unwrap();
             let y = state(&ode, &mut rng, 1e-3, false, 0.0);
             let (exact, backward, fd) = newton_residual(&mut ode, 0.02, &y, gamma, &mut rng, true);
             assert!(
@@ -398,8 +399,12 @@ fn newton_solve_matches_i_minus_gamma_j() {
                 "reduced Newton solve residual by differences {fd:.3e}"
             );
             // Full (sparse) system.
-            let mut ode =
-                MechanicalOde::new(FullSystem::new(&model).unwrap(), &opts(friction)).unwrap();
+            let mut ode = MechanicalOde::new(
+                FullSystem::new(&model).unwrap(),
+                &model.contact,
+                &opts(friction),
+            )
+            .unwrap();
             let y = state(&ode, &mut rng, 1e-3, false, 0.0);
             let (exact, backward, fd) = newton_residual(&mut ode, 0.02, &y, gamma, &mut rng, true);
             assert!(
@@ -415,8 +420,7 @@ fn newton_solve_matches_i_minus_gamma_j() {
             // printed, not asserted)
         }
         // Sliding pairs: the dropped ∂p_t/∂g makes the solve approximate; measure it.
-        let mut ode =
-            MechanicalOde::new(ReducedSystem::new(&model, &rom).unwrap(), &opts(true)).unwrap();
+        let mut ode = MechanicalOde::new(rom.clone(), &model.contact, &opts(true)).unwrap();
         let y = state(&ode, &mut rng, 1e-3, true, 0.0);
         // Against the operator without ∂p_t/∂g (what the solver factors): exact.
         let (_, backward, _) = newton_residual(&mut ode, 0.02, &y, gamma, &mut rng, false);
@@ -465,13 +469,16 @@ fn newton_solve_matches_i_minus_gamma_j() {
 fn identity_reduction_agrees_with_the_full_system() {
     let model = common::model("friction_bar");
     let n = model.dofs();
-    let rom = ReducedModel::new(&model, Mat::identity(n, n)).unwrap();
+    let rom = ReducedSystem::new(&model, Mat::identity(n, n)).unwrap();
     let mut rng = common::rng(0xdead_beef_cafe_f00d);
     for (friction, slip) in [(false, false), (true, true)] {
-        let mut full =
-            MechanicalOde::new(FullSystem::new(&model).unwrap(), &opts(friction)).unwrap();
-        let mut red =
-            MechanicalOde::new(ReducedSystem::new(&model, &rom).unwrap(), &opts(friction)).unwrap();
+        let mut full = MechanicalOde::new(
+            FullSystem::new(&model).unwrap(),
+            &model.contact,
+            &opts(friction),
+        )
+        .unwrap();
+        let mut red = MechanicalOde::new(rom.clone(), &model.contact, &opts(friction)).unwrap();
         assert_eq!(full.dim(), red.dim());
         let y = state(&full, &mut rng, 1e-3, slip, 0.0);
         let t = 0.03;
@@ -529,7 +536,7 @@ fn friction_bar_rom_runs_and_balances_energy() {
         &jointrom::reduction::BasisOptions::default(),
     )
     .unwrap();
-    let rom = ReducedModel::new(&model, basis.phi).unwrap();
+    let rom = ReducedSystem::new(&model, basis.phi).unwrap();
     for (atol, tol) in [(1e-6, 1e-3), (1e-8, 2e-5)] {
         let opts = TransientOptions {
             ode: OdeOptions {
@@ -539,7 +546,7 @@ fn friction_bar_rom_runs_and_balances_energy() {
             end_time: Some(0.02),
             ..TransientOptions::default()
         };
-        let res = run(ReducedSystem::new(&model, &rom).unwrap(), &opts).unwrap();
+        let res = run(rom.clone(), &Scene::of(&model), &opts).unwrap();
         let c = &res.curves;
         assert_eq!(c.t.len(), 201);
         assert!((c.t[200] - 0.02).abs() < 1e-15);
@@ -586,7 +593,7 @@ fn friction_bar_rom_runs_and_balances_energy() {
 #[test]
 fn bad_transient_options_are_errors() {
     let model = common::model("friction_bar");
-    let rom = ReducedModel::new(&model, Mat::identity(model.dofs(), 12)).unwrap();
+    let rom = ReducedSystem::new(&model, Mat::identity(model.dofs(), 12)).unwrap();
     let bad = [
         (
             TransientOptions {
@@ -624,7 +631,7 @@ fn bad_transient_options_are_errors() {
         ),
     ];
     for (opts, field) in bad {
-        let err = run(ReducedSystem::new(&model, &rom).unwrap(), &opts)
+        let err = run(rom.clone(), &Scene::of(&model), &opts)
             .err()
             .unwrap_or_else(|| panic!("{field}: accepted"));
         assert!(err.to_string().contains(field), "{field}: {err}");

@@ -9,9 +9,9 @@
 //!   w(g)-chosen g (w ≥ 0.999, g = 12) by ~20 % in ‖f_c‖ (the static study finds the same gap,
 //!   see `jointrom::studies::convergence`), and the largest POD basis (g = 48) meets the 2 %.
 
-use jointrom::integrate::mechanical::{run, Curves, TransientOptions};
-use jointrom::reduction::{build_basis, BasisKind, BasisOptions, ReducedModel};
-use jointrom::system::{FullSystem, ReducedSystem};
+use jointrom::integrate::{run, Curves, TransientOptions};
+use jointrom::reduction::{build_basis, BasisKind, BasisOptions};
+use jointrom::system::{FullSystem, ReducedSystem, Scene};
 
 use crate::common::{self, rel_l2};
 
@@ -84,9 +84,8 @@ fn rom_errors(friction: bool, g: Option<usize>, r: &Reference) -> (usize, f64, f
     )
     .unwrap();
     let g_used = basis.g;
-    let rom = ReducedModel::new(&model, basis.phi).unwrap();
-    let sys = ReducedSystem::new(&model, &rom).unwrap();
-    let res = run(sys, &options(friction, None)).unwrap();
+    let rom = ReducedSystem::new(&model, basis.phi).unwrap();
+    let res = run(rom.clone(), &Scene::of(&model), &options(friction, None)).unwrap();
     assert_eq!(
         res.curves.t.len(),
         r.t.len(),
@@ -113,7 +112,7 @@ fn full_model_short_window_reproduces_the_stored_reference() {
     ] {
         let r = reference(name);
         let sys = FullSystem::new(&model).unwrap();
-        let res = run(sys, &options(friction, Some(0.01))).unwrap();
+        let res = run(sys, &Scene::of(&model), &options(friction, Some(0.01))).unwrap();
         assert_eq!(res.curves.t.len(), 101);
         let (fc, uy, fr) = errors(&res.curves, &r);
         eprintln!(

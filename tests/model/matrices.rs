@@ -5,11 +5,11 @@
 
 use std::path::{Path, PathBuf};
 
-use jointrom::integrate::mechanical as transient;
+use jointrom::integrate as transient;
 use jointrom::joint::statics::ContactOptions;
 use jointrom::model::contact_static_full;
-use jointrom::reduction::{build_basis, BasisKind, BasisOptions, ReducedModel};
-use jointrom::system::{FullSystem, ReducedSystem};
+use jointrom::reduction::{build_basis, BasisKind, BasisOptions};
+use jointrom::system::{FullSystem, ReducedSystem, Scene};
 use jointrom::Model;
 use serde_json::Value;
 
@@ -90,12 +90,14 @@ fn friction_bar_round_trip_is_identical() {
     // Reduced transient with friction, 0–0.02 s, and the full model, 0–2 ms.
     let ropts = common::until(0.02);
     let ra = transient::run(
-        ReducedSystem::new(&case, &ReducedModel::new(&case, ba.phi).unwrap()).unwrap(),
+        ReducedSystem::new(&case, ba.phi).unwrap(),
+        &Scene::of(&case),
         &ropts,
     )
     .unwrap();
     let rb = transient::run(
-        ReducedSystem::new(&back, &ReducedModel::new(&back, bb.phi).unwrap()).unwrap(),
+        ReducedSystem::new(&back, bb.phi).unwrap(),
+        &Scene::of(&back),
         &ropts,
     )
     .unwrap();
@@ -103,8 +105,8 @@ fn friction_bar_round_trip_is_identical() {
     assert_eq!(ra.stats.steps, rb.stats.steps);
     assert!(ra.curves.contact_force_norm.iter().any(|&f| f > 0.0));
     let fopts = common::until(2e-3);
-    let fa = transient::run(FullSystem::new(&case).unwrap(), &fopts).unwrap();
-    let fb = transient::run(FullSystem::new(&back).unwrap(), &fopts).unwrap();
+    let fa = transient::run(FullSystem::new(&case).unwrap(), &Scene::of(&case), &fopts).unwrap();
+    let fb = transient::run(FullSystem::new(&back).unwrap(), &Scene::of(&back), &fopts).unwrap();
     assert_eq!(fa.curves, fb.curves, "full-model curves identical");
     let _ = std::fs::remove_dir_all(&dir);
 }

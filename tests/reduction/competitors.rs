@@ -16,8 +16,9 @@ use jointrom::linalg::SymCsc;
 use jointrom::model::contact_static_full;
 use jointrom::reduction::{
     alldof_vectors, build_basis, jim_dofs, joint_interface_modes, snapshot_basis, snapshot_pod,
-    BasisKind, BasisOptions, JimSet, ReducedModel,
+    BasisKind, BasisOptions, JimSet,
 };
+use jointrom::system::ReducedSystem;
 use jointrom::{Error, Model};
 
 use crate::common::{self, col, mul, norm};
@@ -76,13 +77,17 @@ fn try_reduced_contact(
     phi: Mat<f64>,
     load: [f64; 6],
 ) -> Result<(ContactState, [f64; 6]), Error> {
-    let red = ReducedModel::new(model, phi)?;
+    let red = ReducedSystem::new(model, phi)?;
     let w = model.joint.pairs();
     let r = red.dim();
     let b_n_phi = Mat::from_fn(w, r, |i, j| red.b_phi[(3 * i + NORMAL, j)]);
     let master = model.master_dofs();
     let f_red: Vec<f64> = (0..r)
-        .map(|c| (0..6).map(|d| red.phi[(master[d], c)] * load[d]).sum())
+        .map(|c| {
+            (0..6)
+                .map(|d| red.phi.as_ref().unwrap()[(master[d], c)] * load[d])
+                .sum()
+        })
         .collect();
     let (eta, state) = contact_static_reduced(
         red.k.as_ref(),
@@ -91,7 +96,11 @@ fn try_reduced_contact(
         model.contact.normal_stiffness,
         &ContactOptions::default(),
     )?;
-    let um = master.map(|d| (0..r).map(|c| red.phi[(d, c)] * eta[c]).sum());
+    let um = master.map(|d| {
+        (0..r)
+            .map(|c| red.phi.as_ref().unwrap()[(d, c)] * eta[c])
+            .sum()
+    });
     Ok((state, um))
 }
 

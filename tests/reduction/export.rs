@@ -4,10 +4,10 @@
 
 use std::path::PathBuf;
 
-use jointrom::integrate::mechanical as transient;
+use jointrom::integrate as transient;
 use jointrom::reduction::rom_file::{BasisInfo, RomFile};
-use jointrom::reduction::{build_basis, BasisKind, BasisOptions, ReducedModel};
-use jointrom::system::ReducedSystem;
+use jointrom::reduction::{build_basis, BasisKind, BasisOptions};
+use jointrom::system::{ReducedSystem, Scene};
 
 use crate::common::{self, jointrom_json, jointrom_ok};
 
@@ -26,7 +26,7 @@ fn exported_rom_reintegrates_to_identical_curves() {
         threshold: 0.999,
         w: b.w.clone(),
     };
-    let rom = ReducedModel::new(&model, b.phi).unwrap();
+    let rom = ReducedSystem::new(&model, b.phi).unwrap();
     let file = RomFile::new(&model, &rom, info).unwrap();
     let path = tmp("roundtrip");
     file.write(&path).unwrap();
@@ -43,12 +43,9 @@ fn exported_rom_reintegrates_to_identical_curves() {
             assert!((back.mass[i][j] - id).abs() < 1e-12);
         }
     }
-    let direct = transient::run(
-        ReducedSystem::new(&model, &rom).unwrap(),
-        &common::until(5e-3),
-    )
-    .unwrap();
-    let again = transient::run(back.system().unwrap(), &common::until(5e-3)).unwrap();
+    let direct = transient::run(rom.clone(), &Scene::of(&model), &common::until(5e-3)).unwrap();
+    let again =
+        transient::run(back.system().unwrap(), &back.scene(), &common::until(5e-3)).unwrap();
     assert_eq!(direct.curves, again.curves, "identical curves");
     assert_eq!(direct.stats.steps, again.stats.steps);
     assert!(direct.curves.contact_force_norm.last().unwrap() > &0.0);
@@ -77,7 +74,7 @@ fn damaged_files_are_rejected_naming_the_field() {
         threshold: 0.999,
         w: Vec::new(),
     };
-    let rom = ReducedModel::new(&model, b.phi).unwrap();
+    let rom = ReducedSystem::new(&model, b.phi).unwrap();
     let good: serde_json::Value =
         serde_json::to_value(RomFile::new(&model, &rom, info).unwrap()).unwrap();
     let cases: Vec<(&str, Box<Damage>, &str)> = vec![

@@ -1,7 +1,8 @@
 //! The main job's report (`jointrom run --quick`): every chart and table is written, the numbers
 //! are consistent with each other and with the paper's qualitative claims on this window.
 
-use jointrom::report::main_job::{run_report, ReportOptions};
+use jointrom::report::main_job::run_report;
+use jointrom::studies::main_job::ReportOptions;
 
 use crate::common;
 
@@ -65,7 +66,7 @@ fn quick_report_on_the_friction_bar() {
     // The full run is the reference and finished; the full run with functional iteration is
     // recorded whatever its fate.
     let full = &rep.runs[0];
-    assert_eq!((full.model.as_str(), full.status.as_str()), ("full", "ok"));
+    assert_eq!((full.model.as_str(), full.status.name()), ("full", "ok"));
     assert_eq!(full.size, model.dofs());
     assert!(rep
         .runs
@@ -91,7 +92,7 @@ fn quick_report_on_the_friction_bar() {
     assert!(all.error_uy.unwrap() < 1e-4);
     // Functional and Newton iteration solve the same ROM: same curves within the tolerances.
     let fun = run("tvd", g, "functional");
-    if fun.status == "ok" {
+    if fun.status.name() == "ok" {
         let d = jointrom::studies::stability::relative_l2(&fun.t, &fun.fc, &chosen.t, &chosen.fc)
             .unwrap();
         assert!(d < 1e-2, "functional vs Newton ‖f_c‖ differ by {d}");
@@ -105,10 +106,12 @@ fn quick_report_on_the_friction_bar() {
     assert!(!front.is_empty());
     for p in &front {
         let (c, e) = (p.cpu_s, p.error_fc.unwrap());
-        assert!(!rep
-            .runs
-            .iter()
-            .any(|r| r.status == "ok" && r.error_fc.is_some_and(|er| r.cpu_s < c && er < e)));
+        assert!(
+            !rep.runs
+                .iter()
+                .any(|r| r.status.name() == "ok"
+                    && r.error_fc.is_some_and(|er| r.cpu_s < c && er < e))
+        );
     }
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -1,25 +1,21 @@
 //! The POD-snapshot competitor (paper Section 5.2) built from a full-FE transient run:
-//! snapshots come from `transient::run_observed`, the basis from `snapshot_basis`, and the ROM
+//! snapshots come from the driver's observer (`integrate`), the basis from `snapshot_basis`, and the ROM
 //! on it reproduces the run it was trained on — far better than Craig–Bampton alone.
 
 use faer::Mat;
-use jointrom::integrate::mechanical::{self as transient, TransientResult};
-use jointrom::reduction::{build_basis, snapshot_basis, BasisKind, BasisOptions, ReducedModel};
+use jointrom::integrate::{self as transient, Run};
+use jointrom::reduction::{build_basis, snapshot_basis, BasisKind, BasisOptions};
 use jointrom::studies::stability::relative_l2;
-use jointrom::system::{FullSystem, ReducedSystem};
+use jointrom::system::{FullSystem, ReducedSystem, Scene};
 use jointrom::Model;
 
 use crate::common::{self, jointrom_err, jointrom_json};
 
 const END: f64 = 5e-3;
 
-fn rom_run(model: &Model, phi: Mat<f64>) -> TransientResult {
-    let rom = ReducedModel::new(model, phi).unwrap();
-    transient::run(
-        ReducedSystem::new(model, &rom).unwrap(),
-        &common::until(END),
-    )
-    .unwrap()
+fn rom_run(model: &Model, phi: Mat<f64>) -> Run {
+    let rom = ReducedSystem::new(model, phi).unwrap();
+    transient::run(rom, &Scene::of(model), &common::until(END)).unwrap()
 }
 
 #[test]
@@ -27,11 +23,13 @@ fn snapshot_pod_rom_reproduces_its_training_run() {
     let model = common::model("friction_bar");
     let n = model.dofs();
     let mut states: Vec<(f64, Vec<f64>)> = Vec::new();
-    let full = transient::run_observed(
+    let full = transient::integrate(
         FullSystem::new(&model).unwrap(),
+        &Scene::of(&model),
         &common::until(END),
         |t, q| states.push((t, q.to_vec())),
     )
+    .finished()
     .unwrap();
     // One observation at t = 0 (rest) and one per output, matching the curves.
     assert_eq!(states.len(), full.curves.t.len());
@@ -67,7 +65,7 @@ fn snapshot_pod_rom_reproduces_its_training_run() {
     .unwrap();
     let g0 = rom_run(&model, cb.phi);
     let c = &full.curves;
-    let err = |r: &TransientResult| {
+    let err = |r: &Run| {
         (
             relative_l2(
                 &r.curves.t,

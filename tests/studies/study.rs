@@ -9,15 +9,14 @@ use jointrom::joint::statics::ContactOptions;
 use jointrom::joint::NORMAL;
 use jointrom::linalg::cholesky::SparseCholesky;
 use jointrom::model::contact_static_full;
-use jointrom::reduction::{
-    build_basis, craig_bampton, final_basis, BasisKind, BasisOptions, ReducedModel,
-};
+use jointrom::reduction::{build_basis, craig_bampton, final_basis, BasisKind, BasisOptions};
 use jointrom::report::chart::{LineChart, Reference, Series};
 use jointrom::report::convergence::write_charts;
 use jointrom::studies::convergence::{
     basis_static, reduced_contact_static, reduced_contact_static_damped,
     reduced_contact_static_restarting, run_study, within, StudyOptions,
 };
+use jointrom::system::ReducedSystem;
 use jointrom::{Interface, Model};
 
 use crate::common;
@@ -26,7 +25,7 @@ fn tmp(name: &str) -> PathBuf {
     common::tmp_dir(&format!("study_{name}"))
 }
 
-/// The study's reduced pipeline (final_basis → ReducedModel → reduced contact solve) is exact
+/// The study's reduced pipeline (final_basis → ReducedSystem → reduced contact solve) is exact
 /// when the basis holds the whole joint space: Φ_S spans K⁻¹ f (master load) and K⁻¹ B_nᵀ spans
 /// every contact force, so the full solution lies in span Φ and the Galerkin solution of the
 /// convex contact energy is it.
@@ -48,7 +47,7 @@ fn reduced_statics_exact_with_the_whole_joint_space() {
             .solve_in_place(&mut f);
         let (phi, dropped) = final_basis(&[cb.as_ref(), f.as_ref()], &model.mass, 1e-8).unwrap();
         assert_eq!(dropped, 0, "{case}");
-        let rm = ReducedModel::new(&model, phi).unwrap();
+        let rm = ReducedSystem::new(&model, phi).unwrap();
         let opts = ContactOptions::default();
         let full = contact_static_full(&model, model.master_load(), &opts).unwrap();
         let red = reduced_contact_static(&model, &rm, 1.0, &opts).unwrap();
@@ -273,16 +272,17 @@ fn chart_log_axis_and_errors() {
 
 /// Independent check of a reduced contact solution: the active set is self-consistent
 /// (active ⇔ gap < 0) and η solves `(K̃ + k_n Σ_active b_iᵀ b_i) η = f̃` to round-off.
-fn assert_equilibrium(model: &Model, rm: &ReducedModel, scale: f64, eta: &[f64], what: &str) {
+fn assert_equilibrium(model: &Model, rm: &ReducedSystem, scale: f64, eta: &[f64], what: &str) {
     let w = model.joint.pairs();
     let r = rm.dim();
     let k_n = model.contact.normal_stiffness;
+    let load = rm.reduced_load();
     let b = |i: usize, j: usize| rm.b_phi[(3 * i + NORMAL, j)];
     let gaps: Vec<f64> = (0..w)
         .map(|i| (0..r).map(|j| b(i, j) * eta[j]).sum())
         .collect();
     let mut res: Vec<f64> = (0..r)
-        .map(|i| (0..r).map(|j| rm.k[(i, j)] * eta[j]).sum::<f64>() - scale * rm.load[i])
+        .map(|i| (0..r).map(|j| rm.k[(i, j)] * eta[j]).sum::<f64>() - scale * load[i])
         .collect();
     for i in 0..w {
         if gaps[i] < 0.0 {
@@ -291,7 +291,7 @@ fn assert_equilibrium(model: &Model, rm: &ReducedModel, scale: f64, eta: &[f64],
             }
         }
     }
-    let fmax = rm.load.iter().fold(0.0f64, |a, v| a.max(v.abs())) * scale.abs();
+    let fmax = load.iter().fold(0.0f64, |a, v| a.max(v.abs())) * scale.abs();
     let rmax = res.iter().fold(0.0f64, |a, v| a.max(v.abs()));
     assert!(
         rmax <= 1e-8 * fmax,
@@ -316,7 +316,7 @@ fn damped_reduced_contact() {
             },
         )
         .unwrap();
-        ReducedModel::new(&model, b.phi).unwrap()
+        ReducedSystem::new(&model, b.phi).unwrap()
     };
     let rm = basis(BasisKind::Tvd, 20);
     let plain = reduced_contact_static(&model, &rm, 1.0, &opts).unwrap();

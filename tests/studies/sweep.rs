@@ -1,10 +1,10 @@
 //! `jointrom sweep`: variants of one shared reduced model, run in parallel, give the same curves
 //! as run one by one and as a direct run of the case; the variant file is validated.
 
-use jointrom::integrate::mechanical as transient;
-use jointrom::reduction::{build_basis, BasisKind, BasisOptions, ReducedModel};
+use jointrom::integrate as transient;
+use jointrom::reduction::{build_basis, BasisKind, BasisOptions};
 use jointrom::studies::sweep::{read_variants, run_sweep, Variant};
-use jointrom::system::ReducedSystem;
+use jointrom::system::{ReducedSystem, Scene};
 
 use crate::common;
 
@@ -22,7 +22,7 @@ fn variant(name: &str, mu: Option<f64>, scale: Option<f64>) -> Variant {
 fn parallel_equals_sequential_and_the_case_variant_equals_a_direct_run() {
     let model = common::model("friction_bar");
     let b = build_basis(&model, BasisKind::Tvd, &BasisOptions::default()).unwrap();
-    let rom = ReducedModel::new(&model, b.phi).unwrap();
+    let rom = ReducedSystem::new(&model, b.phi).unwrap();
     let opts = common::until(0.01);
     let vs = vec![
         variant("case", None, None),
@@ -36,7 +36,7 @@ fn parallel_equals_sequential_and_the_case_variant_equals_a_direct_run() {
         assert_eq!(p.status, "ok");
         assert_eq!(p.curves, s.curves, "{}", p.variant.name);
     }
-    let direct = transient::run(ReducedSystem::new(&model, &rom).unwrap(), &opts).unwrap();
+    let direct = transient::run(rom.clone(), &Scene::of(&model), &opts).unwrap();
     assert_eq!(par.runs[0].curves, direct.curves);
     // μ = 0: no friction force; μ = 0.5 rubs harder than the case's 0.25.
     let last = |v: &[f64]| *v.last().unwrap();
