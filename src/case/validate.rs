@@ -6,7 +6,8 @@ use std::collections::HashMap;
 use super::{Case, ContactSpec, LoadSpec};
 use crate::error::Error;
 
-/// Largest number of nodes a case may generate (sheets and master node).
+/// At most this many nodes in the whole mesh, sheets and master node (keeps absurd element
+/// counts from overflowing or exhausting memory).
 pub(crate) const MAX_NODES: usize = 10_000_000;
 
 /// Where errors go: the file label.

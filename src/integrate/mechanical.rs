@@ -60,35 +60,14 @@
 //! re-initialises the integrator (order 1, history discarded); 1000 roots in a row without
 //! progress in time end the run with an error (a chattering switch).
 //!
-//! Measured on the friction bar ROM (TVD basis, r = 28, 0.02 s, friction on, Newton with the
-//! structured solve): ~1.3 Newton iterations per step whether or not the factorization is
-//! redone for every new γ (so it is not: CVODE decides when to call the setup); at atol 1e-6
-//! ~30 000 steps and the energy balance closes to 3e-4 of the external work, at atol 1e-8
-//! ~24 000 steps and 2e-6. With events on, gaps of nearly closed pairs cross zero tens of
-//! thousands of times in 0.02 s and each restart costs a low-order step: ~20× slower.
+//! Measured step counts, Newton iterations and energy balances of these runs are in
+//! `docs/measurements.md` (section `integrate::mechanical`).
 //!
 //! ## Step size of the full model: defaults
 //!
 //! The full FE model (friction bar, 906 DOF) took ~1e5 steps of ~1e-8 s per millisecond with
-//! CVODE's defaults. Measured on the first 5 ms (Newton, structured solve, rtol 1e-8, atol 1e-6
-//! mm; `vs` = [`ProblemOptions::velocity_scale`], velocity atol = `vs · atol` mm/s; wall times on
-//! 2 cores loaded by other jobs, so compare steps):
-//!
-//! | friction | max order | vs (1/s) | steps | Newton its | conv. fails | last h (s) | wall (s) |
-//! |---|---|---|---|---|---|---|---|
-//! | off | 5 | 1 | > 300 s, not finished | | | | |
-//! | off | 5 | 1e2 | > 300 s, not finished | | | | |
-//! | off | 5 | 1e3 | 15 081 | 16 682 | 84 | 1.4e-8 | 11.7 |
-//! | off | 5 | 1e4 | 307 986 | 328 455 | 61 | 6.2e-9 | 179 |
-//! | off | 5 + stab. lim. det. | 1e3 | 22 937 | 25 955 | 84 | 6.4e-9 | 16.1 |
-//! | off | 2 | 1 | 25 253 | 26 465 | 16 | 8.4e-8 | 11.7 |
-//! | off | 2 | 1e2 | 1 467 | 1 841 | 59 | 7.4e-7 | 6.2 |
-//! | off | 2 | 1e3 | 1 439 | 1 929 | 87 | 1.4e-5 | 1.0 |
-//! | off | 2 | 1e4 | 1 142 | 1 675 | 114 | 2.6e-6 | 0.9 |
-//! | on | 2 | 1 | 25 072 | 26 295 | 11 | 6.8e-8 | 109 |
-//! | on | 2 | 1e2 | 1 996 | 2 491 | 78 | 6.2e-7 | 8.8 |
-//! | on | 2 (and 5: identical) | 1e3 | 1 193 | 1 802 | 126 | 1.9e-6 | 1.5 |
-//! | on | 2 | 1e4 | 1 361 | 2 263 | 245 | 4.3e-6 | 12.4 |
+//! CVODE's defaults (the measured table of max order × velocity tolerance × friction is in
+//! `docs/measurements.md`).
 //!
 //! Two causes, both legitimately removable:
 //!

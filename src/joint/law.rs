@@ -33,7 +33,7 @@
 //! state lags outside the cone by `|e| − c ≈ τ V` (1e-5 mm at 10 mm/s), which changes nothing in
 //! the force (it is capped) and only delays the stick→slip transition by ~τ. The dissipation per
 //! cycle of the exact Coulomb loop `4 μ p_n (A − c)` is reproduced closely for τ = 1e-6 s
-//! (`tests/friction.rs` checks 1 %; measured errors in `docs/measurements.md`, section
+//! (`tests/integrate/friction.rs` checks 1 %; measured errors in `docs/measurements.md`, section
 //! `joint::law`). The price is a stiff eigenvalue `−1/τ` per sliding or open pair: fine for BDF
 //! with Newton (the structured solve of [`crate::integrate::mechanical`] treats it exactly),
 //! prohibitive for functional iteration (step ≲ τ) whenever friction is on.

@@ -11,9 +11,6 @@ use crate::case::validate::{check_contact_and_load, check_material, check_sheets
 use crate::case::{Case, ClampSpec, JointSpec, RigidTieSpec, WeldSpec, NODE_TOLERANCE};
 use crate::error::Error;
 
-/// At most this many nodes in the whole mesh (keeps absurd element counts from overflowing or
-/// exhausting memory).
-
 /// Relative tolerance of the zero-clearance test of a joint.
 const CLEARANCE_TOLERANCE: f64 = 1e-9;
 

@@ -44,7 +44,7 @@
 //! An indefinite K (unsupported structure) is reported by the first factorization.
 //!
 //! [`write()`] goes the other way: any model to `K.mtx`, `M.mtx` (symmetric, shortest round-trip
-//! decimal, so the numbers come back bit for bit) and `model.json`. `tests/matrices.rs` exports
+//! decimal, so the numbers come back bit for bit) and `model.json`. `tests/model/matrices.rs` exports
 //! the friction bar, reads it back and gets identical matrices, bases, statics and transients.
 
 use std::collections::HashMap;

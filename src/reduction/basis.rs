@@ -186,7 +186,7 @@ pub struct Basis {
 /// no diagonal scaling repairs, so rounding `K̃` to double alone perturbs the reduced solution by
 /// cond·eps. The contact gaps of the multilayer sheet are ~1e-6 of its displacement, which made
 /// the all-joint-DOF basis miss the full ‖f_c‖ by 1.4e-7 on the Gram–Schmidt basis and by 2e-10
-/// on the rotated one (measured, `tests/competitors.rs`). The diagonal `K̃` is also the natural
+/// on the rotated one (measured, `tests/reduction/competitors.rs`). The diagonal `K̃` is also the natural
 /// form for the time integration (its largest ω bounds the reduced model's stiffness).
 pub fn modal_rotation(model: &Model, phi: Mat<f64>) -> Result<(Mat<f64>, Vec<f64>), Error> {
     if phi.nrows() != model.dofs() {

@@ -280,44 +280,11 @@ fn markdown(rep: &Report, stab: &Path, stability: bool) -> String {
          reference: BDF + Newton, {} steps, {:.2} s CPU.\n",
         rep.g_chosen, rep.threshold, full.stats.steps, full.cpu_s
     );
-    let _ = writeln!(
-        s,
-        "| model | g | size | iteration | status | err ‖f_c‖ | err u_y | err ‖f_R‖ | CPU s | % of full | speed-up | steps | RHS | Newton its | setups | Pareto |"
-    );
-    let _ = writeln!(
-        s,
-        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
-    );
-    for r in &rep.runs {
-        let _ = writeln!(
-            s,
-            "| {} | {} | {} | {} | {} | {} | {} | {} | {:.3} | {} | {} | {} | {} | {} | {} | {} |",
-            r.model,
-            r.g.map_or("–".into(), |g| g.to_string()),
-            r.size,
-            r.iteration,
-            if r.status.finished() {
-                "ok".to_string()
-            } else {
-                format!("{} at t = {:.3e} s", r.status, r.t_reached)
-            },
-            fmt_opt(r.error_fc, 2),
-            fmt_opt(r.error_uy, 2),
-            fmt_opt(r.error_fr, 2),
-            r.cpu_s,
-            r.cpu_percent.map_or("–".into(), |p| format!("{p:.2}")),
-            r.speedup.map_or("–".into(), |p| format!("{p:.0}×")),
-            r.stats.steps,
-            r.stats.rhs_evals,
-            r.stats.nonlinear_iterations,
-            r.stats.linear_setups,
-            if r.pareto { "●" } else { "" }
-        );
-    }
+    runs_table(&mut s, rep);
     let _ = writeln!(
         s,
         "\nErrors are relative L2 over the output times (every 1e-4 s) against the full FE run. \
-         CPU is the integration's process CPU time (10 ms resolution); basis construction is \
+         CPU is the integrating thread's CPU time; basis construction is \
          extra (`build_s` in `results.json`). A run that does not finish within its wall-clock \
          budget is recorded as `budget` with the time it reached.\n"
     );
@@ -364,6 +331,53 @@ fn markdown(rep: &Report, stab: &Path, stability: bool) -> String {
          the Craig–Bampton vectors, the first TVD and joint modes: `shapes/*.vtu`.\n\n\
          ![joint modes](shapes/joint_modes.png)\n"
     );
+    study_section(&mut s, rep);
+    stability_section(&mut s, rep, stab, stability);
+    s
+}
+
+/// The summary table: one row per run.
+fn runs_table(s: &mut String, rep: &Report) {
+    use std::fmt::Write;
+    let _ = writeln!(
+        s,
+        "| model | g | size | iteration | status | err ‖f_c‖ | err u_y | err ‖f_R‖ | CPU s | % of full | speed-up | steps | RHS | Newton its | setups | Pareto |"
+    );
+    let _ = writeln!(
+        s,
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+    );
+    for r in &rep.runs {
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} | {} | {} | {} | {} | {} | {:.3} | {} | {} | {} | {} | {} | {} | {} |",
+            r.model,
+            r.g.map_or("–".into(), |g| g.to_string()),
+            r.size,
+            r.iteration,
+            if r.status.finished() {
+                "ok".to_string()
+            } else {
+                format!("{} at t = {:.3e} s", r.status, r.t_reached)
+            },
+            fmt_opt(r.error_fc, 2),
+            fmt_opt(r.error_uy, 2),
+            fmt_opt(r.error_fr, 2),
+            r.cpu_s,
+            r.cpu_percent.map_or("–".into(), |p| format!("{p:.2}")),
+            r.speedup.map_or("–".into(), |p| format!("{p:.0}×")),
+            r.stats.steps,
+            r.stats.rhs_evals,
+            r.stats.nonlinear_iterations,
+            r.stats.linear_setups,
+            if r.pareto { "●" } else { "" }
+        );
+    }
+}
+
+/// The static convergence section.
+fn study_section(s: &mut String, rep: &Report) {
+    use std::fmt::Write;
     let _ = writeln!(
         s,
         "## Static convergence and w(g) (Figs. 7, 8, 15, 16, 19)\n"
@@ -394,6 +408,11 @@ fn markdown(rep: &Report, stab: &Path, stability: bool) -> String {
         s,
         "\n![error](study/fc_error.png)\n\n![norm](study/fc_norm.png)\n\n![w(g)](study/w.png)\n"
     );
+}
+
+/// The stability-map section: the stored map if there is one.
+fn stability_section(s: &mut String, rep: &Report, stab: &Path, stability: bool) {
+    use std::fmt::Write;
     let _ = writeln!(s, "## Stability map\n");
     if stability {
         let _ = writeln!(
@@ -413,5 +432,4 @@ fn markdown(rep: &Report, stab: &Path, stability: bool) -> String {
             rep.source
         );
     }
-    s
 }

@@ -382,7 +382,6 @@ pub fn run_main_job(
         model.end_time
     };
     let output_step = 1e-4;
-    let problem = ProblemOptions::default();
 
     let mut bar = Tracker {
         on: opts.progress,
@@ -412,116 +411,14 @@ pub fn run_main_job(
     bar.set_length(plan.len() as u64 + 3);
     bar.inc(1);
 
-    // 2. The full reference.
-    bar.set_message("full FE model, Newton");
-    let t0 = Instant::now();
-    let full_sys = FullSystem::new(model);
-    let build_full = t0.elapsed().as_secs_f64();
-    let full = budgeted(
-        full_sys,
-        model,
-        &problem,
-        ode_options(false),
-        (end_time, output_step),
-        opts.full_budget_s,
-    );
-    if !full.ok() {
-        return Err(Error::Invalid(format!(
-            "the full FE reference run failed at t = {} s ({}): {}",
-            full.t_reached,
-            full.status,
-            full.message.clone().unwrap_or_default()
-        )));
-    }
-    let mut runs = vec![record("full", None, model.dofs(), false, build_full, full)];
-    bar.inc(1);
-    bar.set_message("full FE model, functional iteration");
-    let full_fun = budgeted(
-        FullSystem::new(model),
-        model,
-        &problem,
-        ode_options(true),
-        (end_time, output_step),
-        if opts.quick {
-            opts.full_functional_budget_s.min(2.0)
-        } else {
-            opts.full_functional_budget_s
-        },
-    );
-    runs.push(record(
-        "full",
-        None,
-        model.dofs(),
-        true,
-        build_full,
-        full_fun,
-    ));
-    bar.inc(1);
-
-    // 3. Reduced runs.
-    for p in &plan {
-        bar.set_message(format!(
-            "{} g = {} ({})",
-            p.kind.name(),
-            p.g,
-            if p.functional { "functional" } else { "Newton" }
-        ));
-        let t0 = Instant::now();
-        let basis = build_basis(
-            model,
-            p.kind,
-            &BasisOptions {
-                g: Some(p.g),
-                ..BasisOptions::default()
-            },
-        )?;
-        let g_used = basis.g;
-        let rm = ReducedSystem::new(model, basis.phi)?;
-        let build_s = t0.elapsed().as_secs_f64();
-        let dim = rm.dim();
-        let o = budgeted(
-            Ok(rm),
-            model,
-            &problem,
-            ode_options(p.functional),
-            (end_time, output_step),
-            opts.rom_budget_s,
-        );
-        runs.push(record(
-            p.kind.name(),
-            Some(g_used),
-            dim,
-            p.functional,
-            build_s,
-            o,
-        ));
-        bar.inc(1);
-    }
+    // 2. The full reference and 3. the reduced runs.
+    let span = (end_time, output_step);
+    let mut runs = full_runs(model, opts, span, &mut bar)?;
+    reduced_runs(model, opts, &plan, span, &mut bar, &mut runs)?;
     bar.finish_and_clear();
 
     // Errors, speed-ups, Pareto front.
-    let (t_ref, fc_ref, fr_ref, uy_ref, cpu_ref) = {
-        let f = &runs[0];
-        (
-            f.t.clone(),
-            f.fc.clone(),
-            f.fr.clone(),
-            f.uy.clone(),
-            f.cpu_s,
-        )
-    };
-    for r in runs.iter_mut().skip(1) {
-        if !r.status.finished() {
-            continue;
-        }
-        r.error_fc = relative_l2(&r.t, &r.fc, &t_ref, &fc_ref);
-        r.error_uy = relative_l2(&r.t, &r.uy, &t_ref, &uy_ref);
-        r.error_fr = relative_l2(&r.t, &r.fr, &t_ref, &fr_ref);
-        if r.cpu_s > 0.0 && cpu_ref.is_finite() {
-            r.speedup = Some(cpu_ref / r.cpu_s);
-            r.cpu_percent = Some(100.0 * r.cpu_s / cpu_ref);
-        }
-    }
+    compare_to_full(&mut runs);
     mark_pareto(&mut runs);
 
     let anchors = paper_anchors(&case);
@@ -569,5 +466,140 @@ fn mark_pareto(runs: &mut [RunRecord]) {
             j != i && p.is_some_and(|(cj, ej)| cj <= ci && ej <= ei && (cj < ci || ej < ei))
         });
         runs[i].pareto = !dominated;
+    }
+}
+
+/// The full FE runs (step 2): Newton, the reference of every error (its failure is an error),
+/// and functional iteration (expected to fail: recorded).
+fn full_runs(
+    model: &Model,
+    opts: &ReportOptions,
+    span: (f64, f64),
+    bar: &mut Tracker<'_>,
+) -> Result<Vec<RunRecord>, Error> {
+    let problem = ProblemOptions::default();
+    bar.set_message("full FE model, Newton");
+    let t0 = Instant::now();
+    let full_sys = FullSystem::new(model);
+    let build_full = t0.elapsed().as_secs_f64();
+    let full = budgeted(
+        full_sys,
+        model,
+        &problem,
+        ode_options(false),
+        span,
+        opts.full_budget_s,
+    );
+    if !full.ok() {
+        return Err(Error::Invalid(format!(
+            "the full FE reference run failed at t = {} s ({}): {}",
+            full.t_reached,
+            full.status,
+            full.message.clone().unwrap_or_default()
+        )));
+    }
+    let mut runs = vec![record("full", None, model.dofs(), false, build_full, full)];
+    bar.inc(1);
+    bar.set_message("full FE model, functional iteration");
+    let full_fun = budgeted(
+        FullSystem::new(model),
+        model,
+        &problem,
+        ode_options(true),
+        span,
+        if opts.quick {
+            opts.full_functional_budget_s.min(2.0)
+        } else {
+            opts.full_functional_budget_s
+        },
+    );
+    runs.push(record(
+        "full",
+        None,
+        model.dofs(),
+        true,
+        build_full,
+        full_fun,
+    ));
+    bar.inc(1);
+
+    Ok(runs)
+}
+
+/// The reduced runs of the plan (step 3), each on its own basis and under its budget.
+fn reduced_runs(
+    model: &Model,
+    opts: &ReportOptions,
+    plan: &[Plan],
+    span: (f64, f64),
+    bar: &mut Tracker<'_>,
+    runs: &mut Vec<RunRecord>,
+) -> Result<(), Error> {
+    let problem = ProblemOptions::default();
+    for p in plan {
+        bar.set_message(format!(
+            "{} g = {} ({})",
+            p.kind.name(),
+            p.g,
+            if p.functional { "functional" } else { "Newton" }
+        ));
+        let t0 = Instant::now();
+        let basis = build_basis(
+            model,
+            p.kind,
+            &BasisOptions {
+                g: Some(p.g),
+                ..BasisOptions::default()
+            },
+        )?;
+        let g_used = basis.g;
+        let rm = ReducedSystem::new(model, basis.phi)?;
+        let build_s = t0.elapsed().as_secs_f64();
+        let dim = rm.dim();
+        let o = budgeted(
+            Ok(rm),
+            model,
+            &problem,
+            ode_options(p.functional),
+            span,
+            opts.rom_budget_s,
+        );
+        runs.push(record(
+            p.kind.name(),
+            Some(g_used),
+            dim,
+            p.functional,
+            build_s,
+            o,
+        ));
+        bar.inc(1);
+    }
+    Ok(())
+}
+
+/// Each finished reduced run's relative L2 errors of ‖f_c‖, ‖f_R‖ and u_y against the full run
+/// (`runs[0]`) and its CPU speed-up.
+fn compare_to_full(runs: &mut [RunRecord]) {
+    let (t_ref, fc_ref, fr_ref, uy_ref, cpu_ref) = {
+        let f = &runs[0];
+        (
+            f.t.clone(),
+            f.fc.clone(),
+            f.fr.clone(),
+            f.uy.clone(),
+            f.cpu_s,
+        )
+    };
+    for r in runs.iter_mut().skip(1) {
+        if !r.status.finished() {
+            continue;
+        }
+        r.error_fc = relative_l2(&r.t, &r.fc, &t_ref, &fc_ref);
+        r.error_uy = relative_l2(&r.t, &r.uy, &t_ref, &uy_ref);
+        r.error_fr = relative_l2(&r.t, &r.fr, &t_ref, &fr_ref);
+        if r.cpu_s > 0.0 && cpu_ref.is_finite() {
+            r.speedup = Some(cpu_ref / r.cpu_s);
+            r.cpu_percent = Some(100.0 * r.cpu_s / cpu_ref);
+        }
     }
 }

@@ -36,42 +36,10 @@
 //! right-hand side (a wrapper problem returns a fatal callback error once the budget is spent, so
 //! CVODE stops at once; the cell is reported as `budget` with the time reached).
 //!
-//! ## Measured (friction bar, 2 shared cores, budget 8 s per cell, ROM window 0.01 s, full 1e-3 s)
+//! ## Measured
 //!
-//! Run with `STABILITY_OUT=DIR STABILITY_BUDGET=8 STABILITY_FULL_END=1e-3 cargo test --release
-//! --test stability -- --ignored full_map --nocapture` (≈ 17 min for the 144 cells and 18
-//! references). The ROMs: g = 0 → r = 16, w(g)-chosen g = 12 → r = 28.
-//!
-//! - **ROMs, k_n ≤ 1e4**: every cell ok, functional and Newton alike (0.03–5.6 s); the
-//!   steps are bounded by accuracy, not stability, so functional iteration needs about as many
-//!   steps as Newton (friction on: ~2× more, the slip relaxation 1/τ enters ‖J‖ for sliding
-//!   pairs). Errors against the 100× tighter reference: g = 0 1e-5…8e-5; the w(g) ROM 1e-4…4e-4
-//!   at k_n = 1e2 but **~2 % at k_n = 1e4** in every cell, i.e. the paper's tolerances do not
-//!   resolve ‖f_c‖(t) of the richer basis over the first 0.01 s (the reference needs 2.5× the
-//!   steps).
-//! - **ROMs, k_n = 1e6**: g = 0 still ok (65 000–130 000 steps, errors 1–5 %); the w(g) ROM
-//!   exhausts the budget with Newton and with events (steps ≈ 4e-8 s): the penalty frequency
-//!   `√(k_n/m)` of the lightly loaded pairs sets an *accuracy* limit that Newton cannot lift;
-//!   functional cells that finish are 14–22 % off.
-//! - **Full model, functional iteration**: every cell `budget` (steps ≈ 2e-8 s, 0.1–0.6 ms
-//!   reached): `γ‖J‖ < 1` with the shells' membrane/drilling modes and the weld beams far above
-//!   the contact frequencies.
-//! - **Full model, Newton, events off**: k_n = 1e2 ok in 187 steps (error 1.5e-3 against the
-//!   tight reference); k_n = 1e4 ok at max order 2 (~2 000 steps, 1–2 s) but `budget` at max
-//!   order 5 (10 000 steps for 0.7–0.8 ms): BDF orders 3–5 are not A-stable on the undamped
-//!   high-frequency modes, so the controller keeps rejecting and shrinking high-order steps;
-//!   k_n = 1e6 `budget` except max order 2 with friction (9 052 steps, 5.4 s).
-//! - **Events on, full model**: every cell `budget` before 1e-5 s: from rest, gaps and
-//!   stick/slip switches of many pairs sit at zero and cross it at every step, and each root
-//!   restarts CVODE at order 1 with a tiny step.
-//! - No cell failed with a CVODE flag with `max_steps` = 20 000 per 1e-4 s output interval:
-//!   the wall budget binds first. With a small cap (tests/stability.rs: 100) functional
-//!   iteration at k_n = 1e6 fails with `CV_TOO_MUCH_WORK`.
-//! - The full-model references (rtol 1e-10, atol 1e-8) finished only for k_n = 1e2, friction
-//!   off (57 000 steps, 36 s); elsewhere they hit their 60 s budget, so full-model cells have
-//!   no error and ROM cells no `error_vs_full` except there: over that first millisecond
-//!   (‖f_c‖ still small) the ROM with g = 0 is off by a factor ~5 (4.77), the w(g) ROM by 24 %,
-//!   whatever the iteration, order or events.
+//! The measured map of the friction bar (which cells fail, with which flag, and why) is in
+//! `docs/measurements.md` (section `studies::stability`); the stored run is `results/stability/`.
 //!
 //! ## Failure kinds
 //!
@@ -525,18 +493,61 @@ pub fn run_sweep(case: &Case, opts: &SweepOptions) -> Result<Sweep, Error> {
 pub fn run_sweep_model(base: &Model, model_s: f64, opts: &SweepOptions) -> Result<Sweep, Error> {
     check_options(opts)?;
     let t_all = Instant::now();
-    let progress = |s: &str| {
-        if opts.progress {
-            eprintln!("{s}");
-        }
-    };
     let mut built = Vec::new();
     let mut references = Vec::new();
     let mut cells = Vec::new();
     for &kn in &opts.normal_stiffness {
         let mut model = base.clone();
         model.contact.normal_stiffness = kn;
-        // Prepared models, full first so that its reference is there for the ROMs.
+        let pass = Pass {
+            model: &model,
+            kn,
+            opts,
+        };
+        let prepared = pass.prepare(model_s, &mut built)?;
+        for &friction in &opts.friction {
+            let refs = pass.references(&prepared, friction, &mut references);
+            pass.cells(&prepared, friction, &refs, &mut cells);
+        }
+    }
+    Ok(Sweep {
+        case: base.name.clone(),
+        options: opts.clone(),
+        models: built,
+        references,
+        cells,
+        wall_s: t_all.elapsed().as_secs_f64(),
+    })
+}
+
+/// A prepared model kind: the kind, what to integrate, the number of coordinates.
+type PreparedKind = (ModelKind, Prepared, usize);
+
+/// The references of one k_n and friction setting: the full model's ‖f_c‖ curve (t, ‖f_c‖) if
+/// it finished, and every model's reference outcome.
+struct References {
+    full: Option<(Vec<f64>, Vec<f64>)>,
+    by_model: Vec<(ModelKind, Outcome)>,
+}
+
+/// The sweep's passes over one k_n.
+struct Pass<'a> {
+    model: &'a Model,
+    kn: f64,
+    opts: &'a SweepOptions,
+}
+
+impl Pass<'_> {
+    fn progress(&self, s: &str) {
+        if self.opts.progress {
+            eprintln!("{s}");
+        }
+    }
+
+    /// Builds every model kind of the options, full first so that its reference is there for
+    /// the ROMs; records each in `built`.
+    fn prepare(&self, model_s: f64, built: &mut Vec<Built>) -> Result<Vec<PreparedKind>, Error> {
+        let (model, kn, opts) = (self.model, self.kn, self.opts);
         let mut order = opts.models.clone();
         order.sort_by_key(|m| ModelKind::ALL.iter().position(|k| k == m));
         order.dedup();
@@ -550,7 +561,7 @@ pub fn run_sweep_model(base: &Model, model_s: f64, opts: &SweepOptions) -> Resul
                     if kind == ModelKind::RomG0 {
                         bo.g = Some(0);
                     }
-                    let basis = build_basis(&model, BasisKind::Tvd, &bo)?;
+                    let basis = build_basis(model, BasisKind::Tvd, &bo)?;
                     let fmax = basis
                         .eigenvalues
                         .iter()
@@ -558,7 +569,7 @@ pub fn run_sweep_model(base: &Model, model_s: f64, opts: &SweepOptions) -> Resul
                         .fold(f64::NAN, f64::max)
                         .sqrt()
                         / (2.0 * std::f64::consts::PI);
-                    let rm = ReducedSystem::new(&model, basis.phi)?;
+                    let rm = ReducedSystem::new(model, basis.phi)?;
                     let dim = rm.dim();
                     (Prepared::Rom(Box::new(rm)), dim, Some(basis.g), Some(fmax))
                 }
@@ -569,7 +580,7 @@ pub fn run_sweep_model(base: &Model, model_s: f64, opts: &SweepOptions) -> Resul
                 } else {
                     0.0
                 };
-            progress(&format!(
+            self.progress(&format!(
                 "k_n = {kn:e}: {} built, {dim} coordinates ({build_s:.2} s)",
                 kind.name()
             ));
@@ -583,154 +594,179 @@ pub fn run_sweep_model(base: &Model, model_s: f64, opts: &SweepOptions) -> Resul
             });
             prepared.push((kind, prep, dim));
         }
-        for &friction in &opts.friction {
-            // References: Newton, order 5, events off, tighter tolerances.
-            let mut full_ref: Option<(Vec<f64>, Vec<f64>)> = None;
-            let mut refs_here: Vec<(ModelKind, Outcome)> = Vec::new();
-            if opts.references {
-                for (kind, prep, _) in &prepared {
-                    let end = if *kind == ModelKind::Full {
-                        opts.full_end_time
-                    } else {
-                        opts.end_time
-                    };
-                    let spec = TransientOptions {
-                        problem: ProblemOptions {
-                            friction,
-                            events: false,
-                            velocity_scale: opts.velocity_scale,
-                            ..ProblemOptions::default()
-                        },
-                        ode: OdeOptions {
-                            iteration: IterKind::Newton.iteration(),
-                            rtol: opts.rtol / opts.reference_factor,
-                            atol: opts.atol / opts.reference_factor,
-                            max_order: 5,
-                            max_steps: opts.max_steps.max(100_000),
-                            ..OdeOptions::default()
-                        },
-                        end_time: Some(end),
-                        output_step: opts.full_output_step.min(end),
-                        budget_s: Some(opts.reference_budget_s),
-                    };
-                    let o = system_run(&model, prep, &spec);
-                    progress(&format!(
-                        "reference {} k_n = {kn:e} friction {}: {} t = {:.3e} s, {} steps, {:.2} s",
-                        kind.name(),
-                        on_off(friction),
-                        o.status.name(),
-                        o.t_reached,
-                        o.stats.steps,
-                        o.wall_s
-                    ));
-                    let vs_full = match (&full_ref, *kind) {
-                        (Some((t, f)), ModelKind::RomG0 | ModelKind::Rom) if o.ok() => {
-                            relative_l2(&o.t, &o.fc, t, f)
-                        }
-                        _ => None,
-                    };
-                    if *kind == ModelKind::Full && o.ok() {
-                        full_ref = Some((o.t.clone(), o.fc.clone()));
-                    }
-                    references.push(Reference {
-                        model: *kind,
-                        normal_stiffness: kn,
-                        friction,
-                        rtol: spec.ode.rtol,
-                        atol: spec.ode.atol,
-                        outcome: o.clone(),
-                        error_vs_full: vs_full,
-                    });
-                    refs_here.push((*kind, o));
-                }
+        Ok(prepared)
+    }
+
+    /// The references (Newton, order 5, events off, tighter tolerances) of every prepared
+    /// model, recorded in `references`.
+    fn references(
+        &self,
+        prepared: &[PreparedKind],
+        friction: bool,
+        references: &mut Vec<Reference>,
+    ) -> References {
+        let (kn, opts) = (self.kn, self.opts);
+        let mut refs = References {
+            full: None,
+            by_model: Vec::new(),
+        };
+        if !opts.references {
+            return refs;
+        }
+        for (kind, prep, _) in prepared {
+            let end = if *kind == ModelKind::Full {
+                opts.full_end_time
+            } else {
+                opts.end_time
+            };
+            let spec = TransientOptions {
+                problem: ProblemOptions {
+                    friction,
+                    events: false,
+                    velocity_scale: opts.velocity_scale,
+                    ..ProblemOptions::default()
+                },
+                ode: OdeOptions {
+                    iteration: IterKind::Newton.iteration(),
+                    rtol: opts.rtol / opts.reference_factor,
+                    atol: opts.atol / opts.reference_factor,
+                    max_order: 5,
+                    max_steps: opts.max_steps.max(100_000),
+                    ..OdeOptions::default()
+                },
+                end_time: Some(end),
+                output_step: opts.full_output_step.min(end),
+                budget_s: Some(opts.reference_budget_s),
+            };
+            let o = system_run(self.model, prep, &spec);
+            self.progress(&format!(
+                "reference {} k_n = {kn:e} friction {}: {} t = {:.3e} s, {} steps, {:.2} s",
+                kind.name(),
+                on_off(friction),
+                o.status.name(),
+                o.t_reached,
+                o.stats.steps,
+                o.wall_s
+            ));
+            let vs_full = vs_full(&refs.full, *kind, &o);
+            if *kind == ModelKind::Full && o.ok() {
+                refs.full = Some((o.t.clone(), o.fc.clone()));
             }
-            for (kind, prep, dim) in &prepared {
-                let (end, dt) = if *kind == ModelKind::Full {
-                    (opts.full_end_time, opts.full_output_step)
-                } else {
-                    (opts.end_time, opts.output_step)
-                };
-                for &iteration in &opts.iterations {
-                    for &max_order in &opts.max_orders {
-                        for &events in &opts.events {
-                            let spec = TransientOptions {
-                                problem: ProblemOptions {
-                                    friction,
-                                    events,
-                                    velocity_scale: opts.velocity_scale,
-                                    ..ProblemOptions::default()
-                                },
-                                ode: OdeOptions {
-                                    iteration: iteration.iteration(),
-                                    rtol: opts.rtol,
-                                    atol: opts.atol,
-                                    max_order,
-                                    max_steps: opts.max_steps,
-                                    ..OdeOptions::default()
-                                },
-                                end_time: Some(end),
-                                output_step: dt.min(end),
-                                budget_s: Some(opts.budget_s),
-                            };
-                            let o = system_run(&model, prep, &spec);
-                            let reference = refs_here
-                                .iter()
-                                .find(|(k, r)| k == kind && r.ok())
-                                .map(|(_, r)| r);
-                            let error = match reference {
-                                Some(r) if o.ok() => relative_l2(&o.t, &o.fc, &r.t, &r.fc),
-                                _ => None,
-                            };
-                            // Against the full reference over its (shorter) window: the cell's
-                            // samples within that window, compared where the times match.
-                            let error_vs_full = match (&full_ref, *kind) {
-                                (Some((t, f)), ModelKind::RomG0 | ModelKind::Rom) if o.ok() => {
-                                    relative_l2(&o.t, &o.fc, t, f)
-                                }
-                                _ => None,
-                            };
-                            progress(&format!(
-                                "{:<6} {:<10} order {max_order} k_n {kn:7.0e} friction {:<3} \
-                                 events {:<3}: {:<18} t {:.3e} s steps {:>7} rhs {:>8} {:7.2} s \
-                                 error {}",
-                                kind.name(),
-                                iteration.name(),
-                                on_off(friction),
-                                on_off(events),
-                                o.status.name(),
-                                o.t_reached,
-                                o.stats.steps,
-                                o.stats.rhs_evals,
-                                o.wall_s,
-                                error.map_or("-".into(), |e| format!("{e:.2e}"))
-                            ));
-                            cells.push(Cell {
-                                model: *kind,
-                                dim: *dim,
-                                iteration,
-                                normal_stiffness: kn,
+            references.push(Reference {
+                model: *kind,
+                normal_stiffness: kn,
+                friction,
+                rtol: spec.ode.rtol,
+                atol: spec.ode.atol,
+                outcome: o.clone(),
+                error_vs_full: vs_full,
+            });
+            refs.by_model.push((*kind, o));
+        }
+        refs
+    }
+
+    /// Every cell (iteration × max order × events) of every prepared model, recorded in
+    /// `cells`.
+    fn cells(
+        &self,
+        prepared: &[PreparedKind],
+        friction: bool,
+        refs: &References,
+        cells: &mut Vec<Cell>,
+    ) {
+        let opts = self.opts;
+        for (kind, prep, dim) in prepared {
+            let (end, dt) = if *kind == ModelKind::Full {
+                (opts.full_end_time, opts.full_output_step)
+            } else {
+                (opts.end_time, opts.output_step)
+            };
+            for &iteration in &opts.iterations {
+                for &max_order in &opts.max_orders {
+                    for &events in &opts.events {
+                        let spec = TransientOptions {
+                            problem: ProblemOptions {
                                 friction,
                                 events,
+                                velocity_scale: opts.velocity_scale,
+                                ..ProblemOptions::default()
+                            },
+                            ode: OdeOptions {
+                                iteration: iteration.iteration(),
+                                rtol: opts.rtol,
+                                atol: opts.atol,
                                 max_order,
-                                end_time: end,
-                                outcome: o,
-                                error,
-                                error_vs_full,
-                            });
-                        }
+                                max_steps: opts.max_steps,
+                                ..OdeOptions::default()
+                            },
+                            end_time: Some(end),
+                            output_step: dt.min(end),
+                            budget_s: Some(opts.budget_s),
+                        };
+                        let o = system_run(self.model, prep, &spec);
+                        let cell = Cell {
+                            model: *kind,
+                            dim: *dim,
+                            iteration,
+                            normal_stiffness: self.kn,
+                            friction,
+                            events,
+                            max_order,
+                            end_time: end,
+                            error: None,
+                            error_vs_full: vs_full(&refs.full, *kind, &o),
+                            outcome: o,
+                        };
+                        cells.push(self.finish_cell(cell, refs));
                     }
                 }
             }
         }
     }
-    Ok(Sweep {
-        case: base.name.clone(),
-        options: opts.clone(),
-        models: built,
-        references,
-        cells,
-        wall_s: t_all.elapsed().as_secs_f64(),
-    })
+
+    /// A cell's error against its model's reference, and its progress line.
+    fn finish_cell(&self, mut cell: Cell, refs: &References) -> Cell {
+        let o = &cell.outcome;
+        let reference = refs
+            .by_model
+            .iter()
+            .find(|(k, r)| *k == cell.model && r.ok())
+            .map(|(_, r)| r);
+        cell.error = match reference {
+            Some(r) if o.ok() => relative_l2(&o.t, &o.fc, &r.t, &r.fc),
+            _ => None,
+        };
+        self.progress(&format!(
+            "{:<6} {:<10} order {} k_n {:7.0e} friction {:<3} events {:<3}: {:<18} t {:.3e} s \
+             steps {:>7} rhs {:>8} {:7.2} s error {}",
+            cell.model.name(),
+            cell.iteration.name(),
+            cell.max_order,
+            self.kn,
+            on_off(cell.friction),
+            on_off(cell.events),
+            o.status.name(),
+            o.t_reached,
+            o.stats.steps,
+            o.stats.rhs_evals,
+            o.wall_s,
+            cell.error.map_or("-".into(), |e| format!("{e:.2e}"))
+        ));
+        cell
+    }
+}
+
+/// A ROM outcome's ‖f_c‖ error against the full model's reference over the full model's
+/// (shorter) window, compared where the times match; `None` for the full model or without a
+/// finished reference.
+fn vs_full(full: &Option<(Vec<f64>, Vec<f64>)>, kind: ModelKind, o: &Outcome) -> Option<f64> {
+    match (full, kind) {
+        (Some((t, f)), ModelKind::RomG0 | ModelKind::Rom) if o.ok() => {
+            relative_l2(&o.t, &o.fc, t, f)
+        }
+        _ => None,
+    }
 }
 
 pub(crate) fn on_off(b: bool) -> &'static str {

@@ -318,17 +318,48 @@ fn bad_maps_and_matrices_name_the_file_and_field() {
         "%%MatrixMarket matrix coordinate real general\n3 3\n",
     )
     .unwrap();
-    let tiny_map = |v: &mut Value, k: &str, m: &str| {
-        v["stiffness"] = k.into();
-        v["mass"] = m.into();
-        v["nodes"] = serde_json::json!([
-            {"id": 1, "xyz": [0.0, 0.0, 0.0], "rows": [1, 2, 3, 4, 5, 6]},
-            {"id": 2, "xyz": [1.0, 0.0, 0.0], "rows": [7, null, null, null, null, null]}
-        ]);
-        v["master_node"] = 1.into();
-        v["rigid_followers"] = serde_json::json!([]);
-    };
-    let cases: Vec<(&str, Box<Damage>, &str, &str)> = vec![
+    let cases = damaged_inputs();
+    for (name, damage, file, needle) in cases {
+        let mut v = good.clone();
+        damage(&mut v, &dir);
+        let path = dir.join(format!("bad-{name}.json"));
+        std::fs::write(&path, serde_json::to_string(&v).unwrap()).unwrap();
+        let err = Model::from_case_name(path.to_str().unwrap())
+            .err()
+            .unwrap_or_else(|| panic!("{name}: accepted"))
+            .to_string();
+        let shown = if file == "model.json" {
+            format!("bad-{name}.json")
+        } else {
+            file.to_string()
+        };
+        assert!(
+            err.contains(&shown),
+            "{name}: error does not name {shown}: {err}"
+        );
+        assert!(
+            err.contains(needle),
+            "{name}: error does not name `{needle}`: {err}"
+        );
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Replaces a map's matrices by the tiny 7-DOF files `k`, `m` and its nodes by two matching ones.
+fn tiny_map(v: &mut Value, k: &str, m: &str) {
+    v["stiffness"] = k.into();
+    v["mass"] = m.into();
+    v["nodes"] = serde_json::json!([
+        {"id": 1, "xyz": [0.0, 0.0, 0.0], "rows": [1, 2, 3, 4, 5, 6]},
+        {"id": 2, "xyz": [1.0, 0.0, 0.0], "rows": [7, null, null, null, null, null]}
+    ]);
+    v["master_node"] = 1.into();
+    v["rigid_followers"] = serde_json::json!([]);
+}
+
+/// The damaged maps and matrices: (name, damage, file named in the error, field or reason in it).
+fn damaged_inputs() -> Vec<(&'static str, Box<Damage>, &'static str, &'static str)> {
+    vec![
         (
             "unknown",
             Box::new(|v, _| v["colour"] = "red".into()),
@@ -455,39 +486,15 @@ fn bad_maps_and_matrices_name_the_file_and_field() {
         ),
         (
             "asymmetric",
-            Box::new(move |v, _| tiny_map(v, "asym.mtx", "diag7.mtx")),
+            Box::new(|v, _| tiny_map(v, "asym.mtx", "diag7.mtx")),
             "asym.mtx",
             "entry (",
         ),
         (
             "zero-diagonal",
-            Box::new(move |v, _| tiny_map(v, "zero.mtx", "diag7.mtx")),
+            Box::new(|v, _| tiny_map(v, "zero.mtx", "diag7.mtx")),
             "zero.mtx",
             "entry (7, 7)",
         ),
-    ];
-    for (name, damage, file, needle) in cases {
-        let mut v = good.clone();
-        damage(&mut v, &dir);
-        let path = dir.join(format!("bad-{name}.json"));
-        std::fs::write(&path, serde_json::to_string(&v).unwrap()).unwrap();
-        let err = Model::from_case_name(path.to_str().unwrap())
-            .err()
-            .unwrap_or_else(|| panic!("{name}: accepted"))
-            .to_string();
-        let shown = if file == "model.json" {
-            format!("bad-{name}.json")
-        } else {
-            file.to_string()
-        };
-        assert!(
-            err.contains(&shown),
-            "{name}: error does not name {shown}: {err}"
-        );
-        assert!(
-            err.contains(needle),
-            "{name}: error does not name `{needle}`: {err}"
-        );
-    }
-    let _ = std::fs::remove_dir_all(&dir);
+    ]
 }
