@@ -3,6 +3,7 @@
 use std::path::PathBuf;
 
 pub use crate::integrate::sundials::CvodeFlag;
+pub use crate::linalg::LinalgError;
 
 /// Everything that can go wrong in jointrom. Bad input is an error, never a panic.
 #[derive(Debug, thiserror::Error)]
@@ -15,20 +16,23 @@ pub enum Error {
         #[source]
         source: std::io::Error,
     },
-    /// A case file is malformed or violates the schema; `path` is the JSON path (e.g.
-    /// `sheets[1].thickness`).
+    /// A case file (or a matrix map) is malformed or violates the schema; `path` is the JSON path
+    /// (e.g. `sheets[1].thickness`); `source` is serde's error when the JSON did not parse into
+    /// the schema.
     #[error("{file}: at `{path}`: {reason}")]
     Case {
         file: String,
         path: String,
         reason: String,
+        #[source]
+        source: Option<Box<serde_json::Error>>,
     },
     /// An element could not be built (degenerate geometry, bad material).
     #[error("element: {0}")]
     Element(String),
     /// A linear-algebra failure: singular or indefinite matrix, failed factorization.
     #[error("linear algebra: {0}")]
-    LinearAlgebra(String),
+    LinearAlgebra(#[source] LinalgError),
     /// A request that does not fit the model (too many modes, unknown DOF, ...).
     #[error("invalid request: {0}")]
     Invalid(String),

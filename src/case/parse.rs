@@ -1,4 +1,5 @@
-//! JSON text to [`Case`], with serde errors turned into [`Error::Case`] that name the JSON path.
+//! JSON text to [`Case`], with serde errors turned into [`Error::Case`] that name the JSON path
+//! (serde's error kept as the source).
 
 use super::Case;
 use crate::error::Error;
@@ -23,21 +24,22 @@ pub(crate) fn parse_object<T: serde::de::DeserializeOwned>(
             file: file.to_string(),
             path: "$".to_string(),
             reason: format!("{what} must be one JSON object `{{ ... }}`"),
+            source: None,
         });
     }
     let mut de = serde_json::Deserializer::from_str(text);
     let value: T = serde_path_to_error::deserialize(&mut de).map_err(|e| {
         let path = e.path().to_string();
-        serde_error(file, &path, e.inner())
+        serde_error(file, &path, e.into_inner())
     })?;
-    de.end().map_err(|e| serde_error(file, ".", &e))?;
+    de.end().map_err(|e| serde_error(file, ".", e))?;
     Ok(value)
 }
 
 /// One serde_json error as [`Error::Case`]: the path as `serde_path_to_error` renders it (its
 /// root `.` and an unknown top-level segment `?` are shown as `$`), extended by the field's name
 /// for a missing field; the reason is the message with its line and column.
-fn serde_error(file: &str, path: &str, e: &serde_json::Error) -> Error {
+fn serde_error(file: &str, path: &str, e: serde_json::Error) -> Error {
     let full = e.to_string();
     let position = format!(" at line {} column {}", e.line(), e.column());
     let message = full.strip_suffix(&position).unwrap_or(&full);
@@ -68,5 +70,6 @@ fn serde_error(file: &str, path: &str, e: &serde_json::Error) -> Error {
         file: file.to_string(),
         path,
         reason,
+        source: Some(Box::new(e)),
     }
 }

@@ -21,6 +21,7 @@ impl Ctx<'_> {
             file: self.file.to_string(),
             path: path.into(),
             reason: reason.into(),
+            source: None,
         }
     }
 

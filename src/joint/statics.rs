@@ -63,6 +63,7 @@ use faer::{Mat, MatRef, Side};
 use crate::error::Error;
 use crate::joint::{JointOperator, NORMAL};
 use crate::linalg::compensated::{Dot2, REFINEMENT_STEPS};
+use crate::linalg::LinalgError;
 use crate::linalg::SymCsc;
 
 /// Which pairs are active in the first linear solve.
@@ -163,10 +164,13 @@ where
         active_counts.push(active.iter().filter(|&&a| a).count());
         solve(&active, &mut gaps)?;
         if let Some(i) = gaps.iter().position(|g| !g.is_finite()) {
-            return Err(Error::LinearAlgebra(format!(
-                "contact iteration {it}: gap of pair {i} is not finite ({})",
-                gaps[i]
-            )));
+            return Err(Error::LinearAlgebra(
+                format!(
+                    "contact iteration {it}: gap of pair {i} is not finite ({})",
+                    gaps[i]
+                )
+                .into(),
+            ));
         }
         let next: Vec<bool> = gaps.iter().map(|&g| g < 0.0).collect();
         if next == active {
@@ -189,20 +193,26 @@ where
         }
         if let Some(&first) = visited.get(&next) {
             let len = it + 1 - first;
-            return Err(Error::LinearAlgebra(format!(
-                "contact active-set Newton cycles: the active set after iteration {it} \
+            return Err(Error::LinearAlgebra(
+                format!(
+                    "contact active-set Newton cycles: the active set after iteration {it} \
                  ({} pairs in contact) repeats that of iteration {first} (cycle of length {len})",
-                next.iter().filter(|&&a| a).count()
-            )));
+                    next.iter().filter(|&&a| a).count()
+                )
+                .into(),
+            ));
         }
         active = next;
     }
     let last = active_counts.last().copied().unwrap_or(0);
-    Err(Error::LinearAlgebra(format!(
-        "contact active-set Newton did not converge in {} iterations \
+    Err(Error::LinearAlgebra(
+        format!(
+            "contact active-set Newton did not converge in {} iterations \
          (last active set: {last} of {pairs} pairs)",
-        opts.max_iterations
-    )))
+            opts.max_iterations
+        )
+        .into(),
+    ))
 }
 
 /// Frictionless penalty contact statics of a sparse system `K q = f − B_nᵀ p` with the normal
@@ -232,9 +242,12 @@ pub fn contact_static_sparse(
         let mat = SparseColMatRef::new(pattern.symbolic_matrix.as_ref(), &values);
         let llt = Llt::try_new_with_symbolic(pattern.symbolic_llt.clone(), mat, Side::Lower)
             .map_err(|e| {
-                Error::LinearAlgebra(format!(
-                    "K + K_c ({n}×{n}, {} pairs active) is not positive definite: {e:?}",
-                    active.iter().filter(|&&a| a).count()
+                Error::LinearAlgebra(LinalgError::caused_by(
+                    format!(
+                        "K + K_c ({n}×{n}, {} pairs active) is not positive definite: {e:?}",
+                        active.iter().filter(|&&a| a).count()
+                    ),
+                    e,
                 ))
             })?;
         for i in 0..n {
@@ -302,9 +315,12 @@ pub fn contact_static_reduced(
             }
         }
         let llt = a.llt(Side::Lower).map_err(|e| {
-            Error::LinearAlgebra(format!(
-                "reduced K_r + K_c ({r}×{r}, {} pairs active) is not positive definite: {e:?}",
-                active.iter().filter(|&&a| a).count()
+            Error::LinearAlgebra(LinalgError::caused_by(
+                format!(
+                    "reduced K_r + K_c ({r}×{r}, {} pairs active) is not positive definite: {e:?}",
+                    active.iter().filter(|&&a| a).count()
+                ),
+                e,
             ))
         })?;
         let mut x = llt.solve(&rhs);
@@ -394,7 +410,10 @@ impl ContactPattern {
             SymbolicSparseColMat::new_checked(n, n, col_ptr.clone(), None, row_idx.clone());
         let symbolic_llt =
             SymbolicLlt::try_new(symbolic_matrix.as_ref(), Side::Lower).map_err(|e| {
-                Error::LinearAlgebra(format!("symbolic Cholesky of K + K_c ({n}×{n}): {e:?}"))
+                Error::LinearAlgebra(LinalgError::caused_by(
+                    format!("symbolic Cholesky of K + K_c ({n}×{n}): {e:?}"),
+                    e,
+                ))
             })?;
         Ok(ContactPattern {
             col_ptr,

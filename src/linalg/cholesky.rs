@@ -18,6 +18,7 @@ use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
 use faer::{get_global_parallelism, Conj, Mat, MatMut, Par, Side};
 
 use crate::error::Error;
+use crate::linalg::LinalgError;
 use crate::linalg::SymCsc;
 
 /// A sparse Cholesky factorization `P A Pᵀ = L Lᵀ` (fill-reducing permutation P, AMD) of a
@@ -51,13 +52,19 @@ impl SparseCholesky {
             get_global_parallelism(),
         )
         .map_err(|e| {
-            Error::LinearAlgebra(format!("symbolic Cholesky of a {0}×{0} matrix: {e:?}", a.n))
+            Error::LinearAlgebra(LinalgError::caused_by(
+                format!("symbolic Cholesky of a {0}×{0} matrix: {e:?}", a.n),
+                e,
+            ))
         })?;
         chol.factor_with(&a.values, |e| {
-            Error::LinearAlgebra(format!(
-                "the {0}×{0} matrix is not positive definite (singular or unsupported structure): {1:?}",
-                a.n,
-                SparseLltError::Numeric(e)
+            let e = SparseLltError::Numeric(e);
+            Error::LinearAlgebra(LinalgError::caused_by(
+                format!(
+                    "the {0}×{0} matrix is not positive definite (singular or unsupported structure): {e:?}",
+                    a.n
+                ),
+                e,
             ))
         })?;
         Ok(chol)
@@ -70,8 +77,12 @@ impl SparseCholesky {
         col_ptr: Vec<usize>,
         row_idx: Vec<usize>,
     ) -> Result<SparseCholesky, Error> {
-        SparseCholesky::analyze_with(n, col_ptr, row_idx, Par::Seq)
-            .map_err(|e| Error::LinearAlgebra(format!("symbolic Cholesky ({n}×{n}): {e:?}")))
+        SparseCholesky::analyze_with(n, col_ptr, row_idx, Par::Seq).map_err(|e| {
+            Error::LinearAlgebra(LinalgError::caused_by(
+                format!("symbolic Cholesky ({n}×{n}): {e:?}"),
+                e,
+            ))
+        })
     }
 
     fn analyze_with(
@@ -107,7 +118,10 @@ impl SparseCholesky {
     pub fn factor(&mut self, values: &[f64], what: &str) -> Result<(), Error> {
         let n = self.n;
         self.factor_with(values, |e| {
-            Error::LinearAlgebra(format!("{what} ({n}×{n}) is not positive definite: {e:?}"))
+            Error::LinearAlgebra(LinalgError::caused_by(
+                format!("{what} ({n}×{n}) is not positive definite: {e:?}"),
+                e,
+            ))
         })
     }
 
@@ -256,7 +270,7 @@ pub fn solve_spd(a: &SymCsc, rhs: &[Vec<f64>]) -> Result<Vec<Vec<f64>>, Error> {
         if backward > 1e-10 {
             return Err(Error::LinearAlgebra(format!(
                 "static solve backward error {backward:.3e} exceeds 1e-10 (singular or ill-conditioned stiffness)"
-            )));
+            ).into()));
         }
         out.push(x);
     }

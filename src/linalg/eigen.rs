@@ -24,6 +24,7 @@ use faer::{c64, Col, ColRef, Mat, MatMut, MatRef, Par, Scale, Side};
 use crate::error::Error;
 use crate::linalg::cholesky::SparseCholesky;
 use crate::linalg::sparse::{sym_mul_mat, sym_mul_vec_into};
+use crate::linalg::LinalgError;
 use crate::linalg::SymCsc;
 
 /// Eigenmodes, lowest first.
@@ -87,9 +88,10 @@ pub fn lowest_modes(k: &SymCsc, m: &SymCsc, count: usize) -> Result<Modes, Error
         return dense_modes(k, m, count);
     }
     let chol = SparseCholesky::new(k).map_err(|e| {
-        Error::LinearAlgebra(format!(
-            "eigenproblem: K must be positive definite (is the structure supported?): {e}"
-        ))
+        Error::LinearAlgebra(
+            format!("eigenproblem: K must be positive definite (is the structure supported?): {e}")
+                .into(),
+        )
     })?;
     lowest_modes_factored(k, m, &chol, count)
 }
@@ -125,7 +127,7 @@ pub(crate) fn lowest_modes_factored(
     if !(rq.is_finite() && rq > 0.0) {
         return Err(Error::LinearAlgebra(format!(
             "eigenproblem: Rayleigh quotient {rq:e} of L⁻¹ M L⁻ᵀ is not positive (M not positive definite?)"
-        )));
+        ).into()));
     }
     let mut tol = LOCK_TOL * rq;
     let mut max_dim = 2 * count + 20;
@@ -144,7 +146,7 @@ pub(crate) fn lowest_modes_factored(
     }
     Err(Error::LinearAlgebra(format!(
         "Krylov–Schur: {count} modes not converged (relative residual {worst:.2e} > {RESIDUAL_TOL:e})"
-    )))
+    ).into()))
 }
 
 /// Locking tolerance of the Krylov–Schur iteration relative to the smallest wanted μ.
@@ -234,10 +236,13 @@ fn krylov_schur(
         params,
     );
     if info.n_converged_eigen < count {
-        return Err(Error::LinearAlgebra(format!(
-            "Krylov–Schur converged {} of {count} modes in {} restarts",
-            info.n_converged_eigen, params.max_restarts
-        )));
+        return Err(Error::LinearAlgebra(
+            format!(
+                "Krylov–Schur converged {} of {count} modes in {} restarts",
+                info.n_converged_eigen, params.max_restarts
+            )
+            .into(),
+        ));
     }
     let mut z = Mat::<f64>::zeros(n, count);
     for (j, col) in zc.col_iter().enumerate() {
@@ -274,13 +279,14 @@ fn refine(op: &InverseOperator<'_>, z: Mat<f64>) -> Result<(Vec<f64>, Mat<f64>, 
     let g = Mat::from_fn(count, count, |i, j| 0.5 * (g[(i, j)] + g[(j, i)]));
     let evd = g
         .self_adjoint_eigen(Side::Lower)
-        .map_err(|e| Error::LinearAlgebra(format!("Rayleigh–Ritz eigensolver: {e:?}")))?;
+        .map_err(|e| Error::LinearAlgebra(format!("Rayleigh–Ritz eigensolver: {e:?}").into()))?;
     let s = evd.S().column_vector();
     let mu: Vec<f64> = (0..count).map(|c| s[count - 1 - c]).collect();
     if let Some(&bad) = mu.iter().find(|&&v| !(v.is_finite() && v > 0.0)) {
-        return Err(Error::LinearAlgebra(format!(
-            "non-positive Ritz value μ = 1/ω² = {bad:e}: K or M is not positive definite"
-        )));
+        return Err(Error::LinearAlgebra(
+            format!("non-positive Ritz value μ = 1/ω² = {bad:e}: K or M is not positive definite")
+                .into(),
+        ));
     }
     let u = Mat::from_fn(count, count, |i, c| evd.U()[(i, count - 1 - c)]);
     let z = &q * &u;
@@ -333,12 +339,15 @@ fn verify(k: &SymCsc, m: &SymCsc, modes: &Modes) -> Result<(), Error> {
         let phi_norm = phi.iter().map(|v| v.abs()).fold(0.0, f64::max);
         let backward = res / ((kn + lam * mn) * phi_norm);
         if backward.is_nan() || backward > 1e-10 {
-            return Err(Error::LinearAlgebra(format!(
-                "mode {} ({:.4} Hz) has backward error {:.2e} > 1e-10",
-                c + 1,
-                modes.frequencies_hz[c],
-                backward
-            )));
+            return Err(Error::LinearAlgebra(
+                format!(
+                    "mode {} ({:.4} Hz) has backward error {:.2e} > 1e-10",
+                    c + 1,
+                    modes.frequencies_hz[c],
+                    backward
+                )
+                .into(),
+            ));
         }
     }
     Ok(())
@@ -353,8 +362,11 @@ pub fn dense_modes(k: &SymCsc, m: &SymCsc, count: usize) -> Result<Modes, Error>
     check_count(n, count)?;
     let kd = k.to_dense();
     let llt = kd.llt(Side::Lower).map_err(|e| {
-        Error::LinearAlgebra(format!(
-            "stiffness matrix is not positive definite (is the structure supported?): {e:?}"
+        Error::LinearAlgebra(LinalgError::caused_by(
+            format!(
+                "stiffness matrix is not positive definite (is the structure supported?): {e:?}"
+            ),
+            e,
         ))
     })?;
     let l = llt.L();
@@ -366,7 +378,7 @@ pub fn dense_modes(k: &SymCsc, m: &SymCsc, count: usize) -> Result<Modes, Error>
     let sym = Mat::from_fn(n, n, |i, j| 0.5 * (ct[(i, j)] + ct[(j, i)]));
     let evd = sym
         .self_adjoint_eigen(Side::Lower)
-        .map_err(|e| Error::LinearAlgebra(format!("dense eigensolver: {e:?}")))?;
+        .map_err(|e| Error::LinearAlgebra(format!("dense eigensolver: {e:?}").into()))?;
     let s = evd.S().column_vector();
     let mut eigenvalues = Vec::with_capacity(count);
     let mut shapes = Mat::<f64>::zeros(n, count);

@@ -6,8 +6,10 @@
 pub mod cholesky;
 pub mod compensated;
 pub mod eigen;
+mod error;
 pub mod sparse;
 
 pub use cholesky::{solve_spd, SparseCholesky};
 pub use eigen::{dense_modes, lowest_modes, Modes};
+pub use error::LinalgError;
 pub use sparse::SymCsc;

@@ -217,6 +217,7 @@ fn field_err(file: &str, path: impl Into<String>, reason: impl Into<String>) -> 
         file: file.to_string(),
         path: path.into(),
         reason: reason.into(),
+        source: None,
     }
 }
 

@@ -202,12 +202,12 @@ pub fn modal_rotation(model: &Model, phi: Mat<f64>) -> Result<(Mat<f64>, Vec<f64
     let k = crate::linalg::compensated::compensated_gram(&model.stiffness, phi.as_ref());
     let evd = k
         .self_adjoint_eigen(Side::Lower)
-        .map_err(|e| Error::LinearAlgebra(format!("reduced eigenproblem: {e:?}")))?;
+        .map_err(|e| Error::LinearAlgebra(format!("reduced eigenproblem: {e:?}").into()))?;
     let lambda: Vec<f64> = evd.S().column_vector().iter().copied().collect();
     if let Some(l) = lambda.iter().find(|l| !(l.is_finite() && **l > 0.0)) {
-        return Err(Error::LinearAlgebra(format!(
-            "reduced stiffness ΦᵀKΦ is not positive definite (eigenvalue {l:e})"
-        )));
+        return Err(Error::LinearAlgebra(
+            format!("reduced stiffness ΦᵀKΦ is not positive definite (eigenvalue {l:e})").into(),
+        ));
     }
     Ok((&phi * evd.U(), lambda))
 }

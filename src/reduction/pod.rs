@@ -150,14 +150,15 @@ fn pod_dense_lambda_poms(
     let c = Mat::from_fn(p, p, |i, j| 0.5 * (c[(i, j)] + c[(j, i)]));
     let evd = c
         .self_adjoint_eigen(Side::Lower)
-        .map_err(|e| Error::LinearAlgebra(format!("POD eigensolver: {e:?}")))?;
+        .map_err(|e| Error::LinearAlgebra(format!("POD eigensolver: {e:?}").into()))?;
     let s = evd.S().column_vector();
     let u = evd.U();
     let lmax = s[p - 1];
     if !(lmax.is_finite() && lmax > 0.0) {
-        return Err(Error::LinearAlgebra(format!(
-            "POD: largest eigenvalue of YᵀAY is {lmax:e} (zero or indefinite weight)"
-        )));
+        return Err(Error::LinearAlgebra(
+            format!("POD: largest eigenvalue of YᵀAY is {lmax:e} (zero or indefinite weight)")
+                .into(),
+        ));
     }
     let order: Vec<usize> = (0..p).rev().collect(); // descending
     let kept: Vec<usize> = order
@@ -242,14 +243,15 @@ pub fn pod(y: MatRef<'_, f64>, weight: Option<&SymCsc>) -> Result<Pod, Error> {
     let t = Mat::from_fn(k, k, |i, j| 0.5 * (t[(i, j)] + t[(j, i)]));
     let evd = t
         .self_adjoint_eigen(Side::Lower)
-        .map_err(|e| Error::LinearAlgebra(format!("POD eigensolver: {e:?}")))?;
+        .map_err(|e| Error::LinearAlgebra(format!("POD eigensolver: {e:?}").into()))?;
     let s = evd.S().column_vector();
     let x = evd.U();
     let lmax = s[k - 1];
     if !(lmax.is_finite() && lmax > 0.0) {
-        return Err(Error::LinearAlgebra(format!(
-            "POD: largest eigenvalue of YᵀAY is {lmax:e} (zero or indefinite weight)"
-        )));
+        return Err(Error::LinearAlgebra(
+            format!("POD: largest eigenvalue of YᵀAY is {lmax:e} (zero or indefinite weight)")
+                .into(),
+        ));
     }
     let kept: Vec<usize> = (0..k)
         .rev()
@@ -322,9 +324,9 @@ pub fn pod_tvd(model: &Model, tvd: &Tvd, weighted: bool) -> Result<Pod, Error> {
     // for the plain route.
     let (a, q) = if weighted {
         let g = &f.joint_flexibility;
-        let evd = g
-            .self_adjoint_eigen(Side::Lower)
-            .map_err(|e| Error::LinearAlgebra(format!("POD: joint flexibility eigen: {e:?}")))?;
+        let evd = g.self_adjoint_eigen(Side::Lower).map_err(|e| {
+            Error::LinearAlgebra(format!("POD: joint flexibility eigen: {e:?}").into())
+        })?;
         let d = evd.S().column_vector();
         let v = evd.U();
         let vt_c = v.transpose() * &f.coefficients;
@@ -336,18 +338,18 @@ pub fn pod_tvd(model: &Model, tvd: &Tvd, weighted: bool) -> Result<Pod, Error> {
         let r = qr.thin_R().to_owned();
         (&r * &f.coefficients, Some(q))
     };
-    let svd = a
-        .thin_svd()
-        .map_err(|e| Error::LinearAlgebra(format!("POD: SVD of the TVD coefficients: {e:?}")))?;
+    let svd = a.thin_svd().map_err(|e| {
+        Error::LinearAlgebra(format!("POD: SVD of the TVD coefficients: {e:?}").into())
+    })?;
     let s = svd.S().column_vector();
     let k = s.nrows();
     let mut order: Vec<usize> = (0..k).collect();
     order.sort_by(|&x, &y| s[y].total_cmp(&s[x]));
     let smax = s[order[0]];
     if !(smax.is_finite() && smax > 0.0) {
-        return Err(Error::LinearAlgebra(format!(
-            "POD: largest singular value of the TVD coefficients is {smax:e}"
-        )));
+        return Err(Error::LinearAlgebra(
+            format!("POD: largest singular value of the TVD coefficients is {smax:e}").into(),
+        ));
     }
     let cut = sigma_zero(m, p) * smax;
     let kept: Vec<usize> = order.into_iter().filter(|&i| s[i] > cut).collect();

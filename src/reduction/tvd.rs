@@ -61,6 +61,7 @@ use crate::error::Error;
 use crate::joint::{JointOperator, NORMAL, T1, T2};
 use crate::linalg::cholesky::SparseCholesky;
 use crate::linalg::sparse::{sym_mul_mat, sym_mul_vec_into};
+use crate::linalg::LinalgError;
 use crate::linalg::SymCsc;
 use crate::model::Model;
 
@@ -543,10 +544,13 @@ fn scale_to_unit_energy(
             .map(|(x, y)| x * y)
             .sum();
         if !(e.is_finite() && e > 0.0) {
-            return Err(Error::LinearAlgebra(format!(
-                "TVD column {c} ({:?}) has strain energy {e:e}; K is not positive definite",
-                index[c]
-            )));
+            return Err(Error::LinearAlgebra(
+                format!(
+                    "TVD column {c} ({:?}) has strain energy {e:e}; K is not positive definite",
+                    index[c]
+                )
+                .into(),
+            ));
         }
         let s = e.sqrt();
         q.col_mut(a).iter_mut().for_each(|v| *v /= s);
@@ -574,15 +578,20 @@ fn shifted_solve(
     let sym = match symbolic {
         Some(s) => s.clone(),
         None => {
-            let s = SymbolicLu::try_new(faer_a.symbolic())
-                .map_err(|e| Error::LinearAlgebra(format!("symbolic LU of K − Ω²M: {e:?}")))?;
+            let s = SymbolicLu::try_new(faer_a.symbolic()).map_err(|e| {
+                Error::LinearAlgebra(LinalgError::caused_by(
+                    format!("symbolic LU of K − Ω²M: {e:?}"),
+                    e,
+                ))
+            })?;
             *symbolic = Some(s.clone());
             s
         }
     };
     let lu = Lu::try_new_with_symbolic(sym, faer_a.as_ref()).map_err(|e| {
-        Error::LinearAlgebra(format!(
-            "LU of K − Ω²M for base vector {mode} (Ω² = {om2:e}): {e:?}"
+        Error::LinearAlgebra(LinalgError::caused_by(
+            format!("LU of K − Ω²M for base vector {mode} (Ω² = {om2:e}): {e:?}"),
+            e,
         ))
     })?;
     let mut z = rhs.clone();
@@ -602,10 +611,13 @@ fn shifted_solve(
         };
     }
     if worst > 1e-10 {
-        return Err(Error::LinearAlgebra(format!(
+        return Err(Error::LinearAlgebra(
+            format!(
             "TVD with inertia: (K − Ω²M) solve for base vector {mode} (Ω² = {om2:e}) has backward \
              error {worst:.2e} > 1e-10 (Ω² is (nearly) a free-interface eigenvalue)"
-        )));
+        )
+            .into(),
+        ));
     }
     Ok(z)
 }

@@ -81,6 +81,7 @@ use serde::Serialize;
 use crate::error::Error;
 use crate::joint::statics::{contact_static_reduced, ContactOptions, ContactState};
 use crate::joint::NORMAL;
+use crate::linalg::LinalgError;
 use crate::model::{contact_static_full, Interface, Model};
 use crate::reduction::{
     alldof_vectors, build_basis, craig_bampton, final_basis, jim_vectors, trial_vector_derivatives,
@@ -188,9 +189,9 @@ pub fn reduced_contact_static_restarting(
         Ok(sol) => Ok((sol, None)),
         Err(first) => match reduced_contact_static_damped(model, rm, scale, opts) {
             Ok(sol) => Ok((sol, Some(first))),
-            Err(second) => Err(Error::LinearAlgebra(format!(
-                "reduced contact statics failed: {first}; then, damped: {second}"
-            ))),
+            Err(second) => Err(Error::LinearAlgebra(
+                format!("reduced contact statics failed: {first}; then, damped: {second}").into(),
+            )),
         },
     }
 }
@@ -252,17 +253,20 @@ pub fn reduced_contact_static_damped(
             }
         }
         let llt = h.llt(Side::Lower).map_err(|e| {
-            Error::LinearAlgebra(format!(
-                "damped reduced contact, step {it}: K̃ + K_c is not positive definite: {e:?}"
+            Error::LinearAlgebra(LinalgError::caused_by(
+                format!(
+                    "damped reduced contact, step {it}: K̃ + K_c is not positive definite: {e:?}"
+                ),
+                e,
             ))
         })?;
         let rhs = Mat::from_fn(r, 1, |i, _| f[i]);
         let x = faer::linalg::solvers::Solve::solve(&llt, &rhs);
         let full: Vec<f64> = (0..r).map(|i| x[(i, 0)]).collect();
         if full.iter().any(|v| !v.is_finite()) {
-            return Err(Error::LinearAlgebra(format!(
-                "damped reduced contact, step {it}: solution is not finite"
-            )));
+            return Err(Error::LinearAlgebra(
+                format!("damped reduced contact, step {it}: solution is not finite").into(),
+            ));
         }
         let gaps = gaps_of(&full);
         let next: Vec<bool> = gaps.iter().map(|&g| g < 0.0).collect();
@@ -309,16 +313,19 @@ pub fn reduced_contact_static_damped(
             }
             t *= 0.5;
             if t < 1e-12 {
-                return Err(Error::LinearAlgebra(format!(
+                return Err(Error::LinearAlgebra(
+                    format!(
                     "damped reduced contact, step {it}: line search failed (no decrease of the \
                      contact energy along the Newton direction)"
-                )));
+                )
+                    .into(),
+                ));
             }
         }
     }
-    Err(Error::LinearAlgebra(format!(
-        "damped reduced contact did not converge in {max_steps} steps"
-    )))
+    Err(Error::LinearAlgebra(
+        format!("damped reduced contact did not converge in {max_steps} steps").into(),
+    ))
 }
 
 /// What `jointrom static --basis` reports.

@@ -71,7 +71,9 @@ impl FullSystem {
         let pos = |i: usize, j: usize| -> Result<usize, Error> {
             let col = &row_idx[col_ptr[j]..col_ptr[j + 1]];
             col.binary_search(&i).map(|p| col_ptr[j] + p).map_err(|_| {
-                Error::LinearAlgebra(format!("entry ({i}, {j}) missing from the Newton pattern"))
+                Error::LinearAlgebra(
+                    format!("entry ({i}, {j}) missing from the Newton pattern").into(),
+                )
             })
         };
         let mut k_pos = Vec::with_capacity(k.values.len());

@@ -13,6 +13,7 @@ use crate::case::LoadSpec;
 use crate::error::Error;
 use crate::joint::JointOperator;
 use crate::linalg::compensated::compensated_gram;
+use crate::linalg::LinalgError;
 use crate::linalg::SymCsc;
 use crate::model::Model;
 
@@ -200,8 +201,9 @@ impl ReducedSystem {
                 Default::default(),
             )
             .map_err(|e| {
-                Error::LinearAlgebra(format!(
-                    "reduced mass ({r}×{r}) not positive definite: {e:?}"
+                Error::LinearAlgebra(LinalgError::caused_by(
+                    format!("reduced mass ({r}×{r}) not positive definite: {e:?}"),
+                    e,
                 ))
             })?;
         }
@@ -354,8 +356,9 @@ impl SecondOrderSystem for ReducedSystem {
             Default::default(),
         )
         .map_err(|e| {
-            Error::LinearAlgebra(format!(
-                "reduced Newton matrix ({r}×{r}) not positive definite: {e:?}"
+            Error::LinearAlgebra(LinalgError::caused_by(
+                format!("reduced Newton matrix ({r}×{r}) not positive definite: {e:?}"),
+                e,
             ))
         })?;
         self.newton_ok = true;

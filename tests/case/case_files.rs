@@ -84,3 +84,17 @@ fn load_of_an_unknown_name_lists_the_builtins() {
         other => panic!("expected Error::Io, got {other:?}"),
     }
 }
+
+#[test]
+fn schema_errors_keep_serde_as_the_source() {
+    use std::error::Error as _;
+    let text = include_str!("../../cases/friction_bar.json").replacen('{', "{\"colour\": 1,", 1);
+    let err = Case::from_json_str(&text, "colour.json").unwrap_err();
+    assert!(matches!(err, Error::Case { .. }), "{err}");
+    let source = err.source().expect("serde's error as the source");
+    assert!(
+        source.downcast_ref::<serde_json::Error>().is_some(),
+        "{source}"
+    );
+    assert!(source.to_string().contains("colour"), "{source}");
+}

@@ -30,6 +30,7 @@ fn expect_text_err(text: &str, path: &str, word: &str) {
             file,
             path: got,
             reason,
+            ..
         }) => {
             assert_eq!(file, FILE);
             assert_eq!(got, path, "wrong path; reason: {reason}");
@@ -63,6 +64,7 @@ fn expect_mesh_err(edit: impl FnOnce(&mut Case), path: &str, word: &str) {
             file,
             path: got,
             reason,
+            ..
         }) => {
             assert_eq!(file, "builtin:friction_bar");
             assert_eq!(got, path, "wrong path; reason: {reason}");

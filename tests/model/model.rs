@@ -195,3 +195,26 @@ fn cli_errors_name_the_problem() {
     let err = jointrom_err(["info", bad.to_str().unwrap()]);
     assert!(err.contains("bad.json"), "{err}");
 }
+
+#[test]
+fn factorization_errors_keep_faer_as_the_source() {
+    use std::error::Error as _;
+    // diag(1, −1): not positive definite.
+    let a = jointrom::linalg::SymCsc {
+        n: 2,
+        col_ptr: vec![0, 1, 2],
+        row_idx: vec![0, 1],
+        values: vec![1.0, -1.0],
+    };
+    let err = match jointrom::linalg::SparseCholesky::new(&a) {
+        Err(e) => e,
+        Ok(_) => panic!("an indefinite matrix was factored"),
+    };
+    assert!(matches!(err, jointrom::Error::LinearAlgebra(_)), "{err}");
+    assert!(err.to_string().contains("not positive definite"), "{err}");
+    let source = err.source().expect("the linear-algebra error");
+    assert!(
+        source.source().is_some(),
+        "faer's error as the source of {source}"
+    );
+}

@@ -62,6 +62,7 @@ use faer::{Mat, Par, Side};
 
 use crate::error::Error;
 use crate::linalg::cholesky::SparseCholesky;
+use crate::linalg::LinalgError;
 use crate::model::Model;
 
 use crate::reduction::basis::JimSet;
@@ -165,8 +166,11 @@ fn condensed_modes(
     let g = xs.transpose() * &mx;
     let g = Mat::from_fn(p, p, |a, b| 0.5 * (g[(a, b)] + g[(b, a)]));
     let llt = f.llt(Side::Lower).map_err(|e| {
-        Error::LinearAlgebra(format!(
+        Error::LinearAlgebra(LinalgError::caused_by(
+            format!(
             "Joint Interface Modes: the {p}×{p} joint flexibility is not positive definite: {e:?}"
+        ),
+            e,
         ))
     })?;
     let l = llt.L();
@@ -176,9 +180,9 @@ fn condensed_modes(
     let mut c = y.transpose().to_owned();
     solve_lower_triangular_in_place(l, c.as_mut(), Par::Seq);
     let c = Mat::from_fn(p, p, |a, b| 0.5 * (c[(a, b)] + c[(b, a)]));
-    let evd = c
-        .self_adjoint_eigen(Side::Lower)
-        .map_err(|e| Error::LinearAlgebra(format!("Joint Interface Modes eigensolver: {e:?}")))?;
+    let evd = c.self_adjoint_eigen(Side::Lower).map_err(|e| {
+        Error::LinearAlgebra(format!("Joint Interface Modes eigensolver: {e:?}").into())
+    })?;
     let mu = evd.S().column_vector();
     let mut u = evd.U().to_owned();
     solve_upper_triangular_in_place(l.transpose(), u.as_mut(), Par::Seq);
@@ -199,9 +203,10 @@ fn condensed_modes(
             let ugu: f64 = (0..p).map(|a| ui[a] * gu[a]).sum();
             let ufu: f64 = (0..p).map(|a| ui[a] * fu[a]).sum();
             if !(ugu > 0.0 && ufu > 0.0) {
-                return Err(Error::LinearAlgebra(format!(
-                    "Joint Interface Modes: mode {k} has uᵀGu = {ugu:e}, uᵀFu = {ufu:e}"
-                )));
+                return Err(Error::LinearAlgebra(
+                    format!("Joint Interface Modes: mode {k} has uᵀGu = {ugu:e}, uᵀFu = {ufu:e}")
+                        .into(),
+                ));
             }
             lambda.push(ufu / ugu);
             let inv = 1.0 / ugu.sqrt();
@@ -290,12 +295,15 @@ pub fn joint_interface_modes(
     picks.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
     picks.truncate(count);
     if let Some(&(_, s, k)) = picks.iter().find(|p| !p.0.is_finite()) {
-        return Err(Error::LinearAlgebra(format!(
-            "Joint Interface Mode {} of the {} set has a numerically infinite frequency \
+        return Err(Error::LinearAlgebra(
+            format!(
+                "Joint Interface Mode {} of the {} set has a numerically infinite frequency \
              (condensed mass eigenvalue ≤ 1e-12 of the largest): request fewer than {count}",
-            k + 1,
-            parts[s].0.name()
-        )));
+                k + 1,
+                parts[s].0.name()
+            )
+            .into(),
+        ));
     }
     let mut vectors = Mat::<f64>::zeros(n, count);
     let mut mphi = vec![0.0; n];
@@ -315,9 +323,9 @@ pub fn joint_interface_modes(
             .sum::<f64>()
             .sqrt();
         if !(norm.is_finite() && norm > 0.0) {
-            return Err(Error::LinearAlgebra(format!(
-                "Joint Interface Mode {c} has M-norm {norm:e}"
-            )));
+            return Err(Error::LinearAlgebra(
+                format!("Joint Interface Mode {c} has M-norm {norm:e}").into(),
+            ));
         }
         full.iter_mut().for_each(|v| *v /= norm);
         for r in 0..m {
