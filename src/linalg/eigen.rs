@@ -3,7 +3,7 @@
 //! [`lowest_modes`] uses faer's Krylov–Schur eigensolver (`faer::matrix_free::eigen`,
 //! sequential, fixed start vector) on the inverse operator: with the sparse Cholesky
 //! factorization `P K Pᵀ = L Lᵀ` (shared with Craig–Bampton through
-//! [`lowest_modes_factored`]) the operator `C = L⁻¹ P M Pᵀ L⁻ᵀ` is symmetric positive definite
+//! `lowest_modes_factored`) the operator `C = L⁻¹ P M Pᵀ L⁻ᵀ` is symmetric positive definite
 //! and its largest eigenvalues `μ = 1/ω²` belong to the lowest modes, `φ = Pᵀ L⁻ᵀ z`. The
 //! converged vectors get one subspace-iteration step with Rayleigh–Ritz, every pair must meet
 //! the true residual `‖C z − μ z‖ ≤ 1e-9 μ` (else a rerun with a tighter locking tolerance and a

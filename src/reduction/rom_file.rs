@@ -46,7 +46,7 @@ use crate::case::{ContactSpec, MasterLoadSpec, RampSpec};
 use crate::error::Error;
 use crate::joint::law::DEFAULT_TAU;
 use crate::model::Model;
-use crate::system::{ReducedMatrices, ReducedSystem, Scene};
+use crate::system::{ReducedSystem, Scene};
 
 /// Schema name of the file.
 pub const SCHEMA: &str = "jointrom-rom";
@@ -234,16 +234,13 @@ impl RomFile {
             Mat::from_fn(m.len(), nc, |i, j| m[i][j])
         };
         ReducedSystem::from_matrices(
-            ReducedMatrices {
-                k: mat(&self.stiffness),
-                m: mat(&self.mass),
-                b_phi: mat(&self.joint_operator),
-                phi_master: mat(&self.master_rows),
-                column_size: self.coordinate_size.clone(),
-                load: crate::case::LoadSpec {
-                    master: self.master_load,
-                    ramp: self.load_ramp,
-                },
+            mat(&self.stiffness),
+            mat(&self.mass),
+            mat(&self.joint_operator),
+            (mat(&self.master_rows), self.coordinate_size.clone()),
+            crate::case::LoadSpec {
+                master: self.master_load,
+                ramp: self.load_ramp,
             },
             None,
         )

@@ -1,8 +1,10 @@
 //! Output for people and tools: charts ([`chart`], [`heatmap`]), VTU fields for ParaView
-//! ([`vtu`], [`shapes`]) and the main job's report ([`main_job`]).
+//! ([`vtu`], [`shapes`]), CSV curves ([`curves`]), the convergence study's and the stability
+//! map's outputs ([`convergence`], [`stability`]) and the main job's report ([`main_job`]).
 
 pub mod chart;
 pub mod convergence;
+pub mod curves;
 pub mod heatmap;
 pub mod main_job;
 pub mod shapes;

@@ -59,7 +59,7 @@ pub struct ReportOptions {
     /// Wall-clock budget of the full FE run with functional iteration, s (it is expected to fail:
     /// the budget bounds what that failure costs; at most 2 s when `quick`).
     pub full_functional_budget_s: f64,
-    /// Report progress to the observer of [`run_report_observed`] (`jointrom run` draws it as a
+    /// Report progress to the observer of [`crate::report::main_job::run_report_observed`] (`jointrom run` draws it as a
     /// bar when stderr is a terminal).
     pub progress: bool,
     /// Folder holding stored stability maps (`<dir>/<case>/stability_status.png`).

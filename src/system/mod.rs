@@ -32,7 +32,7 @@ mod full;
 mod reduced;
 
 pub use full::FullSystem;
-pub use reduced::{ReducedMatrices, ReducedSystem};
+pub use reduced::ReducedSystem;
 
 use serde::Serialize;
 

@@ -47,24 +47,6 @@ pub struct ReducedSystem {
     mem: MemBuffer,
 }
 
-/// The matrices of a [`ReducedSystem`], independent of the full model (e.g. read back from an
-/// exported reduced model, [`crate::reduction::rom_file`]).
-#[derive(Clone, Debug)]
-pub struct ReducedMatrices {
-    /// `K̃ = ΦᵀKΦ` (r × r), N/mm per unit coordinate².
-    pub k: Mat<f64>,
-    /// `M̃ = ΦᵀMΦ` (r × r), t per unit coordinate².
-    pub m: Mat<f64>,
-    /// `BΦ` (3w × r), rows normal, t1, t2 per pair, mm per unit coordinate.
-    pub b_phi: Mat<f64>,
-    /// Rows of Φ at the six master DOF (6 × r: ux, uy, uz (mm), rx, ry, rz (rad) per unit).
-    pub phi_master: Mat<f64>,
-    /// Largest absolute entry of each basis column (mm or rad per unit coordinate).
-    pub column_size: Vec<f64>,
-    /// Master load and its ramp.
-    pub load: LoadSpec,
-}
-
 impl ReducedSystem {
     /// Projects a model on the basis `phi` (n × r) with the model's load (eq. 7): the same as
     /// [`crate::system::FullSystem::reduce`] without factoring the full model.
@@ -102,14 +84,11 @@ impl ReducedSystem {
             .map(|c| phi.col(c).iter().fold(0.0f64, |m, x| m.max(x.abs())))
             .collect();
         ReducedSystem::from_matrices(
-            ReducedMatrices {
-                k: compensated_gram(k, phi.as_ref()),
-                m: compensated_gram(m, phi.as_ref()),
-                b_phi: joint.reduce(phi.as_ref()),
-                phi_master,
-                column_size,
-                load,
-            },
+            compensated_gram(k, phi.as_ref()),
+            compensated_gram(m, phi.as_ref()),
+            joint.reduce(phi.as_ref()),
+            (phi_master, column_size),
+            load,
             Some(phi),
         )
     }
@@ -117,11 +96,21 @@ impl ReducedSystem {
     /// Builds the system from its matrices (e.g. read back from an exported reduced model,
     /// [`crate::reduction::rom_file`]), with the basis if known; checks the dimensions,
     /// finiteness and the coordinate sizes, factors M̃ unless it is the identity.
+    ///
+    /// `k` = K̃ (r × r, N/mm per unit coordinate²), `m` = M̃ (r × r, t per unit coordinate²),
+    /// `b_phi` = BΦ (3w × r, mm per unit), `master` = (the rows of Φ at the six master DOF,
+    /// 6 × r; the largest absolute entry of each basis column, r), `load` the master load and
+    /// its ramp, `phi` the basis if known (n × r).
     pub fn from_matrices(
-        p: ReducedMatrices,
+        k: Mat<f64>,
+        m: Mat<f64>,
+        b_phi: Mat<f64>,
+        master: (Mat<f64>, Vec<f64>),
+        load: LoadSpec,
         phi: Option<Mat<f64>>,
     ) -> Result<ReducedSystem, Error> {
-        let r = p.k.nrows();
+        let (phi_master, column_size) = master;
+        let r = k.nrows();
         if let Some(phi) = &phi {
             if phi.ncols() != r {
                 return Err(Error::Invalid(format!(
@@ -130,34 +119,34 @@ impl ReducedSystem {
                 )));
             }
         }
-        if p.k.ncols() != r
-            || p.m.nrows() != r
-            || p.m.ncols() != r
-            || p.b_phi.ncols() != r
-            || p.b_phi.nrows() % 3 != 0
-            || p.phi_master.nrows() != 6
-            || p.phi_master.ncols() != r
-            || p.column_size.len() != r
+        if k.ncols() != r
+            || m.nrows() != r
+            || m.ncols() != r
+            || b_phi.ncols() != r
+            || b_phi.nrows() % 3 != 0
+            || phi_master.nrows() != 6
+            || phi_master.ncols() != r
+            || column_size.len() != r
         {
             return Err(Error::Invalid(format!(
                 "reduced model of dimension {r} has inconsistent K̃ ({}×{}), M̃ ({}×{}), BΦ ({}×{}, \
                  3 rows per pair), master rows ({}×{}) or coordinate sizes ({})",
-                p.k.nrows(),
-                p.k.ncols(),
-                p.m.nrows(),
-                p.m.ncols(),
-                p.b_phi.nrows(),
-                p.b_phi.ncols(),
-                p.phi_master.nrows(),
-                p.phi_master.ncols(),
-                p.column_size.len()
+                k.nrows(),
+                k.ncols(),
+                m.nrows(),
+                m.ncols(),
+                b_phi.nrows(),
+                b_phi.ncols(),
+                phi_master.nrows(),
+                phi_master.ncols(),
+                column_size.len()
             )));
         }
         for (name, a) in [
-            ("K̃", &p.k),
-            ("M̃", &p.m),
-            ("BΦ", &p.b_phi),
-            ("master rows", &p.phi_master),
+            ("K̃", &k),
+            ("M̃", &m),
+            ("BΦ", &b_phi),
+            ("master rows", &phi_master),
         ] {
             if a.col_iter().any(|c| c.iter().any(|v| !v.is_finite())) {
                 return Err(Error::Invalid(format!(
@@ -165,14 +154,6 @@ impl ReducedSystem {
                 )));
             }
         }
-        let ReducedMatrices {
-            k,
-            m,
-            b_phi,
-            phi_master,
-            column_size,
-            load,
-        } = p;
         if let Some(c) = column_size
             .iter()
             .position(|s| !(s.is_finite() && *s > 0.0))
@@ -237,18 +218,6 @@ impl ReducedSystem {
         (0..self.r)
             .map(|c| (0..6).map(|d| self.phi_master[(d, c)] * f[d]).sum())
             .collect()
-    }
-
-    /// The matrices the system is made of (e.g. to write them to a file).
-    pub fn matrices(&self) -> ReducedMatrices {
-        ReducedMatrices {
-            k: self.k.clone(),
-            m: self.m.clone(),
-            b_phi: self.b_phi.clone(),
-            phi_master: self.phi_master.clone(),
-            column_size: self.column_size.clone(),
-            load: self.load,
-        }
     }
 }
 

@@ -93,7 +93,7 @@ fn schema_errors_keep_serde_as_the_source() {
     assert!(matches!(err, Error::Case { .. }), "{err}");
     let source = err.source().expect("serde's error as the source");
     assert!(
-        source.downcast_ref::<serde_json::Error>().is_some(),
+        source.downcast_ref::<Box<serde_json::Error>>().is_some(),
         "{source}"
     );
     assert!(source.to_string().contains("colour"), "{source}");

@@ -390,23 +390,7 @@ fn write_outputs(dir: &Path, doc: &Value, c: &Curves) -> Result<(), Error> {
         &dir.join("transient.json"),
         serde_json::to_string(doc).expect("JSON values serialise"),
     )?;
-    let mut csv = String::from(
-        "t_s,contact_force_norm_N,friction_force_norm_N,master_uy_mm,kinetic_Nmm,strain_Nmm,pair_Nmm,external_work_Nmm,dissipated_Nmm\n",
-    );
-    for i in 0..c.t.len() {
-        csv.push_str(&format!(
-            "{:.8e},{:.10e},{:.10e},{:.10e},{:.10e},{:.10e},{:.10e},{:.10e},{:.10e}\n",
-            c.t[i],
-            c.contact_force_norm[i],
-            c.friction_force_norm[i],
-            c.master_uy[i],
-            c.kinetic[i],
-            c.strain[i],
-            c.pair[i],
-            c.external_work[i],
-            c.dissipated[i]
-        ));
-    }
+    let csv = jointrom::report::curves::curves_csv(c)?;
     write_file(&dir.join("curves.csv"), csv)
 }
 
