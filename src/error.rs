@@ -27,6 +27,17 @@ pub enum Error {
         #[source]
         source: Option<Box<serde_json::Error>>,
     },
+    /// A JSON document jointrom reads besides case files and maps (an exported reduced model, a
+    /// sweep's variants) is malformed: the file, the JSON path, the reason, and serde's error as
+    /// the source when the JSON did not parse into the schema.
+    #[error("invalid request: {}: at `{path}`: {reason}", file.display())]
+    Document {
+        file: PathBuf,
+        path: String,
+        reason: String,
+        #[source]
+        source: Option<Box<serde_json::Error>>,
+    },
     /// An element could not be built (degenerate geometry, bad material).
     #[error("element: {0}")]
     Element(String),

@@ -157,12 +157,19 @@ impl RomFile {
             file: path.to_path_buf(),
             source: e,
         })?;
-        let bad = |field: &str, msg: String| {
-            Error::Invalid(format!("{}: at `{field}`: {msg}", path.display()))
+        let bad = |field: &str, msg: String| Error::Document {
+            file: path.to_path_buf(),
+            path: field.to_string(),
+            reason: msg,
+            source: None,
         };
         let de = &mut serde_json::Deserializer::from_str(&text);
-        let f: RomFile = serde_path_to_error::deserialize(de)
-            .map_err(|e| bad(&e.path().to_string(), e.inner().to_string()))?;
+        let f: RomFile = serde_path_to_error::deserialize(de).map_err(|e| Error::Document {
+            file: path.to_path_buf(),
+            path: e.path().to_string(),
+            reason: e.inner().to_string(),
+            source: Some(Box::new(e.into_inner())),
+        })?;
         if f.schema != SCHEMA {
             return Err(bad(
                 "schema",

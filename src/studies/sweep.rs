@@ -57,12 +57,19 @@ pub fn read_variants(path: &Path) -> Result<Vec<Variant>, Error> {
         file: path.to_path_buf(),
         source: e,
     })?;
-    let bad = |field: String, msg: String| {
-        Error::Invalid(format!("{}: at `{field}`: {msg}", path.display()))
+    let bad = |field: String, msg: String| Error::Document {
+        file: path.to_path_buf(),
+        path: field,
+        reason: msg,
+        source: None,
     };
     let de = &mut serde_json::Deserializer::from_str(&text);
-    let f: VariantFile = serde_path_to_error::deserialize(de)
-        .map_err(|e| bad(e.path().to_string(), e.inner().to_string()))?;
+    let f: VariantFile = serde_path_to_error::deserialize(de).map_err(|e| Error::Document {
+        file: path.to_path_buf(),
+        path: e.path().to_string(),
+        reason: e.inner().to_string(),
+        source: Some(Box::new(e.into_inner())),
+    })?;
     if f.variants.is_empty() {
         return Err(bad("variants".into(), "no variants".into()));
     }
