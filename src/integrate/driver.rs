@@ -219,7 +219,7 @@ pub struct Run {
 
 impl Run {
     /// The run if it finished, else the error that ended it.
-    pub fn finished(self) -> Result<Run, Error> {
+    pub fn into_result(self) -> Result<Run, Error> {
         match self.failure {
             Some(e) => Err(e),
             None => Ok(self),
@@ -257,7 +257,8 @@ pub fn thread_cpu_s() -> f64 {
 /// scene's) and samples the outputs every `opts.output_step`; `observe(t, q)` sees the
 /// coordinates at t = 0 and at every output. Never fails as a whole: a setup or integration
 /// failure, the budget running out or chattering events become the run's [`RunStatus`], with
-/// the curves up to the time reached and the error in [`Run::failure`].
+/// the curves up to the time reached and the error in [`Run::failure`] ([`Run::into_result`]
+/// turns it into a `Result`).
 pub fn integrate<S: SecondOrderSystem>(
     system: S,
     scene: &Scene,
@@ -281,7 +282,7 @@ pub fn run<S: SecondOrderSystem>(
     scene: &Scene,
     opts: &TransientOptions,
 ) -> Result<Run, Error> {
-    integrate(system, scene, opts, |_, _| {}).finished()
+    integrate(system, scene, opts, |_, _| {}).into_result()
 }
 
 /// A problem with an optional wall-clock deadline checked in every right-hand side.

@@ -64,7 +64,7 @@ pub fn train_snapshot_basis(
             k += 1;
         },
     )
-    .finished()?;
+    .into_result()?;
     let y = faer::Mat::from_fn(model.dofs(), states.len(), |r, c| states[c][r]);
     let basis = snapshot_basis(model, y.as_ref(), None, basis)?;
     let training = Training {

@@ -29,7 +29,7 @@ fn snapshot_pod_rom_reproduces_its_training_run() {
         &common::until(END),
         |t, q| states.push((t, q.to_vec())),
     )
-    .finished()
+    .into_result()
     .unwrap();
     // One observation at t = 0 (rest) and one per output, matching the curves.
     assert_eq!(states.len(), full.curves.t.len());

@@ -369,7 +369,7 @@ fn run_keeping<S: SecondOrderSystem>(
         }
         k += 1;
     })
-    .finished()?;
+    .into_result()?;
     Ok((res, frames))
 }
 
