@@ -48,8 +48,9 @@
 //! - empty or duplicate sheet names, an unknown sheet name anywhere, a sheet listed twice;
 //! - a clamp or tie `x` that is not a node line of each listed sheet; no clamp at all; a node
 //!   that is both clamped and tied;
-//! - a weld whose (x, z) is not a node of each listed sheet, with fewer than two sheets, or with
-//!   sheets not in strictly increasing y;
+//! - a weld whose (x, z) is not a node of each listed sheet, with fewer than two sheets, with
+//!   sheets not in strictly increasing y, whose diameter exceeds a listed sheet's width, or whose
+//!   nugget overlaps an earlier weld's on a shared sheet (centres closer than the mean diameter);
 //! - a joint whose sheets are the same, are declared twice, have a clearance
 //!   (`upper.y − lower.y ≠ (t_lower + t_upper)/2` within 1e-9 of the scale), do not overlap in
 //!   (x, z), or overlap without coinciding nodes; an explicit joint point that is not a node of

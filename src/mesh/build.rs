@@ -433,6 +433,7 @@ impl Sheets<'_> {
             ctx.finite(&format!("{p}.z"), weld.z, " mm")?;
             ctx.positive(&format!("{p}.diameter"), weld.diameter, " mm")?;
             let stack = self.resolve(&weld.sheets, &format!("{p}.sheets"), 2)?;
+            self.check_nugget(welds, w, &stack)?;
             let mut weld_nodes = Vec::with_capacity(stack.len());
             for &s in &stack {
                 let g = &grids[s];
@@ -469,6 +470,44 @@ impl Sheets<'_> {
             }
         }
         Ok(beams)
+    }
+
+    /// The nugget of weld `w` (diameter d, on the sheets `stack`) fits each sheet (d no larger
+    /// than the sheet's width, its smaller extent) and does not overlap the nugget of an earlier
+    /// weld that shares a sheet (centre distance ≥ (d₁ + d₂)/2).
+    fn check_nugget(&self, welds: &[WeldSpec], w: usize, stack: &[usize]) -> Result<(), Error> {
+        let (grids, ctx) = (self.grids, self.ctx);
+        let weld = &welds[w];
+        for &s in stack {
+            let g = &grids[s];
+            let width = (g.hi[0] - g.lo[0]).min(g.hi[1] - g.lo[1]);
+            if weld.diameter > width {
+                return Err(ctx.err(
+                    format!("welds[{w}].diameter"),
+                    format!(
+                        "{} mm is larger than the width of sheet `{}` ({width} mm)",
+                        weld.diameter, g.name
+                    ),
+                ));
+            }
+        }
+        for (v, other) in welds[..w].iter().enumerate() {
+            if !other.sheets.iter().any(|s| weld.sheets.contains(s)) {
+                continue;
+            }
+            let distance = (weld.x - other.x).hypot(weld.z - other.z);
+            let reach = 0.5 * (weld.diameter + other.diameter);
+            if distance < reach {
+                return Err(ctx.err(
+                    format!("welds[{w}]"),
+                    format!(
+                        "its nugget overlaps that of welds[{v}]: centres {distance} mm apart, \
+                         closer than the mean diameter {reach} mm"
+                    ),
+                ));
+            }
+        }
+        Ok(())
     }
 
     /// The joint pairs, joint by joint in case-file order, within a joint sorted by (x, z) of the

@@ -437,6 +437,28 @@ fn welds_must_sit_on_nodes() {
 }
 
 #[test]
+fn weld_nuggets_fit_the_sheets_and_do_not_overlap() {
+    // Wider than the 25 mm strip.
+    edited(
+        |c| c["welds"][0]["diameter"] = json!(30.0),
+        "welds[0].diameter",
+        "larger than the width of sheet `A`",
+    );
+    // Two welds 5 mm apart with 5 mm nuggets touch (allowed); 10 mm nuggets overlap.
+    edited(
+        |c| {
+            c["welds"][1]["x"] = json!(65.0);
+            c["welds"][1]["diameter"] = json!(10.0);
+        },
+        "welds[1]",
+        "overlaps that of welds[0]",
+    );
+    let mut touching = friction_bar();
+    touching["welds"][1]["x"] = json!(65.0);
+    validated(&touching.to_string(), FILE).expect("touching nuggets are allowed");
+}
+
+#[test]
 fn weld_sheets_must_rise_in_y() {
     edited(
         |c| c["welds"][0]["sheets"] = json!(["B", "A"]),
