@@ -11,8 +11,11 @@ use std::process::{Command, Output};
 
 use jointrom::case::Case;
 use jointrom::integrate::TransientOptions;
+use jointrom::joint::statics::{contact_static_reduced, ContactOptions, ContactState};
+use jointrom::joint::NORMAL;
 use jointrom::linalg::SymCsc;
-use jointrom::Model;
+use jointrom::system::ReducedSystem;
+use jointrom::{Error, Model};
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
 use serde_json::Value;
@@ -220,4 +223,27 @@ pub fn rng(seed: u64) -> StdRng {
 /// Uniform in [−1, 1).
 pub fn uniform(rng: &mut StdRng) -> f64 {
     rng.random_range(-1.0..1.0)
+}
+
+/// Frictionless contact statics of a reduced system under the master load `load`
+/// (`[Fx, Fy, Fz, Mx, My, Mz]`, N and N·mm) with penalty `k_n` (N/mm): the reduced coordinates
+/// and the contact state.
+pub fn reduced_contact(
+    red: &ReducedSystem,
+    load: [f64; 6],
+    k_n: f64,
+) -> Result<(Vec<f64>, ContactState), Error> {
+    let r = red.dim();
+    let w = red.b_phi.nrows() / 3;
+    let b_n_phi = faer::Mat::from_fn(w, r, |i, j| red.b_phi[(3 * i + NORMAL, j)]);
+    let f_red: Vec<f64> = (0..r)
+        .map(|c| (0..6).map(|d| red.phi_master[(d, c)] * load[d]).sum())
+        .collect();
+    contact_static_reduced(
+        red.k.as_ref(),
+        b_n_phi.as_ref(),
+        &f_red,
+        k_n,
+        &ContactOptions::default(),
+    )
 }

@@ -9,8 +9,7 @@ use std::time::Instant;
 
 use faer::{Mat, MatRef};
 use jointrom::case::Case;
-use jointrom::joint::statics::{contact_static_reduced, ContactOptions, ContactState};
-use jointrom::joint::NORMAL;
+use jointrom::joint::statics::{ContactOptions, ContactState};
 use jointrom::linalg::cholesky::SparseCholesky;
 use jointrom::linalg::SymCsc;
 use jointrom::model::contact_static_full;
@@ -78,27 +77,10 @@ fn try_reduced_contact(
     load: [f64; 6],
 ) -> Result<(ContactState, [f64; 6]), Error> {
     let red = ReducedSystem::new(model, phi)?;
-    let w = model.joint.pairs();
-    let r = red.dim();
-    let b_n_phi = Mat::from_fn(w, r, |i, j| red.b_phi[(3 * i + NORMAL, j)]);
-    let master = model.master_dofs();
-    let f_red: Vec<f64> = (0..r)
-        .map(|c| {
-            (0..6)
-                .map(|d| red.phi.as_ref().unwrap()[(master[d], c)] * load[d])
-                .sum()
-        })
-        .collect();
-    let (eta, state) = contact_static_reduced(
-        red.k.as_ref(),
-        b_n_phi.as_ref(),
-        &f_red,
-        model.contact.normal_stiffness,
-        &ContactOptions::default(),
-    )?;
-    let um = master.map(|d| {
-        (0..r)
-            .map(|c| red.phi.as_ref().unwrap()[(d, c)] * eta[c])
+    let (eta, state) = common::reduced_contact(&red, load, model.contact.normal_stiffness)?;
+    let um = std::array::from_fn(|d| {
+        (0..red.dim())
+            .map(|c| red.phi_master[(d, c)] * eta[c])
             .sum()
     });
     Ok((state, um))

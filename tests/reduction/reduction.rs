@@ -8,7 +8,7 @@ use std::time::Instant;
 
 use faer::{Mat, MatRef};
 use jointrom::case::Case;
-use jointrom::joint::statics::{contact_static_reduced, ContactOptions};
+use jointrom::joint::statics::ContactOptions;
 use jointrom::joint::NORMAL;
 use jointrom::linalg::cholesky::SparseCholesky;
 use jointrom::linalg::SymCsc;
@@ -599,24 +599,7 @@ fn weighted_pod_of_tvd_resolves_small_eigenvalues() {
     let load = model.master_load();
     let full = contact_static_full(&model, load, &ContactOptions::default()).unwrap();
     let red = ReducedSystem::new(&model, b.phi).unwrap();
-    let r = red.dim();
-    let b_n_phi = Mat::from_fn(w, r, |i, j| red.b_phi[(3 * i + NORMAL, j)]);
-    let master = model.master_dofs();
-    let f_red: Vec<f64> = (0..r)
-        .map(|c| {
-            (0..6)
-                .map(|d| red.phi.as_ref().unwrap()[(master[d], c)] * load[d])
-                .sum()
-        })
-        .collect();
-    let (_, state) = contact_static_reduced(
-        red.k.as_ref(),
-        b_n_phi.as_ref(),
-        &f_red,
-        kn,
-        &ContactOptions::default(),
-    )
-    .unwrap();
+    let (_, state) = common::reduced_contact(&red, load, kn).unwrap();
     let fc = full.state.contact_force_norm;
     let err = (state.contact_force_norm - fc).abs() / fc;
     println!("  g = {}: ‖f_c‖ relative error {err:.2e}", p.lambda.len());
