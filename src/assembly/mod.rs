@@ -16,7 +16,7 @@
 
 use faer::Mat;
 
-use crate::element::{Beam2, Shell4};
+use crate::element::{Beam2, Shell4, Weld};
 use crate::error::Error;
 use crate::linalg::SymCsc;
 use crate::mesh::Mesh;
@@ -32,7 +32,8 @@ pub struct Structure {
     pub mass: SymCsc,
 }
 
-/// Builds every `Shell4` and `Beam2` of the mesh and assembles K and M on the independent DOF.
+/// Builds every `Shell4`, `Beam2` and area `Weld` of the mesh and assembles K and M on the
+/// independent DOF.
 pub fn assemble_structure(mesh: &Mesh) -> Result<Structure, Error> {
     let material = mesh.material;
     let shells = mesh
@@ -52,28 +53,30 @@ pub fn assemble_structure(mesh: &Mesh) -> Result<Structure, Error> {
             )
         })
         .collect::<Result<Vec<_>, _>>()?;
+    let welds = mesh
+        .welds
+        .iter()
+        .map(|w| Weld::new(w, material))
+        .collect::<Result<Vec<_>, _>>()?;
     let dof_map = DofMap::new(mesh);
     let element_nodes: Vec<&[usize]> = mesh
         .shells
         .iter()
         .map(|s| &s.nodes[..])
         .chain(mesh.beams.iter().map(|b| &b.nodes[..]))
+        .chain(welds.iter().map(Weld::nodes))
         .collect();
     let assembler = Assembler::new(&dof_map, element_nodes);
-    let ns = shells.len();
-    let stiffness = assembler.assemble(|e| {
-        if e < ns {
-            shells[e].stiffness()
-        } else {
-            beams[e - ns].stiffness()
-        }
+    let (ns, nb) = (shells.len(), beams.len());
+    let stiffness = assembler.assemble(|e| match e {
+        e if e < ns => shells[e].stiffness(),
+        e if e < ns + nb => beams[e - ns].stiffness(),
+        e => welds[e - ns - nb].stiffness(),
     });
-    let mass = assembler.assemble(|e| {
-        if e < ns {
-            shells[e].mass()
-        } else {
-            beams[e - ns].mass()
-        }
+    let mass = assembler.assemble(|e| match e {
+        e if e < ns => shells[e].mass(),
+        e if e < ns + nb => beams[e - ns].mass(),
+        e => welds[e - ns - nb].mass(),
     });
     Ok(Structure {
         dof_map,

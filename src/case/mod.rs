@@ -2,12 +2,15 @@
 //! with JSON paths (the mesh is generated from it by `crate::mesh::Mesh::from_case`).
 //!
 //! A case file describes flat sheets parallel to the x–z plane, the clamps that support them, one
-//! rigid tie (NASTRAN RBE2) from the free end to a master node that carries the load, weld spots
-//! (beams through a stack of sheets), the joints (sheet interfaces with node-to-node contact and
-//! friction, zero initial clearance) and the load history. The two structures of Witteveen &
+//! rigid tie (NASTRAN RBE2) from the free end to a master node that carries the load, spot welds
+//! through a stack of sheets, the joints (sheet interfaces with node-to-node contact and
+//! friction, zero initial clearance) and the load history. Spot welds are area welds by default
+//! (the nugget joins the sheets over its area, anywhere in their overlap: `crate::element::Weld`);
+//! `"model": "point"` keeps the paper's beam between two nodes for comparison. The two structures of Witteveen &
 //! Pichler (2014), Section 4, ship as built-in cases: [`Case::builtin`]`("friction_bar")`
-//! (Section 4.1, 906 DOF, 648 of them in the joint) and `"multilayer_sheet"` (Section 4.2, 834 DOF,
-//! all in the joints).
+//! (Section 4.1, 906 DOF; 624 in the joint's 52 pairs — the paper's 648 less the two node pairs
+//! at the weld centres, which the area welds fuse) and `"multilayer_sheet"` (Section 4.2, 834 DOF;
+//! 86 pairs).
 //!
 //! ```json
 //! {
@@ -48,9 +51,10 @@
 //! - empty or duplicate sheet names, an unknown sheet name anywhere, a sheet listed twice;
 //! - a clamp or tie `x` that is not a node line of each listed sheet; no clamp at all; a node
 //!   that is both clamped and tied;
-//! - a weld whose (x, z) is not a node of each listed sheet, with fewer than two sheets, with
-//!   sheets not in strictly increasing y, whose diameter exceeds a listed sheet's width, or whose
-//!   nugget overlaps an earlier weld's on a shared sheet (centres closer than the mean diameter);
+//! - a weld with fewer than two sheets, with sheets not in strictly increasing y, whose diameter
+//!   exceeds a listed sheet's width, whose nugget overlaps an earlier weld's on a shared sheet
+//!   (centres closer than the mean diameter), whose centre lies outside a listed sheet (an area
+//!   weld: outside the sheets' overlap) or, for a point weld, is not a node of each listed sheet;
 //! - a joint whose sheets are the same, are declared twice, have a clearance
 //!   (`upper.y − lower.y ≠ (t_lower + t_upper)/2` within 1e-9 of the scale), do not overlap in
 //!   (x, z), or overlap without coinciding nodes; an explicit joint point that is not a node of
@@ -93,7 +97,7 @@ pub struct Case {
     pub clamps: Vec<ClampSpec>,
     /// The rigid tie of one line x = const to the master node that carries the load.
     pub rigid_tie: RigidTieSpec,
-    /// Weld spots: beams through a stack of sheets.
+    /// Spot welds through a stack of sheets.
     pub welds: Vec<WeldSpec>,
     /// Joints: interfaces between two sheets with node-to-node contact and friction.
     pub joints: Vec<JointSpec>,
@@ -163,19 +167,38 @@ pub struct RigidTieSpec {
     pub master: [f64; 3],
 }
 
-/// A weld spot at (x, z) through a stack of sheets `[s0, s1, s2, …]`, modelled as the beams
-/// s0–s1, s1–s2, … between the sheets' nodes there.
+/// A spot weld at (x, z) through a stack of sheets `[s0, s1, s2, …]` (see `crate::element::Weld`
+/// for the area model and [`WeldModel`] for the choice).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct WeldSpec {
-    /// Position along x, mm; with `z` a node of every listed sheet.
+    /// Centre along x, mm; inside every listed sheet (a node of each for [`WeldModel::Point`]).
     pub x: f64,
-    /// Position along z, mm.
+    /// Centre along z, mm.
     pub z: f64,
     /// Names of the welded sheets in strictly increasing y (at least two).
     pub sheets: Vec<String>,
-    /// Diameter of the circular beam section, mm (> 0).
+    /// Nugget diameter d, mm (> 0, no larger than a listed sheet's width).
     pub diameter: f64,
+    /// How the weld attaches to the sheets; `"area"` when omitted.
+    #[serde(default)]
+    pub model: WeldModel,
+}
+
+/// How a spot weld attaches to its sheets.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum WeldModel {
+    /// Area weld (the default): the nugget disc of diameter d joins the sheets over its area,
+    /// through interpolation constraints on the shells' own shape functions (like NASTRAN's
+    /// CWELD ELPAT or an ACM2 weld); the centre may lie anywhere inside the sheets' overlap.
+    /// Joint pairs inside the nugget are welded, not in contact, and leave the joint.
+    #[default]
+    Area,
+    /// Point weld (the paper's wording, kept for comparison): a Timoshenko beam of diameter d
+    /// between the sheets' nodes at (x, z), which must be a node of every listed sheet; its
+    /// footprint on the sheets is set by the mesh, so it does not converge under refinement.
+    Point,
 }
 
 /// A joint: the interface between two stacked sheets with zero initial clearance,

@@ -6,9 +6,10 @@
 use std::collections::{HashMap, HashSet};
 
 use super::Material;
-use super::{BeamElem, JointPair, Mesh, RigidTie, SheetGrid, ShellElem};
+use super::nugget;
+use super::{BeamElem, JointPair, Mesh, RigidTie, SheetGrid, ShellElem, WeldElem};
 use crate::case::validate::{check_contact_and_load, check_material, check_sheets, Ctx};
-use crate::case::{Case, ClampSpec, JointSpec, RigidTieSpec, WeldSpec, NODE_TOLERANCE};
+use crate::case::{Case, ClampSpec, JointSpec, RigidTieSpec, WeldModel, WeldSpec, NODE_TOLERANCE};
 use crate::error::Error;
 
 /// Relative tolerance of the zero-clearance test of a joint.
@@ -39,8 +40,12 @@ pub(super) fn build(case: &Case) -> Result<Mesh, Error> {
         .filter(|&n| clamp_of[n].is_some())
         .collect();
     let (tied, tie) = sheets.rigid_tie(&case.rigid_tie, &clamp_of, &mut nodes)?;
-    let beams = sheets.welds(&case.welds)?;
-    let supports = Supports { clamp_of, tied };
+    let welds = sheets.welds(&case.welds)?;
+    let supports = Supports {
+        clamp_of,
+        tied,
+        nuggets: welds.nuggets,
+    };
     let pairs = sheets.joints(&case.joints, &supports, &nodes)?;
 
     check_contact_and_load(case, &ctx)?;
@@ -56,7 +61,8 @@ pub(super) fn build(case: &Case) -> Result<Mesh, Error> {
             })
             .collect(),
         shells,
-        beams,
+        beams: welds.beams,
+        welds: welds.welds,
         clamped,
         tie,
         pairs,
@@ -105,11 +111,21 @@ struct Supports {
     clamp_of: Vec<Option<usize>>,
     /// Whether each sheet node is rigidly tied to the master node.
     tied: Vec<bool>,
+    /// The area welds' nuggets: node pairs inside one are welded, not in contact.
+    nuggets: Vec<Nugget>,
 }
 
 impl Supports {
     fn excluded(&self, n: usize) -> bool {
         self.clamp_of[n].is_some() || self.tied[n]
+    }
+
+    /// The area weld (`welds[i]`) whose nugget fuses sheets `lower` and `upper` at `xz`, if any.
+    fn welded(&self, lower: usize, upper: usize, xz: [f64; 2]) -> Option<usize> {
+        self.nuggets
+            .iter()
+            .find(|n| n.welds(lower, upper, xz))
+            .map(|n| n.index)
     }
 
     /// What holds node `n`, in words, if anything does.
@@ -122,15 +138,22 @@ impl Supports {
     }
 }
 
-/// The node pairs of a joint's overlap (the `None` case of `points`): every coincident pair
-/// neither of whose nodes is clamped or tied, i-major over the lower sheet.
-fn coincident_pairs(gl: &Grid, gu: &Grid, overlap: &Rect, supports: &Supports) -> Vec<JointPair> {
+/// The node pairs of a joint between sheets `[lower, upper]` in their overlap (the `None` case
+/// of `points`): every coincident pair neither of whose nodes is clamped or tied and that no
+/// area weld's nugget fuses, i-major over the lower sheet.
+fn coincident_pairs(
+    [lower, upper]: [usize; 2],
+    [gl, gu]: [&Grid; 2],
+    overlap: &Rect,
+    supports: &Supports,
+) -> Vec<JointPair> {
     let mut found = Vec::new();
     for (i, k) in gl.nodes_in(overlap) {
         let [x, z] = gl.xz(i, k);
         let l = gl.index(i, k);
         if let Some(u) = gu.node_at(x, z) {
-            if !supports.excluded(l) && !supports.excluded(u) {
+            let welded = supports.welded(lower, upper, [x, z]).is_some();
+            if !supports.excluded(l) && !supports.excluded(u) && !welded {
                 found.push(JointPair { lower: l, upper: u });
             }
         }
@@ -219,7 +242,7 @@ fn pairs_at_points(
     ctx: &Ctx,
     p: &str,
     points: &[[f64; 2]],
-    [gl, gu]: [&Grid; 2],
+    ([lower, upper], [gl, gu]): ([usize; 2], [&Grid; 2]),
     supports: &Supports,
 ) -> Result<Vec<JointPair>, Error> {
     if points.is_empty() {
@@ -256,6 +279,15 @@ fn pairs_at_points(
                     ),
                 ));
             }
+        }
+        if let Some(w) = supports.welded(lower, upper, [x, z]) {
+            return Err(ctx.err(
+                &pq,
+                format!(
+                    "(x, z) = ({x}, {z}) mm lies inside the nugget of welds[{w}]: the sheets are \
+                     welded there, not in contact"
+                ),
+            ));
         }
         if !seen.insert(at[0]) {
             return Err(ctx.err(&pq, format!("(x, z) = ({x}, {z}) mm is listed twice")));
@@ -423,35 +455,18 @@ impl Sheets<'_> {
         Ok((tied, RigidTie { master, slaves }))
     }
 
-    /// The weld beams: one between each two consecutive sheets of a weld's stack.
-    fn welds(&self, welds: &[WeldSpec]) -> Result<Vec<BeamElem>, Error> {
+    /// The welds: for a point weld one beam between each two consecutive sheets of its stack
+    /// at their nodes there, for an area weld its nugget sampled on every sheet of the stack.
+    fn welds(&self, welds: &[WeldSpec]) -> Result<Welds, Error> {
         let (grids, ctx) = (self.grids, self.ctx);
-        let mut beams = Vec::new();
+        let mut out = Welds::default();
         for (w, weld) in welds.iter().enumerate() {
             let p = format!("welds[{w}]");
             ctx.finite(&format!("{p}.x"), weld.x, " mm")?;
             ctx.finite(&format!("{p}.z"), weld.z, " mm")?;
             ctx.positive(&format!("{p}.diameter"), weld.diameter, " mm")?;
             let stack = self.resolve(&weld.sheets, &format!("{p}.sheets"), 2)?;
-            self.check_nugget(welds, w, &stack)?;
-            let mut weld_nodes = Vec::with_capacity(stack.len());
-            for &s in &stack {
-                let g = &grids[s];
-                let n = g.node_at(weld.x, weld.z).ok_or_else(|| {
-                    ctx.err(
-                        &p,
-                        format!(
-                            "(x, z) = ({}, {}) mm is not a node of sheet `{}` ({})",
-                            weld.x,
-                            weld.z,
-                            g.name,
-                            g.describe()
-                        ),
-                    )
-                })?;
-                weld_nodes.push(n);
-            }
-            for (pair, nodes_pair) in stack.windows(2).zip(weld_nodes.windows(2)) {
+            for pair in stack.windows(2) {
                 let (lo, hi) = (&grids[pair[0]], &grids[pair[1]]);
                 if hi.y <= lo.y {
                     return Err(ctx.err(
@@ -463,13 +478,86 @@ impl Sheets<'_> {
                         ),
                     ));
                 }
-                beams.push(BeamElem {
-                    nodes: [nodes_pair[0], nodes_pair[1]],
-                    diameter: weld.diameter,
-                });
+            }
+            self.check_nugget(welds, w, &stack)?;
+            match weld.model {
+                WeldModel::Point => out.beams.extend(self.point_weld(weld, &p, &stack)?),
+                WeldModel::Area => {
+                    let elem = self.area_weld(w, weld, &stack)?;
+                    out.nuggets.push(Nugget {
+                        index: w,
+                        centre: elem.centre,
+                        radius: 0.5 * elem.diameter,
+                        sheets: stack,
+                    });
+                    out.welds.push(elem);
+                }
             }
         }
-        Ok(beams)
+        Ok(out)
+    }
+
+    /// The beams of a point weld: (x, z) must be a node of every sheet of the stack.
+    fn point_weld(&self, weld: &WeldSpec, p: &str, stack: &[usize]) -> Result<Vec<BeamElem>, Error> {
+        let (grids, ctx) = (self.grids, self.ctx);
+        let mut weld_nodes = Vec::with_capacity(stack.len());
+        for &s in stack {
+            let g = &grids[s];
+            let n = g.node_at(weld.x, weld.z).ok_or_else(|| {
+                ctx.err(
+                    p,
+                    format!(
+                        "(x, z) = ({}, {}) mm is not a node of sheet `{}` ({}); a point weld \
+                         (\"model\": \"point\") joins nodes — the area weld (the default) does not \
+                         need one",
+                        weld.x,
+                        weld.z,
+                        g.name,
+                        g.describe()
+                    ),
+                )
+            })?;
+            weld_nodes.push(n);
+        }
+        Ok(weld_nodes
+            .windows(2)
+            .map(|pair| BeamElem {
+                nodes: [pair[0], pair[1]],
+                diameter: weld.diameter,
+            })
+            .collect())
+    }
+
+    /// An area weld (`welds[w]`): its centre must lie inside every sheet of the stack; the
+    /// nugget is clipped to the sheets' common rectangle and sampled on each.
+    fn area_weld(&self, w: usize, weld: &WeldSpec, stack: &[usize]) -> Result<WeldElem, Error> {
+        let (grids, ctx) = (self.grids, self.ctx);
+        let centre = [weld.x, weld.z];
+        for &s in stack {
+            let g = &grids[s];
+            let own = Rect { lo: g.lo, hi: g.hi };
+            if !own.contains(centre) {
+                return Err(ctx.err(
+                    format!("welds[{w}]"),
+                    format!(
+                        "the centre (x, z) = ({}, {}) mm lies outside sheet `{}` (x ∈ [{}, {}], \
+                         z ∈ [{}, {}] mm): a weld must lie where all its sheets overlap",
+                        weld.x, weld.z, g.name, g.lo[0], g.hi[0], g.lo[1], g.hi[1]
+                    ),
+                ));
+            }
+        }
+        let clip = Rect::common(stack.iter().map(|&s| &grids[s]));
+        let layers = stack
+            .iter()
+            .map(|&s| nugget::sample(centre, weld.diameter, &clip, s, &grids[s]))
+            .collect();
+        Ok(WeldElem {
+            index: w,
+            centre,
+            diameter: weld.diameter,
+            layers,
+        })
     }
 
     /// The nugget of weld `w` (diameter d, on the sheets `stack`) fits each sheet (d no larger
@@ -545,15 +633,17 @@ impl Sheets<'_> {
             check_clearance(ctx, &p, gl, gu)?;
             let overlap = overlap(ctx, &p, gl, gu)?;
             let mut found = match &joint.points {
-                None => coincident_pairs(gl, gu, &overlap, supports),
-                Some(points) => pairs_at_points(ctx, &p, points, [gl, gu], supports)?,
+                None => coincident_pairs([lower, upper], [gl, gu], &overlap, supports),
+                Some(points) => {
+                    pairs_at_points(ctx, &p, points, ([lower, upper], [gl, gu]), supports)?
+                }
             };
             if found.is_empty() {
                 return Err(ctx.err(
                     &p,
                     format!(
                         "the joint between `{}` and `{}` has no node pairs: every coincident \
-                         node is clamped or tied",
+                         node is clamped, tied or inside a weld nugget",
                         gl.name, gu.name
                     ),
                 ));
@@ -568,20 +658,76 @@ impl Sheets<'_> {
     }
 }
 
+/// What the welds pass produces.
+#[derive(Default)]
+struct Welds {
+    /// Beams of point welds.
+    beams: Vec<BeamElem>,
+    /// Area welds.
+    welds: Vec<WeldElem>,
+    /// The area welds' nuggets, for taking welded node pairs out of the joints.
+    nuggets: Vec<Nugget>,
+}
+
+/// An area weld's nugget as the joints pass sees it.
+struct Nugget {
+    /// `welds[index]` in the case file.
+    index: usize,
+    /// Centre (x, z), mm.
+    centre: [f64; 2],
+    /// d/2, mm.
+    radius: f64,
+    /// The welded sheets.
+    sheets: Vec<usize>,
+}
+
+impl Nugget {
+    /// Whether a node pair of sheets `lower`, `upper` at `xz` lies strictly inside the nugget
+    /// (farther than [`NODE_TOLERANCE`] from its rim): the sheets are fused there.
+    fn welds(&self, lower: usize, upper: usize, xz: [f64; 2]) -> bool {
+        self.sheets.contains(&lower)
+            && self.sheets.contains(&upper)
+            && (xz[0] - self.centre[0]).hypot(xz[1] - self.centre[1])
+                < self.radius - NODE_TOLERANCE
+    }
+}
+
 /// An axis-parallel rectangle in (x, z), mm.
-struct Rect {
+pub(super) struct Rect {
     lo: [f64; 2],
     hi: [f64; 2],
 }
 
+impl Rect {
+    /// Whether `p` lies in the closed rectangle (widened by [`NODE_TOLERANCE`]).
+    pub(super) fn contains(&self, p: [f64; 2]) -> bool {
+        (0..2).all(|a| p[a] >= self.lo[a] - NODE_TOLERANCE && p[a] <= self.hi[a] + NODE_TOLERANCE)
+    }
+
+    /// The intersection of the rectangles of `grids` (empty when `hi < lo` on an axis).
+    fn common<'g>(grids: impl IntoIterator<Item = &'g Grid<'g>>) -> Rect {
+        let mut r = Rect {
+            lo: [f64::NEG_INFINITY; 2],
+            hi: [f64::INFINITY; 2],
+        };
+        for g in grids {
+            for a in 0..2 {
+                r.lo[a] = r.lo[a].max(g.lo[a]);
+                r.hi[a] = r.hi[a].min(g.hi[a]);
+            }
+        }
+        r
+    }
+}
+
 /// One sheet's node grid in (x, z); axis 0 is x, axis 1 is z.
-struct Grid<'a> {
+pub(super) struct Grid<'a> {
     name: &'a str,
     lo: [f64; 2],
     hi: [f64; 2],
-    step: [f64; 2],
+    pub(super) step: [f64; 2],
     n: [usize; 2],
-    y: f64,
+    pub(super) y: f64,
     thickness: f64,
     first: usize,
 }
@@ -611,6 +757,42 @@ impl Grid<'_> {
         }
         let i = r as usize;
         ((self.coord(axis, i) - v).abs() <= NODE_TOLERANCE).then_some(i)
+    }
+
+    /// The shell containing the point `p` = (x, z) of the sheet (the last one along an axis for a
+    /// point on the sheet's far edge) and the bilinear shape functions of its nodes at `p`, in
+    /// [`ShellElem`] node order.
+    pub(super) fn interpolation(&self, p: [f64; 2]) -> ([usize; 4], [f64; 4], [[f64; 2]; 4]) {
+        let mut cell = [0usize; 2];
+        let mut local = [0.0; 2];
+        for a in 0..2 {
+            let s = ((p[a] - self.lo[a]) / self.step[a]).clamp(0.0, self.n[a] as f64);
+            cell[a] = (s.floor() as usize).min(self.n[a] - 1);
+            local[a] = (s - cell[a] as f64).clamp(0.0, 1.0);
+        }
+        let [i, k] = cell;
+        let [xi, eta] = local;
+        let [hx, hz] = self.step;
+        (
+            [
+                self.index(i, k),
+                self.index(i + 1, k),
+                self.index(i + 1, k + 1),
+                self.index(i, k + 1),
+            ],
+            [
+                (1.0 - xi) * (1.0 - eta),
+                xi * (1.0 - eta),
+                xi * eta,
+                (1.0 - xi) * eta,
+            ],
+            [
+                [-(1.0 - eta) / hx, -(1.0 - xi) / hz],
+                [(1.0 - eta) / hx, -xi / hz],
+                [eta / hx, xi / hz],
+                [-eta / hx, (1.0 - xi) / hz],
+            ],
+        )
     }
 
     /// The global index of the node at (x, z), if there is one.

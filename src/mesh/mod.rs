@@ -1,5 +1,6 @@
-//! The discretised structure: nodes, `Shell4` sheets, `Beam2` weld spots, clamps, the rigid tie
-//! to the master node, and the joint node pairs. Built from a [`crate::case::Case`] by
+//! The discretised structure: nodes, `Shell4` sheets, spot welds (area nuggets sampled on the
+//! sheets, or point-weld `Beam2`s), clamps, the rigid tie to the master node, and the joint node
+//! pairs. Built from a [`crate::case::Case`] by
 //! [`Mesh::from_case`], which validates the case while it generates the mesh (`build`).
 //!
 //! Axes: x along the length, y normal to the sheets, z across the width (mm).
@@ -8,6 +9,7 @@ use crate::case::Case;
 use crate::error::Error;
 
 mod build;
+mod nugget;
 
 /// A 4-node shell on a sheet's mid-surface. Nodes run counter-clockwise in the (x, z) plane:
 /// `(i, k), (i+1, k), (i+1, k+1), (i, k+1)` of the sheet's grid.
@@ -28,6 +30,46 @@ pub struct BeamElem {
     pub nodes: [usize; 2],
     /// Section diameter, mm.
     pub diameter: f64,
+}
+
+/// An area spot weld (see `crate::element::Weld`): the nugget disc, clipped to the welded
+/// sheets, sampled on each sheet of the stack.
+#[derive(Clone, Debug, PartialEq)]
+pub struct WeldElem {
+    /// Index of the weld in the case file (`welds[i]`).
+    pub index: usize,
+    /// Centre (x, z), mm.
+    pub centre: [f64; 2],
+    /// Nugget diameter d, mm.
+    pub diameter: f64,
+    /// The welded sheets, lower to upper (strictly increasing y).
+    pub layers: Vec<NuggetLayer>,
+}
+
+/// The nugget on one welded sheet: its sampling points on the sheet's mid-surface.
+#[derive(Clone, Debug, PartialEq)]
+pub struct NuggetLayer {
+    /// Index of the sheet (into [`Mesh::sheets`]).
+    pub sheet: usize,
+    /// Height of the sheet's mid-surface, mm.
+    pub y: f64,
+    /// Sampling points of the (clipped) nugget disc, with their area weights.
+    pub points: Vec<NuggetPoint>,
+}
+
+/// A point of a nugget disc and how the sheet's displacement there is interpolated.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NuggetPoint {
+    /// Position (x, z), mm.
+    pub xz: [f64; 2],
+    /// Area weight, mm² (the weights of a layer sum to the clipped disc's area).
+    pub weight: f64,
+    /// The nodes of the shell containing the point, in [`ShellElem`] order.
+    pub nodes: [usize; 4],
+    /// The bilinear shape functions of those nodes at the point (they sum to 1).
+    pub shape: [f64; 4],
+    /// Their derivatives `[∂N/∂x, ∂N/∂z]` at the point, 1/mm.
+    pub gradient: [[f64; 2]; 4],
 }
 
 /// Rigid-body tie (NASTRAN RBE2, all 6 DOF): every slave node moves as
@@ -70,8 +112,10 @@ pub struct Mesh {
     pub sheets: Vec<SheetGrid>,
     /// Shell elements.
     pub shells: Vec<ShellElem>,
-    /// Weld beams.
+    /// Beams of point welds (`"model": "point"`).
     pub beams: Vec<BeamElem>,
+    /// Area welds (`"model": "area"`, the default).
+    pub welds: Vec<WeldElem>,
     /// Nodes with all 6 DOF clamped, in increasing order.
     pub clamped: Vec<usize>,
     /// The rigid tie to the master node.

@@ -49,14 +49,16 @@ fn friction_bar_counts_match_the_paper() {
     let (_, mesh) = builtin("friction_bar");
     assert_eq!(mesh.nodes.len(), 156 + 1);
     assert_eq!(mesh.shells.len(), 100);
-    assert_eq!(mesh.beams.len(), 2);
+    assert_eq!(mesh.beams.len(), 0);
+    assert_eq!(mesh.welds.len(), 2);
     assert_eq!(mesh.clamped.len(), 3);
     assert_eq!(mesh.tie.slaves.len(), 3);
-    assert_eq!(mesh.pairs.len(), 54);
+    // The paper's 54 pairs less the two inside the nuggets (welded, not in contact).
+    assert_eq!(mesh.pairs.len(), 52);
     assert_eq!(independent_dofs(&mesh), 906);
     let joint = pair_nodes(&mesh);
-    assert_eq!(joint.len(), 108);
-    assert_eq!(6 * joint.len(), 648);
+    assert_eq!(joint.len(), 104);
+    assert_eq!(6 * joint.len(), 624);
 }
 
 #[test]
@@ -80,10 +82,23 @@ fn friction_bar_numbering_and_coordinates() {
     assert_eq!(mesh.tie.master, 156);
     assert_eq!(mesh.clamped, vec![0, 1, 2]);
     assert_eq!(mesh.tie.slaves, vec![153, 154, 155]);
-    // Welds at (60, 12.5) and (105, 12.5): A (12, 1) – B (4, 1), A (21, 1) – B (13, 1).
-    let beams: Vec<[usize; 2]> = mesh.beams.iter().map(|b| b.nodes).collect();
-    assert_eq!(beams, vec![[37, 91], [64, 118]]);
-    assert!(mesh.beams.iter().all(|b| b.diameter == 5.0));
+    // Area welds at (60, 12.5) and (105, 12.5) through A and B: full nuggets (the sampling
+    // weights sum to the disc's area); the node pairs at their centres, A (12, 1) – B (4, 1) and
+    // A (21, 1) – B (13, 1), are welded and not joint pairs.
+    let centres: Vec<[f64; 2]> = mesh.welds.iter().map(|w| w.centre).collect();
+    assert_eq!(centres, vec![[60.0, 12.5], [105.0, 12.5]]);
+    for w in &mesh.welds {
+        assert_eq!(w.diameter, 5.0);
+        let sheets: Vec<usize> = w.layers.iter().map(|l| l.sheet).collect();
+        assert_eq!(sheets, vec![0, 1]);
+        for l in &w.layers {
+            let area: f64 = l.points.iter().map(|p| p.weight).sum();
+            assert!((area - std::f64::consts::PI * 6.25).abs() < 1e-9, "{area}");
+        }
+    }
+    for (l, u) in [(37, 91), (64, 118)] {
+        assert!(!mesh.pairs.iter().any(|p| p.lower == l || p.upper == u));
+    }
     // The first shell of A, counter-clockwise in (x, z).
     assert_eq!(mesh.shells[0].nodes, [0, 3, 4, 1]);
     assert_eq!(mesh.shells[0].thickness, 0.5);
@@ -132,13 +147,15 @@ fn multilayer_sheet_counts_match_the_paper() {
     let (_, mesh) = builtin("multilayer_sheet");
     assert_eq!(mesh.nodes.len(), 150 + 1);
     assert_eq!(mesh.shells.len(), 72);
-    assert_eq!(mesh.beams.len(), 6);
+    assert_eq!(mesh.beams.len(), 0);
+    assert_eq!(mesh.welds.len(), 3);
     assert_eq!(mesh.clamped.len(), 6);
     assert_eq!(mesh.tie.slaves.len(), 6);
-    assert_eq!(mesh.pairs.len(), 92);
+    // The paper's 92 pairs less the six at the weld centres (three welds, two interfaces).
+    assert_eq!(mesh.pairs.len(), 86);
     let joint = pair_nodes(&mesh);
-    assert_eq!(joint.len(), 138);
-    assert_eq!(6 * joint.len(), 828);
+    assert_eq!(joint.len(), 129);
+    assert_eq!(6 * joint.len(), 774);
     assert_eq!(independent_dofs(&mesh), 834);
 }
 
@@ -154,25 +171,25 @@ fn multilayer_sheet_numbering_and_coordinates() {
     assert_eq!(mesh.tie.master, 150);
     assert_eq!(mesh.clamped, vec![0, 1, 50, 51, 100, 101]);
     assert_eq!(mesh.tie.slaves, vec![48, 49, 98, 99, 148, 149]);
-    let beams: Vec<[usize; 2]> = mesh.beams.iter().map(|b| b.nodes).collect();
-    assert_eq!(
-        beams,
-        vec![
-            [12, 62],
-            [62, 112],
-            [25, 75],
-            [75, 125],
-            [36, 86],
-            [86, 136]
-        ]
-    );
+    // Three area welds through bottom, middle and top, each centred on a free edge (z = 0 or
+    // 25): half of each nugget lies inside the sheets.
+    assert_eq!(mesh.welds.len(), 3);
+    for w in &mesh.welds {
+        let sheets: Vec<usize> = w.layers.iter().map(|l| l.sheet).collect();
+        assert_eq!(sheets, vec![0, 1, 2]);
+        for l in &w.layers {
+            let area: f64 = l.points.iter().map(|p| p.weight).sum();
+            assert!((area - 0.5 * std::f64::consts::PI * 6.25).abs() < 1e-9, "{area}");
+            assert!(l.points.iter().all(|p| p.xz[1] >= 0.0 && p.xz[1] <= 25.0));
+        }
+    }
     assert_eq!(case.master_load(), [0.0, -50.0, 0.0, -2500.0, 0.0, 0.0]);
     assert_eq!(case.load.ramp.duration, 0.005);
     assert_eq!(case.end_time, 0.05);
-    // Interface by interface: bottom–middle first, then middle–top, 46 pairs each.
+    // Interface by interface: bottom–middle first, then middle–top, 43 pairs each.
     let sheet_of = |n: usize| n / 50;
     for (q, p) in mesh.pairs.iter().enumerate() {
-        let interface = q / 46;
+        let interface = q / 43;
         assert_eq!(
             (sheet_of(p.lower), sheet_of(p.upper)),
             (interface, interface + 1),
@@ -269,4 +286,19 @@ fn a_case_survives_a_json_round_trip() {
         );
         assert_eq!(Mesh::from_case(&again).expect("mesh"), mesh);
     }
+}
+
+#[test]
+fn point_welds_keep_the_papers_beams_and_pairs() {
+    let mut case = common::builtin_case("friction_bar");
+    for w in &mut case.welds {
+        w.model = jointrom::case::WeldModel::Point;
+    }
+    let mesh = Mesh::from_case(&case).unwrap();
+    assert!(mesh.welds.is_empty());
+    let beams: Vec<[usize; 2]> = mesh.beams.iter().map(|b| b.nodes).collect();
+    assert_eq!(beams, vec![[37, 91], [64, 118]]);
+    assert!(mesh.beams.iter().all(|b| b.diameter == 5.0));
+    assert_eq!(mesh.pairs.len(), 54);
+    assert_eq!(6 * pair_nodes(&mesh).len(), 648);
 }

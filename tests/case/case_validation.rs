@@ -417,22 +417,66 @@ fn the_structure_must_be_clamped() {
 }
 
 #[test]
-fn welds_must_sit_on_nodes() {
+fn point_welds_must_sit_on_nodes() {
+    let point = |c: &mut Value, w: usize| c["welds"][w]["model"] = json!("point");
     edited(
-        |c| c["welds"][0]["x"] = json!(61.0),
+        |c| {
+            point(c, 0);
+            c["welds"][0]["x"] = json!(61.0);
+        },
         "welds[0]",
         "not a node of sheet `A`",
     );
     // (20, 12.5) is a node of A only.
     edited(
-        |c| c["welds"][1]["x"] = json!(20.0),
+        |c| {
+            point(c, 1);
+            c["welds"][1]["x"] = json!(20.0);
+        },
         "welds[1]",
         "not a node of sheet `B`",
     );
     edited(
-        |c| c["welds"][0]["z"] = json!(10.0),
+        |c| {
+            point(c, 0);
+            c["welds"][0]["z"] = json!(10.0);
+        },
         "welds[0]",
         "not a node",
+    );
+    edited(
+        |c| c["welds"][0]["model"] = json!("spot"),
+        "welds[0].model",
+        "unknown variant",
+    );
+}
+
+#[test]
+fn area_welds_lie_anywhere_in_the_overlap_and_nowhere_else() {
+    // Off the nodes: accepted, and the mesh keeps every coincident pair outside the nuggets.
+    let mut case = friction_bar();
+    case["welds"][0]["x"] = json!(61.3);
+    case["welds"][0]["z"] = json!(10.1);
+    let mesh = Mesh::from_case(&validated(&case.to_string(), FILE).unwrap()).unwrap();
+    assert_eq!(mesh.welds.len(), 2);
+    assert_eq!(mesh.pairs.len(), 52 + 1);
+    // Outside sheet B (x < 40): outside the overlap.
+    edited(
+        |c| c["welds"][1]["x"] = json!(20.0),
+        "welds[1]",
+        "outside sheet `B`",
+    );
+    // Outside both sheets.
+    edited(
+        |c| c["welds"][0]["z"] = json!(-3.0),
+        "welds[0]",
+        "outside sheet `A`",
+    );
+    // An explicit joint point inside a nugget is welded, not a contact pair.
+    edited(
+        |c| c["joints"][0]["points"] = json!([[60.0, 12.5]]),
+        "joints[0].points[0]",
+        "inside the nugget of welds[0]",
     );
 }
 
@@ -525,11 +569,12 @@ fn overlapping_joint_sheets_must_coincide() {
     );
     let reason = validated(&case.to_string(), FILE).unwrap_err().to_string();
     assert!(reason.contains("`A`") && reason.contains("`B`"), "{reason}");
-    // Shifted across z by a quarter element.
+    // Shifted across z by a quarter element: the area welds still fit (they need no node), the
+    // joint does not.
     edited(
         |c| c["sheets"][1]["z"] = json!([3.125, 28.125]),
-        "welds[0]",
-        "not a node",
+        "joints[0]",
+        "do not coincide",
     );
     edited(
         |c| {
@@ -558,19 +603,19 @@ fn joints_must_be_between_two_distinct_sheets_once() {
 #[test]
 fn explicit_joint_points() {
     let mut case = friction_bar();
-    case["joints"][0]["points"] = json!([[105.0, 12.5], [60.0, 12.5], [60.0, 0.0]]);
+    case["joints"][0]["points"] = json!([[105.0, 0.0], [60.0, 25.0], [60.0, 0.0]]);
     let case = validated(&case.to_string(), FILE).expect("explicit points");
     let mesh = Mesh::from_case(&case).unwrap();
     let pairs: Vec<(usize, usize)> = mesh.pairs.iter().map(|p| (p.lower, p.upper)).collect();
     assert_eq!(
         pairs,
-        vec![(36, 90), (37, 91), (64, 118)],
+        vec![(36, 90), (38, 92), (63, 117)],
         "sorted by (x, z)"
     );
 
     // x = 10 is a node of A but outside B.
     edited(
-        |c| c["joints"][0]["points"] = json!([[60.0, 12.5], [10.0, 12.5]]),
+        |c| c["joints"][0]["points"] = json!([[60.0, 0.0], [10.0, 12.5]]),
         "joints[0].points[1]",
         "not a node of sheet `B`",
     );
@@ -580,7 +625,7 @@ fn explicit_joint_points() {
         "not a node",
     );
     edited(
-        |c| c["joints"][0]["points"] = json!([[60.0, 12.5], [60.0, 12.5]]),
+        |c| c["joints"][0]["points"] = json!([[60.0, 0.0], [60.0, 0.0]]),
         "joints[0].points[1]",
         "twice",
     );
@@ -597,7 +642,7 @@ fn explicit_joint_points_must_be_free() {
     edited(
         |c| {
             push(&mut c["clamps"], json!({"x": 40.0, "sheets": ["B"]}));
-            c["joints"][0]["points"] = json!([[60.0, 12.5], [40.0, 0.0]]);
+            c["joints"][0]["points"] = json!([[60.0, 0.0], [40.0, 0.0]]);
         },
         "joints[0].points[1]",
         "clamped (clamps[1])",
@@ -619,7 +664,7 @@ fn implicit_pairs_skip_clamped_and_tied_nodes() {
     push(&mut case["clamps"], json!({"x": 40.0, "sheets": ["B"]}));
     case["rigid_tie"] = json!({"x": 125.0, "sheets": ["A", "B"], "master": [125.0, 0.25, 12.5]});
     let mesh = Mesh::from_case(&validated(&case.to_string(), FILE).unwrap()).unwrap();
-    assert_eq!(mesh.pairs.len(), 54 - 6);
+    assert_eq!(mesh.pairs.len(), 52 - 6);
     // A joint whose every pair is clamped or tied is an error.
     let mut case = friction_bar();
     case["sheets"][1]["x"] = json!([120.0, 245.0]);

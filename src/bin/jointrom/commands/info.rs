@@ -28,10 +28,11 @@ pub fn run(a: InfoArgs) -> Result<(), Error> {
         println!("joint DOF       {}", model.joint_dofs());
         println!("nodes           {}", model.geometry.nodes.len());
         println!(
-            "elements        {} ({} Shell4, {} Beam2)",
-            model.geometry.cells.len(),
+            "elements        {} ({} Shell4, {} Beam2, {} Weld)",
+            v["elements"],
             cell_count(&model, true),
-            cell_count(&model, false)
+            cell_count(&model, false),
+            area_welds(&model)
         );
     }
     Ok(())
@@ -49,9 +50,10 @@ pub fn info_json(model: &Model) -> Value {
             jointrom::model::Origin::Matrices { .. } => "matrices",
         },
         "nodes": model.geometry.nodes.len(),
-        "elements": model.geometry.cells.len(),
+        "elements": model.geometry.cells.len() + area_welds(model),
         "shells": cell_count(model, true),
         "beams": cell_count(model, false),
+        "area_welds": area_welds(model),
         "clamped_nodes": model
             .dof_map
             .nodes
@@ -61,6 +63,11 @@ pub fn info_json(model: &Model) -> Value {
         "tied_nodes": model.geometry.followers.len(),
         "stiffness_nonzeros": model.stiffness.values.len(),
     })
+}
+
+/// Number of area welds (a generated case's `Weld` elements; none for a user's matrices).
+fn area_welds(model: &Model) -> usize {
+    model.mesh().map_or(0, |m| m.welds.len())
 }
 
 /// Number of 4-node (`quads`) or 2-node display cells.
