@@ -110,7 +110,9 @@ impl Weld {
         let beams = weld
             .layers
             .windows(2)
-            .map(|pair| Beam2::circular(centre(&pair[0]), centre(&pair[1]), weld.diameter, material))
+            .map(|pair| {
+                Beam2::circular(centre(&pair[0]), centre(&pair[1]), weld.diameter, material)
+            })
             .collect::<Result<Vec<_>, _>>()
             .map_err(|e| match e {
                 Error::Element(m) => Error::Element(format!("welds[{}]: {m}", weld.index)),
@@ -241,4 +243,3 @@ fn fit_row_block(r: [f64; 3]) -> [[f64; 6]; 3] {
         [0.0, 0.0, 1.0, r[1], -r[0], 0.0],
     ]
 }
-

@@ -5,8 +5,8 @@
 
 use std::collections::{HashMap, HashSet};
 
-use super::Material;
 use super::nugget;
+use super::Material;
 use super::{BeamElem, JointPair, Mesh, RigidTie, SheetGrid, ShellElem, WeldElem};
 use crate::case::validate::{check_contact_and_load, check_material, check_sheets, Ctx};
 use crate::case::{Case, ClampSpec, JointSpec, RigidTieSpec, WeldModel, WeldSpec, NODE_TOLERANCE};
@@ -498,7 +498,12 @@ impl Sheets<'_> {
     }
 
     /// The beams of a point weld: (x, z) must be a node of every sheet of the stack.
-    fn point_weld(&self, weld: &WeldSpec, p: &str, stack: &[usize]) -> Result<Vec<BeamElem>, Error> {
+    fn point_weld(
+        &self,
+        weld: &WeldSpec,
+        p: &str,
+        stack: &[usize],
+    ) -> Result<Vec<BeamElem>, Error> {
         let (grids, ctx) = (self.grids, self.ctx);
         let mut weld_nodes = Vec::with_capacity(stack.len());
         for &s in stack {
@@ -687,8 +692,7 @@ impl Nugget {
     fn welds(&self, lower: usize, upper: usize, xz: [f64; 2]) -> bool {
         self.sheets.contains(&lower)
             && self.sheets.contains(&upper)
-            && (xz[0] - self.centre[0]).hypot(xz[1] - self.centre[1])
-                < self.radius - NODE_TOLERANCE
+            && (xz[0] - self.centre[0]).hypot(xz[1] - self.centre[1]) < self.radius - NODE_TOLERANCE
     }
 }
 

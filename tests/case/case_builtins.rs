@@ -179,7 +179,10 @@ fn multilayer_sheet_numbering_and_coordinates() {
         assert_eq!(sheets, vec![0, 1, 2]);
         for l in &w.layers {
             let area: f64 = l.points.iter().map(|p| p.weight).sum();
-            assert!((area - 0.5 * std::f64::consts::PI * 6.25).abs() < 1e-9, "{area}");
+            assert!(
+                (area - 0.5 * std::f64::consts::PI * 6.25).abs() < 1e-9,
+                "{area}"
+            );
             assert!(l.points.iter().all(|p| p.xz[1] >= 0.0 && p.xz[1] <= 25.0));
         }
     }

@@ -1,0 +1,240 @@
+//! The area spot weld (`jointrom::element::Weld`): its interpolation constraint reproduces rigid
+//! and constant-strain motions wherever the nugget lies on the mesh (patch independence), it
+//! keeps the rigid-body modes, it is symmetric, it transmits every load between two coincident
+//! plates, and, unlike the point weld, it converges under mesh refinement.
+
+use faer::Mat;
+use jointrom::assembly::assemble_structure;
+use jointrom::case::Case;
+use jointrom::element::{Material, Weld};
+use jointrom::mesh::Mesh;
+use jointrom::{Interface, Model};
+use serde_json::json;
+
+/// Two coincident 60 × 60 × 0.5 mm plates (`n × n` shells each): A clamped at x = 0, B tied at
+/// x = 60 to the master at (60, 0.5, 30), joined only by one 5 mm weld at (x, z).
+fn plates(n: usize, weld: [f64; 2], model: &str) -> Case {
+    let text = json!({
+        "name": "plates",
+        "material": {"youngs_modulus": 210000.0, "poisson_ratio": 0.3, "density": 7.85e-9},
+        "sheets": [
+            {"name": "A", "x": [0.0, 60.0], "z": [0.0, 60.0], "y": 0.0, "thickness": 0.5, "elements": [n, n]},
+            {"name": "B", "x": [0.0, 60.0], "z": [0.0, 60.0], "y": 0.5, "thickness": 0.5, "elements": [n, n]}
+        ],
+        "clamps": [{"x": 0.0, "sheets": ["A"]}],
+        "rigid_tie": {"x": 60.0, "sheets": ["B"], "master": [60.0, 0.5, 30.0]},
+        "welds": [{"x": weld[0], "z": weld[1], "sheets": ["A", "B"], "diameter": 5.0, "model": model}],
+        "joints": [],
+        "contact": {"normal_stiffness": 1.0e4, "friction_coefficient": 0.25, "stick_stiffness": 1.0e4},
+        "load": {"master": {"fx": 1.0, "fy": -0.1, "fz": 0.5, "mx": -2.0, "my": 1.0, "mz": 1.0},
+                 "ramp": {"shape": "half_cosine", "duration": 0.05}},
+        "end_time": 0.1
+    });
+    Case::from_json_str(&text.to_string(), "plates.json").unwrap()
+}
+
+/// The node DOF vector of a field `f(x, y, z) → [u; θ]` over the weld's nodes.
+fn field(mesh: &Mesh, weld: &Weld, f: impl Fn([f64; 3]) -> [f64; 6]) -> Vec<f64> {
+    weld.nodes()
+        .iter()
+        .flat_map(|&n| f(mesh.nodes[n]))
+        .collect()
+}
+
+fn apply(t: &Mat<f64>, u: &[f64]) -> Vec<f64> {
+    (0..t.nrows())
+        .map(|i| (0..t.ncols()).map(|j| t[(i, j)] * u[j]).sum())
+        .collect()
+}
+
+/// A rigid motion `[a; ω]` about the point `c`: u = a + ω × (x − c), θ = ω.
+fn rigid(a: [f64; 3], w: [f64; 3], c: [f64; 3]) -> impl Fn([f64; 3]) -> [f64; 6] {
+    move |x| {
+        let r = [x[0] - c[0], x[1] - c[1], x[2] - c[2]];
+        [
+            a[0] + w[1] * r[2] - w[2] * r[1],
+            a[1] + w[2] * r[0] - w[0] * r[2],
+            a[2] + w[0] * r[1] - w[1] * r[0],
+            w[0],
+            w[1],
+            w[2],
+        ]
+    }
+}
+
+#[test]
+fn nugget_reproduces_rigid_and_uniform_motions_wherever_it_lies() {
+    // Node, mid-element, quarter points, and on the free edge z = 60 (half a nugget).
+    let placements = [
+        [30.0, 30.0],
+        [32.5, 32.5],
+        [31.25, 28.75],
+        [33.7, 31.1],
+        [30.0, 60.0],
+    ];
+    let mut membrane = Vec::new();
+    for xz in placements {
+        let case = plates(12, xz, "area");
+        let mesh = Mesh::from_case(&case).unwrap();
+        let weld = Weld::new(&mesh.welds[0], Material::STEEL).unwrap();
+        for (layer, y) in [(0, 0.0), (1, 0.5)] {
+            let c = [xz[0], y, xz[1]];
+            let t = weld.reference_map(layer);
+            // A rigid motion: the reference point follows it exactly.
+            let (a, w) = ([0.3, -0.2, 0.1], [0.01, -0.02, 0.03]);
+            let got = apply(t, &field(&mesh, &weld, rigid(a, w, [1.0, 2.0, 3.0])));
+            let want = rigid(a, w, [1.0, 2.0, 3.0])(c);
+            for k in 0..6 {
+                assert!(
+                    (got[k] - want[k]).abs() < 1e-12,
+                    "{xz:?} layer {layer} dof {k}: {} vs {}",
+                    got[k],
+                    want[k]
+                );
+            }
+        }
+        // A uniform membrane strain (ux = 1e-3 x, uz = −3e-4 z + 5e-4 x): the reference point
+        // of a full nugget moves with the field at its centre; the fit does not depend on the
+        // mesh under the nugget.
+        let t = weld.reference_map(0);
+        let strain = |x: [f64; 3]| [1e-3 * x[0], 0.0, -3e-4 * x[2] + 5e-4 * x[0], 0.0, 0.0, 0.0];
+        let got = apply(t, &field(&mesh, &weld, strain));
+        if xz[1] < 60.0 {
+            let want = strain([xz[0], 0.0, xz[1]]);
+            assert!((got[0] - want[0]).abs() < 1e-9 && (got[2] - want[2]).abs() < 1e-9);
+            // The in-plane rotation of the field's antisymmetric part, ½(∂ux/∂z − ∂uz/∂x).
+            membrane.push(got[4]);
+        }
+    }
+    for r in &membrane {
+        assert!((r - membrane[0]).abs() < 1e-3 * 2.5e-4, "{membrane:?}");
+    }
+    assert!((membrane[0] + 2.5e-4).abs() < 1e-2 * 2.5e-4, "{membrane:?}");
+}
+
+#[test]
+fn weld_stiffness_is_symmetric_and_free_of_rigid_work() {
+    let case = plates(12, [31.25, 28.75], "area");
+    let mesh = Mesh::from_case(&case).unwrap();
+    let weld = Weld::new(&mesh.welds[0], Material::STEEL).unwrap();
+    let k = weld.stiffness();
+    let scale = (0..k.nrows()).map(|i| k[(i, i)]).fold(0.0, f64::max);
+    for i in 0..k.nrows() {
+        for j in 0..i {
+            assert_eq!(k[(i, j)], k[(j, i)]);
+        }
+    }
+    for (a, w) in [
+        ([1.0, 0.0, 0.0], [0.0; 3]),
+        ([0.0; 3], [0.0, 0.02, 0.0]),
+        ([0.0, 0.5, 0.0], [0.03, 0.0, -0.01]),
+    ] {
+        let u = field(&mesh, &weld, rigid(a, w, [0.0; 3]));
+        let f = apply(&k, &u);
+        let fmax = f.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let umax = u.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        assert!(
+            fmax < 1e-9 * scale * umax,
+            "rigid motion loads the weld: {fmax}"
+        );
+    }
+    // The whole free structure keeps exactly six zero-energy modes.
+    let mut mesh = mesh;
+    mesh.clamped.clear();
+    let s = assemble_structure(&mesh).unwrap();
+    let eig = s
+        .stiffness
+        .to_dense()
+        .self_adjoint_eigenvalues(faer::Side::Lower)
+        .unwrap();
+    let largest = eig[eig.len() - 1];
+    let zero = eig.iter().filter(|&&l| l.abs() <= 1e-10 * largest).count();
+    assert_eq!(zero, 6, "smallest eigenvalues {:?}", &eig[..8]);
+}
+
+#[test]
+fn mirrored_welds_give_mirrored_structures() {
+    // The plates and their mesh are symmetric about z = 30; welds at z = 30 ∓ 1.25 are mirror
+    // images, so the frequencies agree and the statics mirror.
+    let lo = Model::from_case(plates(12, [31.0, 28.75], "area")).unwrap();
+    let hi = Model::from_case(plates(12, [31.0, 31.25], "area")).unwrap();
+    let (fl, fh) = (
+        lo.modes(6, Interface::Free).unwrap().frequencies_hz,
+        hi.modes(6, Interface::Free).unwrap().frequencies_hz,
+    );
+    for (a, b) in fl.iter().zip(&fh) {
+        assert!((a - b).abs() < 1e-8 * a, "{fl:?} vs {fh:?}");
+    }
+    let load = [0.0, -0.1, 0.0, 0.0, 0.0, 1.0];
+    let (ul, uh) = (
+        lo.static_linear(&[load]).unwrap()[0].master_displacement,
+        hi.static_linear(&[load]).unwrap()[0].master_displacement,
+    );
+    // Fy and Mz are symmetric about z = 30: ux, uy, rz equal; uz, rx, ry change sign.
+    for (k, sign) in [
+        (0, 1.0),
+        (1, 1.0),
+        (2, -1.0),
+        (3, -1.0),
+        (4, -1.0),
+        (5, 1.0),
+    ] {
+        assert!(
+            (ul[k] - sign * uh[k]).abs() < 1e-8 * ul[1].abs(),
+            "dof {k}: {ul:?} vs {uh:?}"
+        );
+    }
+}
+
+#[test]
+fn one_weld_between_coincident_plates_carries_every_load() {
+    // Membrane shear (Fx, Fz), bending (Fy, Mz), torsion (Mx) and in-plane twist (My) all pass
+    // from B through the single nugget to A: K is positive definite and each load does work
+    // equal to twice the strain energy.
+    let model = Model::from_case(plates(12, [30.0, 30.0], "area")).unwrap();
+    let loads: Vec<[f64; 6]> = (0..6)
+        .map(|k| {
+            let mut l = [0.0; 6];
+            l[k] = if k < 3 { 1.0 } else { 10.0 };
+            l
+        })
+        .collect();
+    let sols = model.static_linear(&loads).unwrap();
+    for (k, sol) in sols.iter().enumerate() {
+        let u = &sol.displacement;
+        assert!(u.iter().all(|v| v.is_finite()));
+        let mut ku = vec![0.0; u.len()];
+        model.stiffness.mul_vec(u, &mut ku);
+        let two_u: f64 = ku.iter().zip(u).map(|(a, b)| a * b).sum();
+        let work = loads[k][k] * sol.master_displacement[k];
+        assert!(
+            work > 0.0 && (two_u - work).abs() <= 1e-8 * work,
+            "load {k}: {two_u} vs {work}"
+        );
+    }
+}
+
+/// Static master deflection uy (mm) of the plates under the case's load, meshed `n × n`.
+fn deflection(n: usize, model: &str) -> f64 {
+    let m = Model::from_case(plates(n, [30.0, 30.0], model)).unwrap();
+    m.static_linear(&[m.master_load()]).unwrap()[0].master_displacement[1]
+}
+
+#[test]
+fn the_area_weld_converges_where_the_point_weld_drifts() {
+    let area: Vec<f64> = [6, 12, 24, 48].map(|n| deflection(n, "area")).to_vec();
+    let point: Vec<f64> = [6, 12, 24, 48].map(|n| deflection(n, "point")).to_vec();
+    let steps =
+        |v: &[f64]| -> Vec<f64> { v.windows(2).map(|w| (w[1] / w[0] - 1.0).abs()).collect() };
+    let (sa, sp) = (steps(&area), steps(&point));
+    // Measured: area 4.6 %, 3.1 %, 1.5 % (about halving, first order in h); point 7.0 %, 7.6 %,
+    // 9.5 % (growing: its local flexibility grows without bound as the mesh resolves the load).
+    assert!(
+        sa.windows(2).all(|w| w[1] < 0.75 * w[0]) && sa[2] < 0.02,
+        "area {area:?}: {sa:?}"
+    );
+    assert!(
+        sp.windows(2).all(|w| w[1] > w[0]) && sp[2] > 0.05,
+        "point {point:?}: {sp:?}"
+    );
+}
