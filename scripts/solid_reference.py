@@ -35,6 +35,7 @@ Solver: scikit-sparse CHOLMOD if importable, else scipy SuperLU (symmetric mode)
 """
 
 import argparse
+import gc
 import json
 import math
 import resource
@@ -201,28 +202,59 @@ def geometric01(n, ratio):
     return b / b[-1]
 
 
-def strip_block(x0, x1, nx, z0, z1, nz):
-    xs = lattice1d(np.linspace(x0, x1, nx + 1))
-    zs = lattice1d(np.linspace(z0, z1, nz + 1))
+def graded(L, h0, hmid, h1, q):
+    """Element boundaries on [0, L]: sizes start at h0, grow geometrically (ratio q)
+    to hmid, and shrink again to h1 at the far end; the count is chosen so that
+    the sum is closest to L and the sizes are then scaled to fit exactly."""
+    if h0 >= hmid and h1 >= hmid:
+        n = max(1, int(round(L / hmid)))
+        return np.linspace(0.0, L, n + 1)
+    best = None
+    for n in range(1, 100000):
+        i = np.arange(n)
+        sz = np.minimum(np.minimum(h0 * q ** i, h1 * q ** (n - 1 - i)), hmid)
+        tot = sz.sum()
+        if best is None or abs(tot - L) < abs(best[1] - L):
+            best = (sz, tot)
+        if tot > L:
+            break
+    sz = best[0] * (L / best[1])
+    return np.concatenate([[0.0], np.cumsum(sz)])
+
+
+def strip_block(xbreaks, zbreaks):
+    xs = lattice1d(xbreaks)
+    zs = lattice1d(zbreaks)
     P = np.stack(np.meshgrid(xs, zs, indexing='ij'), axis=-1)
     return P
 
 
-def ogrid_blocks(cx, cz, W, r, n, a_ratio=0.5):
+def ogrid_blocks(cx, cz, W, r, side01, a_ratio=0.5, grading=None):
     """O-grid of the box [cx-W,cx+W] x [cz-W,cz+W] around a circle of radius r.
+    side01: element boundaries (in [0,1]) along each box side (n = len - 1 elements);
+    grading: None (outer ring geometric from the circle size to the box size) or
+    (h_mid, h_edge, q) for a ring graded fine at the circle and at the box.
     Returns list of (P, bonded, kind) and a parameter dict."""
+    n = len(side01) - 1
     a = a_ratio * r
     hc = (0.5 * math.pi * r) / n          # tangential size on the circle
-    hb = 2.0 * W / n                      # tangential size on the box
+    hb = 2.0 * W / n                      # mean tangential size on the box
     L = W - r
-    if L > hb:
-        q = (L - hc) / (L - hb)
-        n2 = max(1, int(round(1 + math.log(hb / hc) / math.log(q))))
+    if grading is None:
+        if L > hb:
+            q = (L - hc) / (L - hb)
+            n2 = max(1, int(round(1 + math.log(hb / hc) / math.log(q))))
+        else:
+            n2 = max(1, int(round(L / hc)))
+        t_out = lattice1d(geometric01(n2, hb / hc))
     else:
-        n2 = max(1, int(round(L / hc)))
+        hmid, hedge, qg = grading
+        tb = graded(L, hc, hmid, hedge, qg) / L
+        n2 = len(tb) - 1
+        t_out = lattice1d(tb)
     n1 = max(1, int(round((r - a) / (0.5 * (hc + 2 * a / n)))))
     s_lat = lattice1d(np.linspace(0.0, 1.0, n + 1))
-    t_out = lattice1d(geometric01(n2, hb / hc))
+    s_side = lattice1d(np.asarray(side01, float))
     t_in = lattice1d(np.linspace(0.0, 1.0, n1 + 1))
     c = np.array([cx, cz])
     blocks = []
@@ -235,9 +267,12 @@ def ogrid_blocks(cx, cz, W, r, n, a_ratio=0.5):
         def sq(A):
             C0 = c + A * math.sqrt(2.0) * np.array([math.cos(th0), math.sin(th0)])
             C1 = c + A * math.sqrt(2.0) * np.array([math.cos(th1), math.sin(th1)])
-            return C0[None, :] + s_lat[:, None] * (C1 - C0)[None, :]
+            return C0[None, :] + sl[:, None] * (C1 - C0)[None, :]
 
-        sqW, sqa = sq(W), sq(a)
+        sl = s_side
+        sqW = sq(W)
+        sl = s_lat
+        sqa = sq(a)
         Pout = (1 - t_out)[None, :, None] * circ[:, None, :] + t_out[None, :, None] * sqW[:, None, :]
         Pin = (1 - t_in)[None, :, None] * sqa[:, None, :] + t_in[None, :, None] * circ[:, None, :]
         blocks.append((Pout, False, 'weld_outer_ring'))
@@ -247,14 +282,17 @@ def ogrid_blocks(cx, cz, W, r, n, a_ratio=0.5):
     blocks.append((Pc, True, 'weld_core'))
     info = dict(box_half_width=W, radius=r, core_half_width=a, n_tangential_per_side=n,
                 n_radial_inner=n1, n_radial_outer=n2, outer_grading_ratio=hb / hc,
-                circle_arcs=4 * n)
+                circle_arcs=4 * n, outer_ring_sizes_t=np.diff(t_out[0::2]).round(5).tolist())
     return blocks, info
 
 
-def build_2d(case, nz):
+def build_2d(case, nz, grade=1.0, q=1.4):
     h = WIDTH / nz
+    he = h / grade
     blocks = []
-    info = {'nz': nz, 'h_nominal': h}
+    info = {'nz': nz, 'h_nominal': h, 'edge_grading': dict(h_edge=he, ratio=q) if grade > 1 else None}
+    zb = graded(WIDTH, he, h, he, q)
+    info['n_across_width'] = len(zb) - 1
     if case == 'friction_bar':
         W = 0.5 * WIDTH
         boxes = [(wx - W, wx + W, wx) for wx in WELDS_X]
@@ -266,18 +304,19 @@ def build_2d(case, nz):
         for x0, x1 in zip(xb[:-1], xb[1:]):
             box = [b for b in boxes if abs(b[0] - x0) < 1e-12]
             if box:
-                bl, oinfo = ogrid_blocks(box[0][2], WELD_Z, W, WELD_R, nz)
+                bl, oinfo = ogrid_blocks(box[0][2], WELD_Z, W, WELD_R, zb / WIDTH,
+                                         grading=(h, he, q) if grade > 1 else None)
                 blocks += bl
                 info['ogrid'] = oinfo
             else:
-                nx = max(1, int(round((x1 - x0) / h)))
-                blocks.append((strip_block(x0, x1, nx, 0.0, WIDTH, nz), False, 'strip'))
-                strips.append([x0, x1, nx])
+                xbr = x0 + graded(x1 - x0, he, h, he, q)
+                blocks.append((strip_block(xbr, zb), False, 'strip'))
+                strips.append([x0, x1, len(xbr) - 1])
         info['strips'] = strips
     elif case == 'strip':
-        nx = max(1, int(round(165.0 / h)))
-        blocks.append((strip_block(0.0, 165.0, nx, 0.0, WIDTH, nz), False, 'strip'))
-        info['strips'] = [[0.0, 165.0, nx]]
+        xbr = graded(165.0, he, h, he, q)
+        blocks.append((strip_block(xbr, zb), False, 'strip'))
+        info['strips'] = [[0.0, 165.0, len(xbr) - 1]]
     else:
         raise ValueError(case)
 
@@ -337,8 +376,8 @@ def area_2d(P2, E2, mask):
 # 3-D mesh (extrusion through each sheet's thickness)
 # ----------------------------------------------------------------------------
 
-def build_3d(case, nz, nt, nnode, welds='area'):
-    P2, E2, bonded_el, kinds, info = build_2d(case, nz)
+def build_3d(case, nz, nt, nnode, welds='area', grade=1.0):
+    P2, E2, bonded_el, kinds, info = build_2d(case, nz, grade)
     NP = len(P2)
     L = 2 * nt + 1
     el = HexElement(nnode)
@@ -472,6 +511,9 @@ def rigid_modes(X, center=np.zeros(3)):
 # ----------------------------------------------------------------------------
 
 class Factor:
+    """Sparse symmetric positive-definite factorisation (CHOLMOD if available, else
+    SuperLU in symmetric mode).  No self-referencing closures, so 'del' frees it."""
+
     def __init__(self, A):
         A = A.tocsc()
         self.n = A.shape[0]
@@ -479,16 +521,16 @@ class Factor:
             from sksparse.cholmod import cholesky
             self.F = cholesky(A)
             self.kind = 'cholmod'
-            self.solve = lambda b: self.F(b)
         except ImportError:
-            lu = spla.splu(A, permc_spec='MMD_AT_PLUS_A', diag_pivot_thresh=0.0,
-                           options=dict(SymmetricMode=True))
-            self.F = lu
+            self.F = spla.splu(A, permc_spec='MMD_AT_PLUS_A', diag_pivot_thresh=0.0,
+                               options=dict(SymmetricMode=True))
             self.kind = 'superlu'
-            self.solve = lambda b: lu.solve(b)
+
+    def solve(self, b):
+        return self.F(b) if self.kind == 'cholmod' else self.F.solve(b)
 
     def op(self):
-        return spla.LinearOperator((self.n, self.n), matvec=lambda v: self.solve(v), dtype=float)
+        return spla.LinearOperator((self.n, self.n), matvec=self.solve, dtype=float)
 
 
 def lowest_modes(K, M, k, fac):
@@ -540,12 +582,12 @@ def mirror_map(X):
 # one refinement level
 # ----------------------------------------------------------------------------
 
-def run_level(case, refine, nt, nnode, welds, nmodes):
+def run_level(case, refine, nt, nnode, welds, nmodes, grade=1.0):
     nz = 4 * (refine + 1)
     t_start = time.time()
     res = {'refine': refine}
     log(f"level {refine}: nz={nz} nt={nt} hex{nnode} case={case} welds={welds}")
-    el, X, conn, esheet, s_n, info = build_3d(case, nz, nt, nnode, welds)
+    el, X, conn, esheet, s_n, info = build_3d(case, nz, nt, nnode, welds, grade)
     res['mesh'] = info
     log(f"  mesh: {info['n_elements']} elements, {info['n_nodes']} nodes, {info['n_dof']} dof; "
         f"2-D elements {info['n_2d_elements_by_kind']}")
@@ -653,6 +695,7 @@ def run_level(case, refine, nt, nnode, welds, nmodes):
     log(f"  fixed-interface eigen {t_eig:.1f} s; f = " + ", ".join(f"{f:.3f}" for f in f_fi))
     log("    labels: " + ", ".join(l_[0] for l_ in labels))
     del fac, Kf, Mf, vec
+    gc.collect()
     timings = dict(assembly_s=t_asm, factor_fixed_s=t_fac, eig_fixed_s=t_eig)
 
     if master_free:
@@ -705,6 +748,7 @@ def run_level(case, refine, nt, nnode, welds, nmodes):
         timings.update(factor_master_free_s=t_fac2, eig_master_free_s=t_eig2)
         del fac
     del Kr, Mr
+    gc.collect()
     res['solver'] = 'cholmod' if _have_cholmod() else 'superlu'
     res['checks'] = checks
     timings['total_s'] = time.time() - t_start
@@ -761,6 +805,9 @@ def main():
     ap.add_argument('--nt', default='2',
                     help='elements through each sheet thickness; one value or a comma list matching --refine')
     ap.add_argument('--elem', type=int, choices=[20, 27], default=20)
+    ap.add_argument('--grade', type=float, default=1.0,
+                    help='edge grading: element size at free/clamped/tied edges and box sides = '
+                         '(25/nz)/grade, growth ratio 1.4 (1 = uniform strips)')
     ap.add_argument('--modes', type=int, default=None)
     ap.add_argument('--out', required=True)
     args = ap.parse_args()
@@ -771,7 +818,7 @@ def main():
     if len(nts) != len(levels):
         ap.error('--nt must be one value or as many values as --refine')
     nmodes = args.modes or (10 if args.case == 'friction_bar' else 6)
-    out = dict(case=args.case, welds=args.welds, element=f'hex{args.elem}',
+    out = dict(case=args.case, welds=args.welds, element=f'hex{args.elem}', grade=args.grade,
                integration='3x3x3 Gauss', mass='consistent',
                material=dict(E=E_MOD, nu=NU, rho=RHO),
                units='mm, N, t, s; frequencies in Hz; rotations in rad',
@@ -787,7 +834,7 @@ def main():
         out['geometry'] = dict(strip=dict(x=[0, 165], z=[0, 25], y=[-0.25, 0.25]),
                                clamp='faces x=0 and x=165, all translations')
     for N, nt in zip(levels, nts):
-        out['levels'].append(run_level(args.case, N, nt, args.elem, args.welds, nmodes))
+        out['levels'].append(run_level(args.case, N, nt, args.elem, args.welds, nmodes, args.grade))
         with open(args.out, 'w') as fh:
             json.dump(out, fh, indent=1)
     # differences between successive levels and an extrapolated estimate

@@ -553,9 +553,20 @@ impl Sheets<'_> {
             }
         }
         let clip = Rect::common(stack.iter().map(|&s| &grids[s]));
+        let inside = |p: [f64; 2]| clip.contains(p);
         let layers = stack
             .iter()
-            .map(|&s| nugget::sample(centre, weld.diameter, &clip, s, &grids[s]))
+            .map(|&s| {
+                let g = &grids[s];
+                let interpolation = |p: [f64; 2]| g.interpolation(p);
+                let view = nugget::SheetView {
+                    sheet: s,
+                    y: g.y,
+                    h: g.step[0].min(g.step[1]),
+                    interpolation: &interpolation,
+                };
+                nugget::sample(centre, weld.diameter, &inside, &view)
+            })
             .collect();
         Ok(WeldElem {
             index: w,

@@ -21,7 +21,6 @@
 //! at the point is `u(p) = Σ_a N_a(p) u_a` (likewise the rotations), whether or not a node lies
 //! inside the disc — which makes the weld's footprint the nugget's and not the mesh's.
 
-use super::build::{Grid, Rect};
 use super::{NuggetLayer, NuggetPoint};
 
 /// Least number of annuli of the sampling rule.
@@ -29,17 +28,29 @@ pub(crate) const RINGS: usize = 6;
 /// Least number of sectors per annulus (a multiple of four).
 pub(crate) const SECTORS: usize = 24;
 
-/// The sampling points of the disc (centre, diameter) clipped to `clip`, on the sheet `grid`
-/// (index `sheet`). Points on the clip boundary count as inside.
+/// The shell containing a point, the bilinear shape functions of its nodes there and their
+/// derivatives `[∂N/∂x, ∂N/∂z]` (1/mm).
+pub(super) type Interpolation = ([usize; 4], [f64; 4], [[f64; 2]; 4]);
+
+/// How a sheet is seen by the sampling: its index, mid-surface height (mm), smaller element size
+/// (mm), and the shell and shape functions at a point (x, z) (mm).
+pub(super) struct SheetView<'a> {
+    pub(super) sheet: usize,
+    pub(super) y: f64,
+    pub(super) h: f64,
+    pub(super) interpolation: &'a dyn Fn([f64; 2]) -> Interpolation,
+}
+
+/// The sampling points of the disc (centre, diameter) kept by `inside` (the clip rectangle,
+/// boundary included), on the sheet `view`.
 pub(super) fn sample(
     centre: [f64; 2],
     diameter: f64,
-    clip: &Rect,
-    sheet: usize,
-    grid: &Grid,
+    inside: &dyn Fn([f64; 2]) -> bool,
+    view: &SheetView,
 ) -> NuggetLayer {
     let radius = 0.5 * diameter;
-    let h = grid.step[0].min(grid.step[1]);
+    let h = view.h;
     let rings = RINGS.max((2.0 * radius / h).ceil() as usize);
     let sectors = 4 * (SECTORS / 4).max((std::f64::consts::PI * radius / h).ceil() as usize);
     let weight = std::f64::consts::PI * radius * radius / (rings * sectors) as f64;
@@ -49,10 +60,10 @@ pub(super) fn sample(
         for m in 0..sectors {
             let angle = std::f64::consts::TAU * (m as f64 + 0.5) / sectors as f64;
             let xz = [centre[0] + r * angle.cos(), centre[1] + r * angle.sin()];
-            if !clip.contains(xz) {
+            if !inside(xz) {
                 continue;
             }
-            let (nodes, shape, gradient) = grid.interpolation(xz);
+            let (nodes, shape, gradient) = (view.interpolation)(xz);
             points.push(NuggetPoint {
                 xz,
                 weight,
@@ -63,8 +74,8 @@ pub(super) fn sample(
         }
     }
     NuggetLayer {
-        sheet,
-        y: grid.y,
+        sheet: view.sheet,
+        y: view.y,
         points,
     }
 }

@@ -132,13 +132,17 @@ fn full_model_short_window_reproduces_the_stored_reference() {
 fn rom_against_full_reference_friction_off() {
     let r = reference("friction_bar_full_friction_off");
     let (_, fc0, uy0, _) = rom_errors(false, Some(0), &r);
-    assert!(fc0 > 5.0 && uy0 > 0.2, "g = 0: {fc0} {uy0}");
+    // Measured 21.4 / 0.152 (area welds; 32.7 / 0.385 with point welds).
+    assert!(fc0 > 5.0 && uy0 > 0.1, "g = 0: {fc0} {uy0}");
     let (g, fc, uy, _) = rom_errors(false, None, &r);
+    eprintln!("friction off: g = 0 {fc0} {uy0}; chosen g = {g}: {fc} {uy}");
     assert!(g > 0 && g < 48);
-    // Measured 0.233 / 3.7e-3: the 2 % holds for uy, not for ‖f_c‖.
+    // Measured 0.044 / 3.1e-4 at the chosen g = 18 (area welds; the point-weld model chose
+    // g = 12 and was 0.233 / 3.7e-3 off).
     assert!(fc < 0.3 && uy < 0.01, "chosen g = {g}: {fc} {uy}");
     let (_, fc48, uy48, _) = rom_errors(false, Some(48), &r);
-    // Measured 0.0133 / 1e-5.
+    eprintln!("g = 48: {fc48} {uy48}");
+    // Measured 0.0011 / 4.4e-6 (point welds: 0.0133 / 1e-5).
     assert!(fc48 < 0.02 && uy48 < 1e-3, "g = 48: {fc48} {uy48}");
 }
 

@@ -96,10 +96,14 @@ fn static_basis_json_contract() {
     );
     assert!(red["pairs_in_contact"].as_u64().unwrap() > 0);
 
-    // modes: g extra modes; --scale reverses the load.
+    // modes: g extra modes; --scale reverses the load. On the point-weld friction bar (where it
+    // was measured; with area welds this case converges) the active-set method cycles and the
+    // CLI restarts with the damped one.
+    let point = common::point_weld_case_file("friction_bar");
+    let full = jointrom_json(["static", point.as_str(), "--json"]);
     let m = jointrom_json([
         "static",
-        "friction_bar",
+        point.as_str(),
         "--basis",
         "modes",
         "--g",
