@@ -286,37 +286,72 @@ def ogrid_blocks(cx, cz, W, r, side01, a_ratio=0.5, grading=None):
     return blocks, info
 
 
-def build_2d(case, nz, grade=1.0, q=1.4):
+def build_2d(case, nz, grade=1.0, q=1.4, box_half=None):
+    """Multi-block quadratic lattice of the mid-plane.
+
+    grade = 1: uniform strips; each weld in a full-width 25 x 25 O-grid box whose
+      sides have nz elements.
+    grade > 1: element size (25/nz)/grade at all physical edges (free edges z = 0, 25,
+      sheet ends x = 40, 125, clamp x = 0, tie x = 165), growing by ratio q to 25/nz
+      inside (resolves the 3-D edge boundary layers of width ~ t); each weld in an
+      O-grid box of half-width box_half (default 6.25) with nz elements per side,
+      embedded in a tensor-product grid of graded strips."""
     h = WIDTH / nz
     he = h / grade
     blocks = []
-    info = {'nz': nz, 'h_nominal': h, 'edge_grading': dict(h_edge=he, ratio=q) if grade > 1 else None}
-    zb = graded(WIDTH, he, h, he, q)
-    info['n_across_width'] = len(zb) - 1
+    info = {'nz': nz, 'h_nominal': h,
+            'edge_grading': dict(h_edge=he, ratio=q) if grade > 1 else None}
     if case == 'friction_bar':
-        W = 0.5 * WIDTH
-        boxes = [(wx - W, wx + W, wx) for wx in WELDS_X]
+        Wb = box_half if box_half is not None else (0.5 * WIDTH if grade <= 1 else 6.25)
+        full = Wb >= 0.5 * WIDTH - 1e-9
+        if full:
+            Wb = 0.5 * WIDTH
+            zb = graded(WIDTH, he, h, he, q)
+            box_side = zb / WIDTH
+            zints = [zb]
+            hbx = h
+            ograding = (h, he, q) if grade > 1 else None
+        else:
+            nb = nz
+            hbx = 2 * Wb / nb
+            box_side = np.linspace(0.0, 1.0, nb + 1)
+            z1, z2 = WELD_Z - Wb, WELD_Z + Wb
+            zints = [graded(z1, he, h, hbx, q), z1 + 2 * Wb * box_side,
+                     z2 + graded(WIDTH - z2, hbx, h, he, q)]
+            ograding = (hbx, hbx, q)
+        info['box_half_width'] = Wb
+        info['n_across_width'] = int(sum(len(z) - 1 for z in zints))
+        boxes = [(wx - Wb, wx + Wb, wx) for wx in WELDS_X]
         xb = [0.0, 40.0]
-        for b in boxes:
-            xb += [b[0], b[1]]
+        for bx in boxes:
+            xb += [bx[0], bx[1]]
         xb += [125.0, 165.0]
+        physical = (0.0, 40.0, 125.0, 165.0)
         strips = []
         for x0, x1 in zip(xb[:-1], xb[1:]):
-            box = [b for b in boxes if abs(b[0] - x0) < 1e-12]
+            box = [bx for bx in boxes if abs(bx[0] - x0) < 1e-12]
             if box:
-                bl, oinfo = ogrid_blocks(box[0][2], WELD_Z, W, WELD_R, zb / WIDTH,
-                                         grading=(h, he, q) if grade > 1 else None)
-                blocks += bl
-                info['ogrid'] = oinfo
+                xd = x0 + 2 * Wb * box_side
             else:
-                xbr = x0 + graded(x1 - x0, he, h, he, q)
-                blocks.append((strip_block(xbr, zb), False, 'strip'))
-                strips.append([x0, x1, len(xbr) - 1])
-        info['strips'] = strips
+                h0 = he if any(abs(x0 - p) < 1e-9 for p in physical) else (hbx if grade > 1 else h)
+                h1 = he if any(abs(x1 - p) < 1e-9 for p in physical) else (hbx if grade > 1 else h)
+                xd = x0 + graded(x1 - x0, h0, h, h1, q)
+                strips.append([x0, x1, len(xd) - 1])
+            for iz, zd in enumerate(zints):
+                if box and (full or iz == 1):
+                    bl, oinfo = ogrid_blocks(box[0][2], WELD_Z, Wb, WELD_R, box_side,
+                                             grading=ograding)
+                    blocks += bl
+                    info['ogrid'] = oinfo
+                else:
+                    blocks.append((strip_block(xd, zd), False, 'strip'))
+        info['strips_x_elements'] = strips
     elif case == 'strip':
+        zb = graded(WIDTH, he, h, he, q)
         xbr = graded(165.0, he, h, he, q)
         blocks.append((strip_block(xbr, zb), False, 'strip'))
-        info['strips'] = [[0.0, 165.0, len(xbr) - 1]]
+        info['strips_x_elements'] = [[0.0, 165.0, len(xbr) - 1]]
+        info['n_across_width'] = len(zb) - 1
     else:
         raise ValueError(case)
 
