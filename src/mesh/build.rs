@@ -777,7 +777,7 @@ impl Grid<'_> {
     /// The shell containing the point `p` = (x, z) of the sheet (the last one along an axis for a
     /// point on the sheet's far edge) and the bilinear shape functions of its nodes at `p`, in
     /// [`ShellElem`] node order.
-    pub(super) fn interpolation(&self, p: [f64; 2]) -> ([usize; 4], [f64; 4], [[f64; 2]; 4]) {
+    pub(super) fn interpolation(&self, p: [f64; 2]) -> ([usize; 4], [f64; 4]) {
         let mut cell = [0usize; 2];
         let mut local = [0.0; 2];
         for a in 0..2 {
@@ -787,7 +787,6 @@ impl Grid<'_> {
         }
         let [i, k] = cell;
         let [xi, eta] = local;
-        let [hx, hz] = self.step;
         (
             [
                 self.index(i, k),
@@ -800,12 +799,6 @@ impl Grid<'_> {
                 xi * (1.0 - eta),
                 xi * eta,
                 (1.0 - xi) * eta,
-            ],
-            [
-                [-(1.0 - eta) / hx, -(1.0 - xi) / hz],
-                [(1.0 - eta) / hx, -xi / hz],
-                [eta / hx, xi / hz],
-                [-eta / hx, (1.0 - xi) / hz],
             ],
         )
     }

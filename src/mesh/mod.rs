@@ -68,8 +68,6 @@ pub struct NuggetPoint {
     pub nodes: [usize; 4],
     /// The bilinear shape functions of those nodes at the point (they sum to 1).
     pub shape: [f64; 4],
-    /// Their derivatives `[∂N/∂x, ∂N/∂z]` at the point, 1/mm.
-    pub gradient: [[f64; 2]; 4],
 }
 
 /// Rigid-body tie (NASTRAN RBE2, all 6 DOF): every slave node moves as

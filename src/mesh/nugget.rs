@@ -17,7 +17,7 @@
 //! loads, and the weld would lose its mesh convergence again.
 //!
 //! Each point is located in the shell of its sheet that contains it and carries the bilinear
-//! shape functions of that shell's nodes there and their derivatives: the sheet's displacement
+//! shape functions of that shell's nodes there: the sheet's displacement
 //! at the point is `u(p) = Σ_a N_a(p) u_a` (likewise the rotations), whether or not a node lies
 //! inside the disc — which makes the weld's footprint the nugget's and not the mesh's.
 
@@ -28,9 +28,8 @@ pub(crate) const RINGS: usize = 6;
 /// Least number of sectors per annulus (a multiple of four).
 pub(crate) const SECTORS: usize = 24;
 
-/// The shell containing a point, the bilinear shape functions of its nodes there and their
-/// derivatives `[∂N/∂x, ∂N/∂z]` (1/mm).
-pub(super) type Interpolation = ([usize; 4], [f64; 4], [[f64; 2]; 4]);
+/// The shell containing a point and the bilinear shape functions of its nodes there.
+pub(super) type Interpolation = ([usize; 4], [f64; 4]);
 
 /// How a sheet is seen by the sampling: its index, mid-surface height (mm), smaller element size
 /// (mm), and the shell and shape functions at a point (x, z) (mm).
@@ -63,13 +62,12 @@ pub(super) fn sample(
             if !inside(xz) {
                 continue;
             }
-            let (nodes, shape, gradient) = (view.interpolation)(xz);
+            let (nodes, shape) = (view.interpolation)(xz);
             points.push(NuggetPoint {
                 xz,
                 weight,
                 nodes,
                 shape,
-                gradient,
             });
         }
     }
