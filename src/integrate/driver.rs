@@ -38,6 +38,11 @@ pub struct TransientOptions {
     /// right-hand side; running out ends the run as [`RunStatus::Budget`].
     #[serde(skip)]
     pub budget_s: Option<f64>,
+    /// Keep the coordinates, pair forces and slip memory at every output in
+    /// [`Run::trajectory`] (for the a-posteriori error estimate of a reduced run,
+    /// [`crate::reduction::estimate`]); `false` by default.
+    #[serde(skip)]
+    pub record: bool,
 }
 
 impl Default for TransientOptions {
@@ -51,6 +56,7 @@ impl Default for TransientOptions {
             output_step: 1e-4,
             end_time: None,
             budget_s: None,
+            record: false,
         }
     }
 }
@@ -99,6 +105,27 @@ impl Curves {
                     - self.external_work[i]
             })
             .collect()
+    }
+}
+
+/// The states of a run at its output times ([`TransientOptions::record`]), each block stored
+/// output after output.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Trajectory {
+    /// Coordinates per output (n or r values each): mm, rad or generalized coordinates.
+    pub q: Vec<f64>,
+    /// Pair forces per output (3w each: normal, t1, t2 per pair), N.
+    pub p: Vec<f64>,
+    /// Slip memory per output (2w each with friction, else none), mm.
+    pub s: Vec<f64>,
+}
+
+impl Trajectory {
+    /// Appends one output: `q` and the forces and slip memory of the problem's last sample.
+    fn push<S: SecondOrderSystem>(&mut self, q: &[f64], ode: &MechanicalOde<S>) {
+        self.q.extend_from_slice(q);
+        self.p.extend_from_slice(ode.pair_forces());
+        self.s.extend_from_slice(ode.slip_memory());
     }
 }
 
@@ -212,6 +239,10 @@ pub struct Run {
     pub curves: Curves,
     /// Final state `y` (q, v, s, W, D).
     pub final_state: Vec<f64>,
+    /// The states at the output times (the times are `curves.t`), with
+    /// [`TransientOptions::record`].
+    #[serde(skip)]
+    pub trajectory: Option<Trajectory>,
     /// The error that ended a run that did not finish.
     #[serde(skip)]
     pub failure: Option<Error>,
@@ -237,6 +268,7 @@ impl Run {
             events: 0,
             curves: Curves::default(),
             final_state: Vec::new(),
+            trajectory: None,
             failure: Some(e),
         }
     }
@@ -346,6 +378,7 @@ struct Driver<S: SecondOrderSystem> {
     end: f64,
     output_step: f64,
     curves: Curves,
+    trajectory: Option<Trajectory>,
     y0: Vec<f64>,
     events: u64,
     last_root_t: f64,
@@ -371,6 +404,11 @@ impl<S: SecondOrderSystem> Driver<S> {
         let y0 = ode.initial_state();
         let mut curves = Curves::default();
         curves.push(&ode.sample(0.0, &y0));
+        let trajectory = opts.record.then(|| {
+            let mut tr = Trajectory::default();
+            tr.push(&y0[..dim], &ode);
+            tr
+        });
         let problem = Deadline {
             inner: ode,
             deadline: opts
@@ -385,6 +423,7 @@ impl<S: SecondOrderSystem> Driver<S> {
             end,
             output_step: opts.output_step,
             curves,
+            trajectory,
             y0,
             events: 0,
             last_root_t: f64::NEG_INFINITY,
@@ -408,6 +447,9 @@ impl<S: SecondOrderSystem> Driver<S> {
             let y = self.cv.y().to_vec();
             let s = self.cv.problem_mut().inner.sample(t, &y);
             self.curves.push(&s);
+            if let Some(tr) = &mut self.trajectory {
+                tr.push(&y[..self.dim], &self.cv.problem().inner);
+            }
             observe(t, &y[..self.dim]);
         }
         let wall_s = wall.elapsed().as_secs_f64();
@@ -427,6 +469,7 @@ impl<S: SecondOrderSystem> Driver<S> {
             events: self.events,
             curves: self.curves,
             final_state: self.cv.y().to_vec(),
+            trajectory: self.trajectory,
             failure,
         }
     }

@@ -302,6 +302,17 @@ impl<S: SecondOrderSystem> MechanicalOde<S> {
         }
     }
 
+    /// The pair forces `p` (3w: normal, t1, t2 per pair; N) of the last [`MechanicalOde::sample`].
+    pub fn pair_forces(&self) -> &[f64] {
+        &self.p
+    }
+
+    /// The slip memory `s` (2w with friction, else empty; mm) of the last
+    /// [`MechanicalOde::sample`].
+    pub fn slip_memory(&self) -> &[f64] {
+        &self.s_phys
+    }
+
     /// Pairs sliding at the last Newton setup.
     pub fn slipping_at_setup(&self) -> usize {
         self.slipping_at_setup

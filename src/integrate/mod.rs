@@ -10,5 +10,7 @@ pub mod problem;
 pub mod sundials;
 
 pub use crate::system::Scene;
-pub use driver::{integrate, run, thread_cpu_s, Curves, Run, RunStatus, TransientOptions};
+pub use driver::{
+    integrate, run, thread_cpu_s, Curves, Run, RunStatus, Trajectory, TransientOptions,
+};
 pub use mechanical::{EnergySample, MechanicalOde, ProblemOptions};

@@ -50,6 +50,7 @@ pub mod basis;
 mod build;
 pub mod competitors;
 pub mod craig_bampton;
+pub mod estimate;
 pub mod pod;
 pub mod rom_file;
 pub mod tvd;
@@ -61,5 +62,6 @@ pub use competitors::{
     JointInterfaceModes,
 };
 pub use craig_bampton::craig_bampton;
+pub use estimate::{CurveErrors, ErrorEstimator, Estimate, JointFlexibility, RunStates};
 pub use pod::{pod, pod_tvd, sigma_zero, Pod, DEFAULT_THRESHOLD, ZERO_EIGENVALUE};
 pub use tvd::{active_pairs, trial_vector_derivatives, Tvd, TvdFactor, TvdIndex, TvdOptions};

@@ -297,6 +297,7 @@ fn budgeted<S: SecondOrderSystem>(
         output_step: span.1,
         end_time: Some(span.0),
         budget_s: Some(budget_s),
+        record: false,
     };
     Outcome::of_run(match sys {
         Ok(s) => integrate(s, &Scene::of(model), &opts, |_, _| {}),

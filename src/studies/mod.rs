@@ -6,4 +6,5 @@ pub mod convergence;
 pub mod main_job;
 pub mod stability;
 pub mod sweep;
+pub mod tolerance;
 pub mod training;

@@ -637,6 +637,7 @@ impl Pass<'_> {
                 end_time: Some(end),
                 output_step: opts.full_output_step.min(end),
                 budget_s: Some(opts.reference_budget_s),
+                record: false,
             };
             let o = system_run(self.model, prep, &spec);
             self.progress(&format!(
@@ -703,6 +704,7 @@ impl Pass<'_> {
                             end_time: Some(end),
                             output_step: dt.min(end),
                             budget_s: Some(opts.budget_s),
+                            record: false,
                         };
                         let o = system_run(self.model, prep, &spec);
                         let cell = Cell {

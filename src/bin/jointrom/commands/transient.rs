@@ -10,7 +10,8 @@ use serde_json::{json, Value};
 use jointrom::integrate::problem::{Iteration, NewtonLinear};
 use jointrom::integrate::{self as driver, integrate, Curves, Run, TransientOptions};
 use jointrom::reduction::rom_file as export;
-use jointrom::reduction::{build_basis, BasisKind, BasisOptions};
+use jointrom::reduction::{build_basis, BasisKind, BasisOptions, JointFlexibility};
+use jointrom::studies::tolerance::{run_estimated, tolerance_model, RunEstimate, ToleranceOptions};
 use jointrom::studies::training::train_snapshot_basis;
 use jointrom::system::{FullSystem, ReducedSystem, Scene, SecondOrderSystem};
 use jointrom::{Error, Model};
@@ -24,12 +25,18 @@ pub struct TransientArgs {
     case: String,
     /// full (FE model) or a reduced basis: tvd, tvd-plain, modes, jim, alldof, pod (POD of
     /// the displacement snapshots of a full-FE training run, paper Section 5.2), or
-    /// file:PATH (a reduced model written by `jointrom export`; CASE is still loaded).
-    #[arg(long, default_value = "tvd")]
-    model: String,
+    /// file:PATH (a reduced model written by `jointrom export`; CASE is still loaded), or
+    /// adaptive (Craig–Bampton plus the attachment modes of the pairs the error estimate
+    /// selects, see --tolerance). Default: tvd, or adaptive with --tolerance.
+    #[arg(long)]
+    model: Option<String>,
     /// Enrichment vectors of the basis; default: the smallest g with w(g) >= 0.999.
     #[arg(long)]
     g: Option<usize>,
+    /// Build the smallest reduced model whose estimated relative L2 error of |f_c|(t) is at most
+    /// TOL (in (0, 1); e.g. 1e-2), with --model adaptive (the default with this flag).
+    #[arg(long, allow_negative_numbers = true)]
+    tolerance: Option<f64>,
     /// `--model pod`: end of the full-FE training run, s (default: the run's end time).
     #[arg(long)]
     train_end: Option<f64>,
@@ -99,6 +106,11 @@ impl ModelChoice {
     fn parse(name: &str) -> Result<ModelChoice, Error> {
         Ok(match name {
             "full" => ModelChoice::Full,
+            "adaptive" => {
+                return Err(Error::Invalid(
+                    "--model adaptive is chosen by --tolerance TOL: give the tolerance".into(),
+                ))
+            }
             "pod" => ModelChoice::Pod,
             _ if name.starts_with("file:") => {
                 ModelChoice::File(PathBuf::from(&name["file:".len()..]))
@@ -122,6 +134,13 @@ struct Outcome {
     g: Option<usize>,
     training: Option<Value>,
     frames: Frames,
+    /// Wall time of building the reduced model (basis, enrichment, earlier rounds), s.
+    offline_s: Option<f64>,
+    /// `--tolerance`: the tolerance, whether it was met, the rounds and the chosen pairs.
+    tolerance: Option<Value>,
+    /// The a-posteriori error estimate of a reduced run (`None` for the full model), or why
+    /// there is none.
+    estimate: Option<Result<RunEstimate, String>>,
 }
 
 pub fn run(a: TransientArgs) -> Result<(), Error> {
@@ -134,15 +153,19 @@ pub fn run(a: TransientArgs) -> Result<(), Error> {
     let c = &o.res.curves;
     let doc = json!({
         "case": model.name,
-        "model": a.model,
+        "model": model_name(&a),
+        "basis": model_name(&a),
         "basis_size": o.basis_size,
         "g": o.g,
+        "offline_s": o.offline_s,
+        "tolerance": o.tolerance,
         "options": opts,
         "stats": o.res.stats,
         "events": o.res.events,
         "wall_s": o.res.wall_s,
         "cpu_s": o.res.cpu_s,
         "total_s": total_s,
+        "error_estimate": estimate_json(&o.estimate),
         "curves": c,
         "energy_balance": c.balance(),
         "training": o.training,
@@ -221,6 +244,77 @@ fn vtu_every(
     }
 }
 
+/// The model `--model` names, or its default: `adaptive` with `--tolerance`, else `tvd`.
+fn model_name(a: &TransientArgs) -> String {
+    match (&a.model, a.tolerance) {
+        (Some(m), _) => m.clone(),
+        (None, Some(_)) => "adaptive".into(),
+        (None, None) => "tvd".into(),
+    }
+}
+
+/// `--tolerance TOL`: the tolerance-chosen model (`--model adaptive`) and its run.
+fn run_tolerance(
+    a: &TransientArgs,
+    name: &str,
+    tol: f64,
+    model: &Model,
+    opts: &TransientOptions,
+    vtu_every: Option<usize>,
+) -> Result<Outcome, Error> {
+    if name != "adaptive" {
+        return Err(Error::Invalid(format!(
+            "--tolerance builds its own model (--model adaptive); it does not apply to --model {name} \
+             (use --g to size that one)"
+        )));
+    }
+    if a.g.is_some() {
+        return Err(Error::Invalid(
+            "--tolerance and --g both size the model: give one of them".into(),
+        ));
+    }
+    if a.train_end.is_some() {
+        return Err(train_end_error());
+    }
+    let mut topts = ToleranceOptions::new(tol);
+    topts.nu = a.nu;
+    topts.transient = opts.clone();
+    let t = tolerance_model(model, &topts)?;
+    let frames = match (vtu_every, &t.rom.phi) {
+        (Some(every), Some(phi)) => {
+            // The result's states again, expanded: one more run of the (small) chosen model.
+            let (_, kept) = run_keeping(t.rom.clone(), &Scene::of(model), opts, Some(every))?;
+            expand_frames(phi, kept)
+        }
+        _ => Vec::new(),
+    };
+    let info = json!({
+        "tolerance": tol,
+        "met": t.met,
+        "pairs": t.pairs,
+        "nu": t.nu,
+        "rounds": t.rounds,
+    });
+    if !t.met {
+        eprintln!(
+            "warning: --tolerance {tol:e} not met: the best model ({} pairs, r = {}) estimates {:e}",
+            t.pairs.len(),
+            t.rom.dim(),
+            t.estimate.total.contact_force.unwrap_or(f64::NAN)
+        );
+    }
+    Ok(Outcome {
+        basis_size: t.rom.dim(),
+        g: Some(t.pairs.len()),
+        res: t.run,
+        training: None,
+        frames,
+        offline_s: Some(t.offline_s),
+        tolerance: Some(info),
+        estimate: Some(Ok(t.estimate)),
+    })
+}
+
 fn train_end_error() -> Error {
     Error::Invalid("--train-end applies to --model pod only".into())
 }
@@ -232,7 +326,11 @@ fn run_model(
     opts: &TransientOptions,
     vtu_every: Option<usize>,
 ) -> Result<Outcome, Error> {
-    let choice = match ModelChoice::parse(&a.model) {
+    let name = model_name(a);
+    if let Some(tol) = a.tolerance {
+        return run_tolerance(a, &name, tol, model, opts, vtu_every);
+    }
+    let choice = match ModelChoice::parse(&name) {
         Err(_) | Ok(ModelChoice::Basis(_)) if a.train_end.is_some() => {
             return Err(train_end_error())
         }
@@ -256,11 +354,15 @@ fn run_model(
                 g: None,
                 training: None,
                 frames,
+                offline_s: None,
+                tolerance: None,
+                estimate: None,
             })
         }
         ModelChoice::Pod => run_pod(a, model, opts, vtu_every),
         ModelChoice::File(path) => run_file(a, &path, opts),
         ModelChoice::Basis(kind) => {
+            let t0 = Instant::now();
             let basis = build_basis(
                 model,
                 kind,
@@ -270,7 +372,10 @@ fn run_model(
                     ..Default::default()
                 },
             )?;
-            run_reduced(model, basis.phi, basis.g, None, opts, vtu_every)
+            let offline_s = t0.elapsed().as_secs_f64();
+            let mut o = run_reduced(model, basis.phi, basis.g, None, opts, vtu_every)?;
+            o.offline_s = Some(offline_s);
+            Ok(o)
         }
     }
 }
@@ -323,6 +428,11 @@ fn run_file(a: &TransientArgs, path: &Path, opts: &TransientOptions) -> Result<O
         g: Some(f.basis.g),
         training: None,
         frames: Vec::new(),
+        offline_s: None,
+        tolerance: None,
+        estimate: Some(Err(
+            "an exported reduced model carries no basis Φ to correct its joint forces with".into(),
+        )),
     })
 }
 
@@ -338,17 +448,39 @@ fn run_reduced(
     let rom = ReducedSystem::new(model, phi)?;
     let basis_size = rom.dim();
     let phi = rom.phi.clone();
-    let (res, kept) = run_keeping(rom, &Scene::of(model), opts, vtu_every)?;
+    let flex = JointFlexibility::new(model)?;
+    let mut kept = Vec::new();
+    let mut k = 0usize;
+    let (res, estimate) = run_estimated(model, &flex, rom, opts, true, |t, q| {
+        if vtu_every.is_some_and(|every| k % every == 0) {
+            kept.push((t, q.to_vec()));
+        }
+        k += 1;
+    })?;
+    let res = res.into_result()?;
     Ok(Outcome {
         res,
         basis_size,
         g: Some(g),
         training,
+        offline_s: None,
+        tolerance: None,
+        estimate: Some(estimate.map_err(|e| e.to_string())),
         frames: match phi {
             Some(phi) if !kept.is_empty() => expand_frames(&phi, kept),
             _ => kept,
         },
     })
+}
+
+/// `"error_estimate"`: the estimated relative L2 errors, or `{"unavailable": why}`; `null` for
+/// the full model.
+fn estimate_json(e: &Option<Result<RunEstimate, String>>) -> Value {
+    match e {
+        None => Value::Null,
+        Some(Ok(e)) => serde_json::to_value(e).expect("an estimate serialises"),
+        Some(Err(why)) => json!({ "unavailable": why }),
+    }
 }
 
 /// A transient run that keeps every `every`-th state (with its time) when `every` is given.
@@ -401,7 +533,7 @@ fn print_summary(a: &TransientArgs, model: &Model, o: &Outcome, total_s: f64) {
     println!(
         "{} — model {} (n = {}{}), friction {}, events {}",
         model.name,
-        a.model,
+        model_name(a),
         o.basis_size,
         o.g.map(|g| format!(", g = {g}")).unwrap_or_default(),
         a.friction.name(),
@@ -428,5 +560,28 @@ fn print_summary(a: &TransientArgs, model: &Model, o: &Outcome, total_s: f64) {
             "final: |f_c| {:.6e} N, |f_R| {:.6e} N, master uy {:.6e} mm",
             c.contact_force_norm[i], c.friction_force_norm[i], c.master_uy[i]
         );
+    }
+    let pct = |v: Option<f64>| v.map_or("–".to_string(), |v| format!("{:.3} %", 100.0 * v));
+    match &o.estimate {
+        Some(Ok(e)) => {
+            let line = |what: &str, c: &jointrom::reduction::CurveErrors| {
+                println!(
+                    "{what}: |f_c| {}, |f_R| {}, uy {}",
+                    pct(c.contact_force),
+                    pct(c.friction_force),
+                    pct(c.master_uy)
+                )
+            };
+            line("error estimate (relative L2 vs full)", &e.total);
+            line(
+                "  reduction (vs quasi-static joint correction)",
+                &e.reduction,
+            );
+            if let Some(i) = &e.integration {
+                line("  integration (vs 10x looser tolerances)", i);
+            }
+        }
+        Some(Err(why)) => println!("error estimate unavailable: {why}"),
+        None => {}
     }
 }

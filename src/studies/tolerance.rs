@@ -1,0 +1,455 @@
+//! Error-controlled reduction: a tolerance on the joint forces in, the smallest reduced model that
+//! meets it out, with the estimate of [`crate::reduction::estimate`] attached to every reduced run.
+//!
+//! ## Why not the paper's w(g)
+//!
+//! Every TVD column is a static response to loads on the pairs that close, so the TVD span is the
+//! span of the pair attachment modes `K⁻¹ b_kᵀ`, and the POD ranks those directions by global
+//! strain energy, not by how much they change the gaps of the pairs that carry force: on the
+//! friction bar the a-priori g (w ≥ 0.999) misses ‖f_c‖(t) by 4 % and the multilayer sheet's by
+//! 53 % (measured, README). No threshold of w(g) fixes that.
+//!
+//! ## The basis
+//!
+//! `Φ = [Φ_S Φ_V K⁻¹ b_kᵀ (k ∈ S)]`, Craig–Bampton plus the attachment modes of a set S of pairs,
+//! M-orthonormalized and rotated to the reduced eigenbasis ([`crate::reduction::final_basis`],
+//! [`crate::reduction::modal_rotation`]). With S = all pairs this is the "all joint DOF" model
+//! of the paper's Section 5.1; its contact statics are exact.
+//!
+//! ## Choosing S ([`tolerance_model`])
+//!
+//! Start with S = ∅ (Craig–Bampton), and repeat:
+//!
+//! 1. run the reduced model (the user's transient options) and estimate its error: the
+//!    quasi-static joint correction gives the corrected normal forces `p_n*(t)` and the estimate
+//!    `η = ‖ ‖p_n‖ − ‖p_n*‖ ‖_L2 / ‖ ‖p_n*‖ ‖_L2` (module docs of the estimator);
+//! 2. if `η ≤ TOL`, stop: this run is the result;
+//! 3. else rank the pairs outside S by their share `e_k = Σ_t (p_{n,k} − p_{n,k}*)²` and add the
+//!    fewest, largest first, that leave `√(Σ_{k∉S} e_k) ≤ θ · TOL · ‖ ‖p_n*‖ ‖_L2` (θ =
+//!    [`SELECTION_MARGIN`]). Since `|‖a‖ − ‖b‖| ≤ ‖a − b‖`, the pairs left out can contribute at
+//!    most θ·TOL to the next estimate if the added pairs become exact.
+//!
+//! Pairs that never carry force in either the run or the correction have `e_k = 0` and are never
+//! added: the model keeps only the joint directions the scene uses. The estimate's truncation
+//! part (the dynamics of the fixed-interface modes beyond ν) is not removed by pairs: when it
+//! exceeds θ·TOL, ν grows by [`NU_STEP`] (up to [`max_nu`]). The rounds' e_k come from the
+//! joint part alone, so truncation does not masquerade as pair error.
+//!
+//! The last round's run is the result; its estimate then gains the integration part
+//! ([`integration_errors`]: one more run at 10× looser tolerances), and `met` says whether the
+//! total meets TOL. When it does not — nothing left to add, or the integration error of the
+//! user's tolerances above TOL — the best model is returned with `met = false` (the CLI warns;
+//! tighter `--rtol/--atol` lower the integration floor).
+
+use std::time::Instant;
+
+use serde::Serialize;
+
+use crate::error::Error;
+use crate::integrate::{integrate, ProblemOptions, Run, TransientOptions};
+use crate::joint::law::PairLaw;
+use crate::joint::statics::ContactOptions;
+use crate::model::Model;
+use crate::reduction::estimate::TRUNCATION_MODES;
+use crate::reduction::{
+    craig_bampton, final_basis, modal_rotation, CurveErrors, Estimate, JointFlexibility, RunStates,
+    DEFAULT_DROP_TOL,
+};
+use crate::studies::convergence::{reduced_contact_static_restarting, scaled_load, ReducedStatic};
+use crate::studies::stability::relative_l2;
+use crate::system::{ReducedSystem, Scene};
+
+/// θ of the pair selection (module docs): the pairs left out may carry at most this fraction of
+/// the tolerance.
+pub const SELECTION_MARGIN: f64 = 0.5;
+
+/// The pair law of a model's contact under a run's problem options.
+pub fn pair_law(model: &Model, problem: &ProblemOptions) -> PairLaw {
+    PairLaw {
+        k_n: model.contact.normal_stiffness,
+        friction: problem.friction,
+        mu: model.contact.friction_coefficient,
+        k_t: model.contact.stick_stiffness,
+        tau: problem.tau,
+    }
+}
+
+/// Looser tolerances of the integration check ([`integration_errors`]): rtol and atol times
+/// this.
+pub const INTEGRATION_CHECK_FACTOR: f64 = 10.0;
+
+/// The error estimate of a reduced run: the reduction error (the quasi-static joint correction,
+/// [`crate::reduction::estimate`]) and the integration error, combined as independent errors.
+#[derive(Clone, Debug, Serialize)]
+pub struct RunEstimate {
+    /// The estimated relative L2 errors against the full model (root sum of squares of the two
+    /// parts).
+    #[serde(flatten)]
+    pub total: CurveErrors,
+    /// The reduction part: the run against its quasi-static joint correction.
+    pub reduction: CurveErrors,
+    /// The integration part: the run against a re-run at [`INTEGRATION_CHECK_FACTOR`]× looser
+    /// rtol and atol (`None`: not checked).
+    pub integration: Option<CurveErrors>,
+    /// The reduction estimate's details (corrected curves, per-pair errors).
+    #[serde(skip)]
+    pub detail: Estimate,
+}
+
+/// The integration part of a run's error estimate: the relative L2 differences of its curves
+/// from a re-run of the same system at `F` = [`INTEGRATION_CHECK_FACTOR`]× looser tolerances,
+/// divided by `F`.
+///
+/// CVODE controls local errors only; the global error of a run at tolerance `tol` is roughly
+/// proportional to `tol` ("tolerance proportionality"), so the difference `D` of two runs `F`
+/// tolerances apart is ≈ `(F − 1)` times this run's error, and `D / F` estimates it. Stick–slip
+/// histories are not always proportional; the measured ratios are in the README.
+pub fn integration_errors(
+    rom: ReducedSystem,
+    scene: &Scene,
+    opts: &TransientOptions,
+    run: &Run,
+) -> Result<CurveErrors, Error> {
+    let mut loose = TransientOptions {
+        record: false,
+        ..opts.clone()
+    };
+    loose.ode.rtol *= INTEGRATION_CHECK_FACTOR;
+    loose.ode.atol *= INTEGRATION_CHECK_FACTOR;
+    let check = integrate(rom, scene, &loose, |_, _| {}).into_result()?;
+    let (a, b) = (&check.curves, &run.curves);
+    let scaled = |d: Option<f64>| d.map(|d| d / INTEGRATION_CHECK_FACTOR);
+    Ok(CurveErrors {
+        contact_force: scaled(relative_l2(
+            &a.t,
+            &a.contact_force_norm,
+            &b.t,
+            &b.contact_force_norm,
+        )),
+        friction_force: if opts.problem.friction {
+            scaled(relative_l2(
+                &a.t,
+                &a.friction_force_norm,
+                &b.t,
+                &b.friction_force_norm,
+            ))
+        } else {
+            None
+        },
+        master_uy: scaled(relative_l2(&a.t, &a.master_uy, &b.t, &b.master_uy)),
+    })
+}
+
+/// Runs a reduced model (its trajectory recorded) and estimates its error: the reduction part
+/// always, the integration part with `check_integration` (one more run of the same model at
+/// looser tolerances). The run's own failure is in the [`Run`]; an estimate that cannot be made
+/// is the `Err` of the second value.
+///
+/// # Errors
+/// The estimator cannot be set up (a reduced model without its basis Φ, or not of `model`).
+pub fn run_estimated(
+    model: &Model,
+    flex: &JointFlexibility,
+    rom: ReducedSystem,
+    opts: &TransientOptions,
+    check_integration: bool,
+    observe: impl FnMut(f64, &[f64]),
+) -> Result<(Run, Result<RunEstimate, Error>), Error> {
+    let estimator = flex.estimator(model, &rom)?;
+    let check = check_integration.then(|| rom.clone());
+    let opts = TransientOptions {
+        record: true,
+        ..opts.clone()
+    };
+    let mut run = integrate(rom, &Scene::of(model), &opts, observe);
+    let estimate = match run.trajectory.take() {
+        Some(tr) if run.status.finished() => estimator.estimate(
+            &pair_law(model, &opts.problem),
+            RunStates {
+                t: &run.curves.t,
+                q: &tr.q,
+                p: &tr.p,
+                s: &tr.s,
+            },
+        ),
+        _ => Err(Error::Invalid(format!(
+            "no error estimate: the run ended early ({})",
+            run.status
+        ))),
+    };
+    let estimate = estimate.and_then(|detail| {
+        let integration = match check {
+            Some(rom) => Some(integration_errors(rom, &Scene::of(model), &opts, &run)?),
+            None => None,
+        };
+        Ok(RunEstimate {
+            total: match &integration {
+                Some(i) => detail.errors.combine(i),
+                None => detail.errors,
+            },
+            reduction: detail.errors,
+            integration,
+            detail,
+        })
+    });
+    Ok((run, estimate))
+}
+
+/// Options of [`tolerance_model`].
+#[derive(Clone, Debug)]
+pub struct ToleranceOptions {
+    /// The tolerance on the relative L2 error of ‖f_c‖(t), in (0, 1).
+    pub tolerance: f64,
+    /// Fixed-interface modes ν of the Craig–Bampton part.
+    pub nu: usize,
+    /// The transient runs (every round and the result).
+    pub transient: TransientOptions,
+    /// Rounds of enrichment at most (each one reduced run).
+    pub max_rounds: usize,
+}
+
+impl ToleranceOptions {
+    /// ν = 10 (the paper), the default transient options, at most 8 rounds.
+    pub fn new(tolerance: f64) -> ToleranceOptions {
+        ToleranceOptions {
+            tolerance,
+            nu: 10,
+            transient: TransientOptions::default(),
+            max_rounds: 8,
+        }
+    }
+}
+
+/// One round of [`tolerance_model`].
+#[derive(Clone, Debug, Serialize)]
+pub struct Round {
+    /// Pairs whose attachment modes the basis held.
+    pub pairs: usize,
+    /// Fixed-interface modes ν of the basis.
+    pub nu: usize,
+    /// Basis size r.
+    pub basis_size: usize,
+    /// The estimated relative L2 error of ‖f_c‖(t) (reduction part).
+    pub estimate: Option<f64>,
+    /// Its joint part (what more pairs remove).
+    pub joint: Option<f64>,
+    /// Its truncation part (what more fixed-interface modes remove).
+    pub truncation: Option<f64>,
+    /// Wall time of the round's run, s.
+    pub wall_s: f64,
+}
+
+/// The tolerance-chosen reduced model and its run.
+pub struct ToleranceModel {
+    /// The chosen pairs (indices into the model's joint pairs), ascending.
+    pub pairs: Vec<usize>,
+    /// The chosen number of fixed-interface modes ν.
+    pub nu: usize,
+    /// The reduced system of the result (a fresh copy, not the one that ran).
+    pub rom: ReducedSystem,
+    /// The result's run (the last round).
+    pub run: Run,
+    /// Its estimate (reduction and integration parts).
+    pub estimate: RunEstimate,
+    /// Whether the estimate (both parts) meets the tolerance.
+    pub met: bool,
+    /// Every round, the last one the result.
+    pub rounds: Vec<Round>,
+    /// Wall time of everything before the result's run (factorization, Craig–Bampton, the
+    /// flexibility, the earlier rounds' runs and estimates), s.
+    pub offline_s: f64,
+}
+
+/// Builds the smallest Craig–Bampton + pair-attachment-mode model whose estimated ‖f_c‖(t)
+/// error meets `opts.tolerance` (module docs).
+///
+/// # Errors
+/// A tolerance outside (0, 1) or not finite ([`Error::Invalid`] naming it), a failing basis, a
+/// run that does not finish or an estimate that cannot be made.
+pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<ToleranceModel, Error> {
+    let tol = opts.tolerance;
+    check_tolerance(tol)?;
+    let start = Instant::now();
+    let flex = JointFlexibility::new(model)?;
+    let mut nu = opts.nu;
+    let mut cb = craig_bampton(model, nu)?;
+    let mut pairs: Vec<usize> = Vec::new();
+    let mut rounds = Vec::new();
+    loop {
+        let round_start = Instant::now();
+        let rom = reduced_on_pairs(model, &cb, &flex, &pairs)?;
+        let (run, estimate) =
+            run_estimated(model, &flex, rom.clone(), &opts.transient, false, |_, _| {})?;
+        let run = run.into_result()?;
+        let estimate = estimate?;
+        let eta = estimate.reduction.contact_force.unwrap_or(0.0);
+        let d = &estimate.detail;
+        rounds.push(Round {
+            pairs: pairs.len(),
+            nu,
+            basis_size: rom.dim(),
+            estimate: estimate.reduction.contact_force,
+            joint: d.joint,
+            truncation: d.truncation,
+            wall_s: run.wall_s,
+        });
+        let mut changed = false;
+        if eta > tol && rounds.len() < opts.max_rounds {
+            let part = SELECTION_MARGIN * tol;
+            if d.truncation.unwrap_or(0.0) > part && nu + NU_STEP <= max_nu(model) {
+                nu += NU_STEP;
+                cb = craig_bampton(model, nu)?;
+                changed = true;
+            }
+            if d.joint.unwrap_or(0.0) > part {
+                if let Some(add) = more_pairs(d, &pairs, tol) {
+                    pairs.extend(add);
+                    pairs.sort_unstable();
+                    changed = true;
+                }
+            }
+        }
+        if !changed {
+            let offline_s = (round_start - start).as_secs_f64();
+            let mut estimate = estimate;
+            let integration =
+                integration_errors(rom.clone(), &Scene::of(model), &opts.transient, &run)?;
+            estimate.total = estimate.reduction.combine(&integration);
+            estimate.integration = Some(integration);
+            return Ok(ToleranceModel {
+                pairs,
+                nu,
+                rom,
+                run,
+                met: estimate.total.contact_force.unwrap_or(0.0) <= tol,
+                estimate,
+                rounds,
+                offline_s,
+            });
+        }
+    }
+}
+
+/// Fixed-interface modes added to ν when the truncation part of the estimate exceeds its share.
+pub const NU_STEP: usize = 10;
+
+/// The largest ν the enrichment uses: [`TRUNCATION_MODES`] − [`NU_STEP`], so that the estimate
+/// still checks [`NU_STEP`] modes beyond the basis.
+fn max_nu(model: &Model) -> usize {
+    TRUNCATION_MODES
+        .saturating_sub(NU_STEP)
+        .min(model.dofs().saturating_sub(6) / 2)
+}
+
+/// The reduced system on Craig–Bampton plus the attachment modes of `pairs`.
+pub fn reduced_on_pairs(
+    model: &Model,
+    cb: &faer::Mat<f64>,
+    flex: &JointFlexibility,
+    pairs: &[usize],
+) -> Result<ReducedSystem, Error> {
+    let att = flex.attachment_modes(pairs);
+    let (phi, _) = final_basis(&[cb.as_ref(), att.as_ref()], &model.mass, DEFAULT_DROP_TOL)?;
+    let (phi, _) = modal_rotation(model, phi)?;
+    ReducedSystem::new(model, phi)
+}
+
+/// The pairs to add after a round whose estimate missed `tol` (module docs, step 3); `None` when
+/// no pair outside `pairs` carries any of the error.
+fn more_pairs(est: &Estimate, pairs: &[usize], tol: f64) -> Option<Vec<usize>> {
+    let mut cand: Vec<(usize, f64)> = est
+        .pair_error
+        .iter()
+        .enumerate()
+        .filter(|(k, e)| **e > 0.0 && !pairs.contains(k))
+        .map(|(k, e)| (k, *e))
+        .collect();
+    if cand.is_empty() {
+        return None;
+    }
+    cand.sort_by(|a, b| b.1.total_cmp(&a.1).then(a.0.cmp(&b.0)));
+    let allowed = (SELECTION_MARGIN * tol).powi(2) * est.corrected_joint_norm2;
+    let mut left: f64 = cand.iter().map(|c| c.1).sum();
+    let mut add = Vec::new();
+    for (k, e) in cand {
+        if left <= allowed {
+            break;
+        }
+        add.push(k);
+        left -= e;
+    }
+    (!add.is_empty()).then_some(add)
+}
+
+/// The tolerance-chosen model of the contact statics ([`static_tolerance_model`]).
+pub struct StaticTolerance {
+    /// The chosen pairs, by decreasing force in the exact solution.
+    pub pairs: Vec<usize>,
+    /// Basis size r.
+    pub basis_size: usize,
+    /// The reduced solution.
+    pub solution: ReducedStatic,
+    /// The relative error of its ‖f_c‖ against the pair-space solution (exact: the full
+    /// model's, see [`crate::reduction::estimate`]).
+    pub error: f64,
+    /// ‖f_c‖ of the pair-space (full) solution, N.
+    pub exact_norm: f64,
+    /// Wall time, s.
+    pub wall_s: f64,
+}
+
+/// The smallest Craig–Bampton (ν) + attachment-mode model whose static ‖f_c‖ under the case
+/// load × `scale` is within `tol` (relative) of the full model's: the pair-space solution
+/// ([`JointFlexibility::static_contact_forces`], exact) ranks the pairs in contact by force, and
+/// the largest are added one at a time until the reduced ‖f_c‖ meets `tol` (with all of them
+/// the reduced statics are exact). The error reported is exact, not estimated.
+pub fn static_tolerance_model(
+    model: &Model,
+    tol: f64,
+    nu: usize,
+    scale: f64,
+) -> Result<StaticTolerance, Error> {
+    check_tolerance(tol)?;
+    let start = Instant::now();
+    let load = scaled_load(model, scale)?;
+    let flex = JointFlexibility::new(model)?;
+    let exact = flex.static_contact_forces(load)?;
+    let exact_norm = exact.iter().map(|p| p * p).sum::<f64>().sqrt();
+    let mut ranked: Vec<usize> = (0..exact.len()).filter(|&k| exact[k] != 0.0).collect();
+    ranked.sort_by(|&a, &b| exact[a].abs().total_cmp(&exact[b].abs()).reverse());
+    let cb = craig_bampton(model, nu)?;
+    let mut m = 0;
+    loop {
+        let rom = reduced_on_pairs(model, &cb, &flex, &ranked[..m])?;
+        let (solution, _) =
+            reduced_contact_static_restarting(model, &rom, scale, &ContactOptions::default())?;
+        let got = solution.state.contact_force_norm;
+        let error = if exact_norm > 0.0 {
+            (got - exact_norm).abs() / exact_norm
+        } else {
+            got
+        };
+        if error <= tol || m == ranked.len() {
+            return Ok(StaticTolerance {
+                pairs: ranked[..m].to_vec(),
+                basis_size: rom.dim(),
+                solution,
+                error,
+                exact_norm,
+                wall_s: start.elapsed().as_secs_f64(),
+            });
+        }
+        m += 1;
+    }
+}
+
+/// A tolerance must be a relative error in (0, 1).
+pub fn check_tolerance(tol: f64) -> Result<(), Error> {
+    if tol.is_finite() && tol > 0.0 && tol < 1.0 {
+        Ok(())
+    } else {
+        Err(Error::Invalid(format!(
+            "--tolerance must be a relative error in (0, 1), got {tol}"
+        )))
+    }
+}

@@ -1,0 +1,202 @@
+//! Error-controlled reduction (`jointrom::studies::tolerance`) and the a-posteriori estimate
+//! (`jointrom::reduction::estimate`): the pair-space statics against the full model, the
+//! tolerance contract against the stored full references, the estimator's effectivity, and the
+//! `--tolerance` flag's bad input.
+
+use serde_json::Value;
+
+use jointrom::integrate::TransientOptions;
+use jointrom::joint::statics::ContactOptions;
+use jointrom::model::contact_static_full;
+use jointrom::reduction::{build_basis, BasisKind, BasisOptions, JointFlexibility};
+use jointrom::studies::tolerance::{
+    run_estimated, static_tolerance_model, tolerance_model, ToleranceOptions,
+};
+use jointrom::system::ReducedSystem;
+
+use crate::common::{jointrom_err, model, reference_json};
+
+/// A reference curve of a stored full run.
+fn curve(reference: &Value, key: &str) -> Vec<f64> {
+    reference[key]
+        .as_array()
+        .unwrap_or_else(|| panic!("reference has no `{key}`"))
+        .iter()
+        .map(|v| v.as_f64().expect("a number"))
+        .collect()
+}
+
+/// Relative L2 error of `a` against `b` over their common outputs.
+fn rel_err(a: &[f64], b: &[f64]) -> f64 {
+    let n = a.len().min(b.len());
+    crate::common::rel_l2(a, b, n)
+}
+
+/// The pair-space contact statics (one factorization of K, the joint flexibility) reproduce the
+/// full model's contact forces: the static estimate is exact.
+#[test]
+fn pair_space_statics_equal_the_full_model() {
+    for name in ["friction_bar", "multilayer_sheet"] {
+        let m = model(name);
+        let flex = JointFlexibility::new(&m).unwrap();
+        for scale in [1.0, -1.0] {
+            let load = m.master_load().map(|v| v * scale);
+            let pair = flex.static_contact_forces(load).unwrap();
+            let full = contact_static_full(&m, load, &ContactOptions::default()).unwrap();
+            assert_eq!(pair.len(), full.state.forces.len());
+            let scale_f = full.state.contact_force_norm;
+            for (k, (a, b)) in pair.iter().zip(&full.state.forces).enumerate() {
+                assert!(
+                    (a - b).abs() <= 1e-9 * scale_f,
+                    "{name} × {scale}: pair {k} force {a} vs full {b}"
+                );
+            }
+        }
+    }
+}
+
+/// `static --tolerance`: the reduced ‖f_c‖ is within the tolerance of the full model's, the
+/// reported error is the true one, and the model keeps only pairs in contact.
+#[test]
+fn static_tolerance_meets_the_full_model() {
+    for name in ["friction_bar", "multilayer_sheet"] {
+        let m = model(name);
+        let full = contact_static_full(&m, m.master_load(), &ContactOptions::default()).unwrap();
+        let exact = full.state.contact_force_norm;
+        for tol in [1e-1, 1e-2, 1e-3] {
+            let t = static_tolerance_model(&m, tol, 10, 1.0).unwrap();
+            let got = t.solution.state.contact_force_norm;
+            let err = (got - exact).abs() / exact;
+            assert!(err <= tol, "{name} tol {tol}: error {err}");
+            assert!(
+                (t.error - err).abs() <= 1e-9,
+                "{name}: reported {} vs {err}",
+                t.error
+            );
+            assert!(
+                t.pairs.iter().all(|&k| full.state.active[k]),
+                "{name}: pair not in contact"
+            );
+            assert!(t.pairs.len() <= full.state.pairs_in_contact);
+        }
+    }
+}
+
+/// The tolerance contract of `transient --tolerance 1e-2` on both built-in scenes with
+/// friction: the chosen model is within 1e-2 of the stored full run in ‖f_c‖(t), the estimate is
+/// honest (0.5 ≤ estimate / true error ≤ 10), the basis is within 16 + 0.6 w, and the model
+/// keeps far fewer joint directions than all pairs.
+#[test]
+fn tolerance_model_meets_the_stored_full_reference() {
+    for name in ["friction_bar", "multilayer_sheet"] {
+        let m = model(name);
+        let (_, reference) = reference_json(&format!("{name}_full_friction_on"));
+        let t = tolerance_model(&m, &ToleranceOptions::new(1e-2)).unwrap();
+        let c = &t.run.curves;
+        let truth = rel_err(
+            &c.contact_force_norm,
+            &curve(&reference, "contact_force_norm"),
+        );
+        let est = t.estimate.total.contact_force.unwrap();
+        assert!(t.met, "{name}: tolerance reported not met (estimate {est})");
+        assert!(truth <= 1e-2, "{name}: true ‖f_c‖ error {truth}");
+        let eff = est / truth;
+        assert!(
+            (0.5..=10.0).contains(&eff),
+            "{name}: effectivity {eff} ({est} / {truth})"
+        );
+        let w = m.pair_count() as f64;
+        assert!(
+            (t.rom.dim() as f64) <= 16.0 + 0.6 * w,
+            "{name}: basis {} > 16 + 0.6 w",
+            t.rom.dim()
+        );
+        assert!(t.pairs.len() < m.pair_count());
+        assert!(t.offline_s > 0.0 && t.run.wall_s > 0.0);
+    }
+}
+
+/// The estimate of a fixed model (the paper's a-priori TVD and Craig–Bampton alone, g = 0) is
+/// within a factor 2 of the true ‖f_c‖(t) error against the stored full run, from 4 % to 20×.
+#[test]
+fn estimate_tracks_the_true_error_of_fixed_models() {
+    let m = model("friction_bar");
+    let (_, reference) = reference_json("friction_bar_full_friction_on");
+    let flex = JointFlexibility::new(&m).unwrap();
+    for g in [Some(0), None] {
+        let basis = build_basis(
+            &m,
+            BasisKind::Tvd,
+            &BasisOptions {
+                g,
+                ..Default::default()
+            },
+        )
+        .unwrap();
+        let rom = ReducedSystem::new(&m, basis.phi).unwrap();
+        let (run, est) = run_estimated(
+            &m,
+            &flex,
+            rom,
+            &TransientOptions::default(),
+            false,
+            |_, _| {},
+        )
+        .unwrap();
+        let run = run.into_result().unwrap();
+        let est = est.unwrap().total.contact_force.unwrap();
+        let truth = rel_err(
+            &run.curves.contact_force_norm,
+            &curve(&reference, "contact_force_norm"),
+        );
+        let eff = est / truth;
+        assert!(
+            truth > 1e-2,
+            "g {g:?}: the model should miss by more than 1 % ({truth})"
+        );
+        assert!(
+            (0.5..=2.0).contains(&eff),
+            "g {g:?}: effectivity {eff} ({est} / {truth})"
+        );
+    }
+}
+
+/// Bad `--tolerance` values and combinations are errors naming the flag.
+#[test]
+fn tolerance_bad_input_is_named() {
+    for bad in ["0", "1", "-0.1", "NaN", "2"] {
+        let e = jointrom_err(["transient", "friction_bar", "--tolerance", bad]);
+        assert!(e.contains("--tolerance"), "{bad}: {e}");
+        let e = jointrom_err(["static", "friction_bar", "--tolerance", bad]);
+        assert!(e.contains("--tolerance"), "static {bad}: {e}");
+    }
+    let e = jointrom_err([
+        "transient",
+        "friction_bar",
+        "--tolerance",
+        "1e-2",
+        "--g",
+        "4",
+    ]);
+    assert!(e.contains("--g") && e.contains("--tolerance"), "{e}");
+    let e = jointrom_err([
+        "transient",
+        "friction_bar",
+        "--tolerance",
+        "1e-2",
+        "--model",
+        "tvd",
+    ]);
+    assert!(e.contains("--tolerance") && e.contains("tvd"), "{e}");
+    let e = jointrom_err(["transient", "friction_bar", "--model", "adaptive"]);
+    assert!(e.contains("--tolerance"), "{e}");
+    let e = jointrom_err([
+        "static",
+        "friction_bar",
+        "--tolerance",
+        "1e-2",
+        "--basis",
+        "tvd",
+    ]);
+    assert!(e.contains("--tolerance"), "{e}");
+}
