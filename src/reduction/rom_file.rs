@@ -57,16 +57,34 @@ pub const VERSION: u32 = 1;
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct BasisInfo {
-    /// Basis kind (`tvd`, `tvd-plain`, `modes`, `jim`, `alldof`).
+    /// Basis kind (`tvd`, `tvd-plain`, `modes`, `jim`, `alldof`, `adaptive`).
     pub kind: String,
     /// Added vectors g.
     pub g: usize,
     /// Fixed-interface modes ν.
     pub nu: usize,
-    /// w(g) threshold of the a-priori choice.
+    /// w(g) threshold of the a-priori choice (0 for `adaptive`).
     pub threshold: f64,
     /// POD energy ratios w(1), w(2), ... (empty for bases without POD).
     pub w: Vec<f64>,
+    /// `adaptive`: the tolerance on the relative L2 error of ‖f_c‖(t) it was built for, the
+    /// chosen pairs and the estimate of its run (absent for the other kinds and in older files).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tolerance: Option<ToleranceInfo>,
+}
+
+/// How an `adaptive` basis was chosen (`jointrom export --tolerance`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ToleranceInfo {
+    /// The tolerance, relative L2 error of ‖f_c‖(t).
+    pub tolerance: f64,
+    /// Whether the estimate met it.
+    pub met: bool,
+    /// The pairs whose attachment modes the basis holds (indices of the joint pairs).
+    pub pairs: Vec<usize>,
+    /// The estimated relative L2 error of ‖f_c‖(t) of its transient with friction.
+    pub error_estimate: Option<f64>,
 }
 
 /// The exported reduced model (see the module docs for every field).

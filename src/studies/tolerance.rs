@@ -32,7 +32,7 @@
 //! Pairs that never carry force in either the run or the correction have `e_k = 0` and are never
 //! added: the model keeps only the joint directions the scene uses. The estimate's truncation
 //! part (the dynamics of the fixed-interface modes beyond ν) is not removed by pairs: when it
-//! exceeds θ·TOL, ν grows by [`NU_STEP`] (up to [`max_nu`]). The rounds' e_k come from the
+//! exceeds θ·TOL, ν grows by [`NU_STEP`] (up to `TRUNCATION_MODES − NU_STEP`). The rounds' e_k come from the
 //! joint part alone, so truncation does not masquerade as pair error.
 //!
 //! The last round's run is the result; its estimate then gains the integration part

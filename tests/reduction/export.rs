@@ -25,6 +25,7 @@ fn exported_rom_reintegrates_to_identical_curves() {
         nu: 10,
         threshold: 0.999,
         w: b.w.clone(),
+        tolerance: None,
     };
     let rom = ReducedSystem::new(&model, b.phi).unwrap();
     let file = RomFile::new(&model, &rom, info).unwrap();
@@ -73,6 +74,7 @@ fn damaged_files_are_rejected_naming_the_field() {
         nu: 10,
         threshold: 0.999,
         w: Vec::new(),
+        tolerance: None,
     };
     let rom = ReducedSystem::new(&model, b.phi).unwrap();
     let good: serde_json::Value =
