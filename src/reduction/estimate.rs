@@ -193,7 +193,7 @@ impl JointFlexibility {
         })
     }
 
-    /// The frictionless contact statics under the master load `load` (`[Fx, Fy, Fz (N), Mx, My,
+    /// The frictionless contact statics (the model's `k_n`) under the master load `load` (`[Fx, Fy, Fz (N), Mx, My,
     /// Mz (N·mm)]`) solved in the pair space, `g = H_n f_m − k_n F_{n,A} g_A`: the full model's
     /// solution condensed exactly to the pairs (module docs). Returns the normal pair forces
     /// `p_n = k_n min(g, 0)` (w values, N).
@@ -572,7 +572,7 @@ impl<'a> Corrector<'a> {
     fn correct(&mut self, u_hat: &[f64], p: &[f64]) -> Result<Vec<f64>, Error> {
         let w = self.w;
         let f = &self.flex.flex;
-        let k_n = self.flex.k_n;
+        let k_n = self.law.k_n;
         // û − F_{·,t} p_t: the kinematics with the run's tangential forces as loads.
         let mut u0 = u_hat.to_vec();
         for (i, ui) in u0.iter_mut().enumerate() {

@@ -149,6 +149,9 @@ fn time_charts(rep: &Report, dir: &Path) -> Result<Vec<PathBuf>, Error> {
             shown.push(r);
         }
     }
+    if let Some(h) = rep.headline.and_then(|i| rep.runs.get(i)) {
+        shown.push(h);
+    }
     let mut files = Vec::new();
     let quantities: [(&str, &str, &str, Curve); 3] = [
         ("fc_t", "contact force norm ‖f_c‖", "‖f_c‖ (N)", |r| &r.fc),
@@ -157,7 +160,7 @@ fn time_charts(rep: &Report, dir: &Path) -> Result<Vec<PathBuf>, Error> {
     ];
     for (stem, what, unit, get) in quantities {
         let mut c = LineChart::new(
-            format!("{}: {what}, full FE vs TVD ROMs", rep.case),
+            format!("{}: {what}, full FE vs reduced models", rep.case),
             "t (s)",
             unit,
         );
@@ -166,6 +169,8 @@ fn time_charts(rep: &Report, dir: &Path) -> Result<Vec<PathBuf>, Error> {
             let mut s = Series::new(
                 if r.model == "full" {
                     format!("full FE ({} DOF)", r.size)
+                } else if let Some((tol, _)) = r.tolerance {
+                    format!("adaptive, TOL {tol:.0e} (r = {})", r.size)
                 } else if r.g == Some(rep.g_chosen) {
                     format!("TVD g = {} (a priori, w ≥ {})", rep.g_chosen, rep.threshold)
                 } else {
@@ -280,10 +285,14 @@ fn markdown(rep: &Report, stab: &Path, stability: bool) -> String {
          reference: BDF + Newton, {} steps, {:.2} s CPU.\n",
         rep.g_chosen, rep.threshold, full.stats.steps, full.cpu_s
     );
+    headline(&mut s, rep);
     runs_table(&mut s, rep);
     let _ = writeln!(
         s,
-        "\nErrors are relative L2 over the output times (every 1e-4 s) against the full FE run. \
+        "\nErrors are relative L2 over the output times (every 1e-4 s) against the full FE run; \
+         `est.` is each reduced run's own error estimate (no full run needed: the quasi-static \
+         joint correction, the truncated modes' dynamics and an integration check, see \
+         `src/reduction/estimate.rs`), to be read against the true error beside it. \
          CPU is the integrating thread's CPU time; basis construction is \
          extra (`build_s` in `results.json`). A run that does not finish within its wall-clock \
          budget is recorded as `budget` with the time it reached.\n"
@@ -336,22 +345,75 @@ fn markdown(rep: &Report, stab: &Path, stability: bool) -> String {
     s
 }
 
+/// The headline reduced model: the tolerance-chosen one, its true error against its estimate
+/// and its speed, beside the paper's a-priori w(g) model.
+fn headline(s: &mut String, rep: &Report) {
+    use std::fmt::Write;
+    let tol = rep.headline_tolerance;
+    let Some(h) = rep.headline.and_then(|i| rep.runs.get(i)) else {
+        let _ = writeln!(
+            s,
+            "**Headline reduced model** (tolerance {tol:.0e} on ‖f_c‖(t)): could not be built or run \
+             — see the `adaptive` row below.\n"
+        );
+        return;
+    };
+    let est = h.estimate.as_ref().and_then(|e| e.total.contact_force);
+    let _ = writeln!(
+        s,
+        "**Headline reduced model** (tolerance {tol:.0e} on ‖f_c‖(t)): Craig–Bampton + the attachment \
+         modes of {} pairs, r = {}; ‖f_c‖(t) error {} (estimated {}), u_y {}, ‖f_R‖ {}; {:.2} s \
+         to build, {:.3} s CPU to run ({} of the full run's CPU).",
+        h.g.unwrap_or(0),
+        h.size,
+        fmt_opt(h.error_fc, 2),
+        fmt_opt(est, 2),
+        fmt_opt(h.error_uy, 2),
+        fmt_opt(h.error_fr, 2),
+        h.build_s,
+        h.cpu_s,
+        h.cpu_percent.map_or("–".into(), |p| format!("{p:.2} %")),
+    );
+    if let Some(a) = rep
+        .runs
+        .iter()
+        .find(|r| r.model == "tvd" && r.g == Some(rep.g_chosen) && r.iteration == "newton")
+    {
+        let _ = writeln!(
+            s,
+            "The paper's a-priori model (TVD, g = {}, w ≥ {}): ‖f_c‖(t) error {} (estimated {}).",
+            rep.g_chosen,
+            rep.threshold,
+            fmt_opt(a.error_fc, 2),
+            fmt_opt(a.estimate.as_ref().and_then(|e| e.total.contact_force), 2)
+        );
+    }
+    let _ = writeln!(s);
+}
+
 /// The summary table: one row per run.
 fn runs_table(s: &mut String, rep: &Report) {
     use std::fmt::Write;
     let _ = writeln!(
         s,
-        "| model | g | size | iteration | status | err ‖f_c‖ | err u_y | err ‖f_R‖ | CPU s | % of full | speed-up | steps | RHS | Newton its | setups | Pareto |"
+        "| model | g | size | iteration | status | err ‖f_c‖ | est. ‖f_c‖ | err u_y | est. u_y | err ‖f_R‖ | est. ‖f_R‖ | CPU s | % of full | speed-up | steps | RHS | Newton its | setups | Pareto |"
     );
     let _ = writeln!(
         s,
-        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
     );
     for r in &rep.runs {
+        let est = r.estimate.as_ref().map(|e| e.total);
         let _ = writeln!(
             s,
-            "| {} | {} | {} | {} | {} | {} | {} | {} | {:.3} | {} | {} | {} | {} | {} | {} | {} |",
-            r.model,
+            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {:.3} | {} | {} | {} | {} | {} | {} | {} |",
+            match r.tolerance {
+                Some((tol, met)) => format!(
+                    "adaptive, TOL {tol:.0e}{}",
+                    if met { "" } else { " (not met)" }
+                ),
+                None => r.model.clone(),
+            },
             r.g.map_or("–".into(), |g| g.to_string()),
             r.size,
             r.iteration,
@@ -361,8 +423,11 @@ fn runs_table(s: &mut String, rep: &Report) {
                 format!("{} at t = {:.3e} s", r.status, r.t_reached)
             },
             fmt_opt(r.error_fc, 2),
+            fmt_opt(est.and_then(|e| e.contact_force), 2),
             fmt_opt(r.error_uy, 2),
+            fmt_opt(est.and_then(|e| e.master_uy), 2),
             fmt_opt(r.error_fr, 2),
+            fmt_opt(est.and_then(|e| e.friction_force), 2),
             r.cpu_s,
             r.cpu_percent.map_or("–".into(), |p| format!("{p:.2}")),
             r.speedup.map_or("–".into(), |p| format!("{p:.0}×")),

@@ -13,7 +13,10 @@
 //!    sheet 20, 60) and the a-priori g (smallest g with w(g) ≥ the threshold, eq. 26), plus the
 //!    competitors (plain POD, modes only, Joint Interface Modes, all joint DOF) and functional
 //!    (fixed-point) iteration next to Newton; every run under a wall-clock budget, so a method
-//!    that does not finish is a measured failure, not a hang;
+//!    that does not finish is a measured failure, not a hang; every reduced run carries its own
+//!    error estimate ([`crate::studies::tolerance::run_estimated`]) beside its true error; and
+//!    the tolerance-chosen models ([`crate::studies::tolerance`], TOL = 1e-1, 1e-2, 1e-3), the
+//!    one for 1e-2 being the headline reduced model;
 //! 4. charts: ‖f_c‖(t), ‖f_R‖(t), master u_y(t) (Figs. 9, 11, 12, 17, 18), and speed against
 //!    accuracy — integration CPU time (log) against the relative L2 error of ‖f_c‖(t)
 //!
@@ -40,9 +43,10 @@ use crate::error::Error;
 use crate::integrate::problem::{Iteration, OdeOptions, OdeStats};
 use crate::integrate::{integrate, ProblemOptions, Run, RunStatus, Scene, TransientOptions};
 use crate::model::Model;
-use crate::reduction::{build_basis, BasisKind, BasisOptions};
+use crate::reduction::{build_basis, BasisKind, BasisOptions, JointFlexibility};
 use crate::studies::convergence::{self as study, StudyOptions};
 use crate::studies::stability::{relative_l2, Outcome};
+use crate::studies::tolerance::{run_estimated, tolerance_model, RunEstimate, ToleranceOptions};
 use crate::system::{FullSystem, ReducedSystem, SecondOrderSystem};
 
 /// Options of the main job ([`run_main_job`], [`crate::report::main_job::run_report`]). Defaults: the full job (case end time, study g ≤ 60, functional
@@ -64,6 +68,11 @@ pub struct ReportOptions {
     pub progress: bool,
     /// Folder holding stored stability maps (`<dir>/<case>/stability_status.png`).
     pub stability_dir: PathBuf,
+    /// Tolerances of the tolerance-chosen models run ([`crate::studies::tolerance`]; `quick`:
+    /// the headline one only).
+    pub tolerances: Vec<f64>,
+    /// The tolerance of the headline reduced model (run whether or not in `tolerances`).
+    pub headline_tolerance: f64,
 }
 
 impl Default for ReportOptions {
@@ -75,6 +84,8 @@ impl Default for ReportOptions {
             full_functional_budget_s: 5.0,
             progress: true,
             stability_dir: PathBuf::from("results/stability"),
+            tolerances: vec![1e-1, 1e-2, 1e-3],
+            headline_tolerance: 1e-2,
         }
     }
 }
@@ -110,6 +121,13 @@ pub struct RunRecord {
     pub error_uy: Option<f64>,
     /// Relative L2 error of ‖f_R‖(t).
     pub error_fr: Option<f64>,
+    /// The run's own error estimate (reduced runs; [`crate::studies::tolerance::RunEstimate`]),
+    /// to set beside the true errors above.
+    pub estimate: Option<RunEstimate>,
+    /// Why a reduced run has no estimate.
+    pub estimate_note: Option<String>,
+    /// `adaptive`: the tolerance it was built for and whether its estimate met it.
+    pub tolerance: Option<(f64, bool)>,
     /// Full-run integration CPU time over this run's (speed-up).
     pub speedup: Option<f64>,
     /// This run's CPU time in % of the full run's (the paper's measure).
@@ -168,6 +186,11 @@ pub struct Report {
     pub study: study::Study,
     /// The transient runs, full first.
     pub runs: Vec<RunRecord>,
+    /// The headline reduced model: the tolerance-chosen one for
+    /// [`ReportOptions::headline_tolerance`] (index into `runs`; `None` if it failed to build).
+    pub headline: Option<usize>,
+    /// Its tolerance.
+    pub headline_tolerance: f64,
     /// The paper's CPU ratios for this case (empty for other cases).
     pub paper_anchors: Vec<PaperAnchor>,
     /// Files written (relative to the report folder).
@@ -271,6 +294,9 @@ fn record(
         error_fc: None,
         error_uy: None,
         error_fr: None,
+        estimate: None,
+        estimate_note: None,
+        tolerance: None,
         speedup: None,
         cpu_percent: None,
         pareto: false,
@@ -291,18 +317,29 @@ fn budgeted<S: SecondOrderSystem>(
     span: (f64, f64),
     budget_s: f64,
 ) -> Outcome {
-    let opts = TransientOptions {
+    let opts = transient_options(problem, ode, span, budget_s);
+    Outcome::of_run(match sys {
+        Ok(s) => integrate(s, &Scene::of(model), &opts, |_, _| {}),
+        Err(e) => Run::failed(e),
+    })
+}
+
+/// The options of one run of the report over `span` = (end, output step) s under a wall-clock
+/// budget (s).
+fn transient_options(
+    problem: &ProblemOptions,
+    ode: OdeOptions,
+    span: (f64, f64),
+    budget_s: f64,
+) -> TransientOptions {
+    TransientOptions {
         ode,
         problem: *problem,
         output_step: span.1,
         end_time: Some(span.0),
         budget_s: Some(budget_s),
         record: false,
-    };
-    Outcome::of_run(match sys {
-        Ok(s) => integrate(s, &Scene::of(model), &opts, |_, _| {}),
-        Err(e) => Run::failed(e),
-    })
+    }
 }
 
 fn ode_options(functional: bool) -> OdeOptions {
@@ -409,13 +446,15 @@ pub fn run_main_job(
 
     let pairs = model.joint.pairs();
     let plan = plans(&case, g_chosen, pairs, opts.quick);
-    bar.set_length(plan.len() as u64 + 3);
+    bar.set_length((plan.len() + run_tolerances(opts).len()) as u64 + 3);
     bar.inc(1);
 
     // 2. The full reference and 3. the reduced runs.
     let span = (end_time, output_step);
     let mut runs = full_runs(model, opts, span, &mut bar)?;
-    reduced_runs(model, opts, &plan, span, &mut bar, &mut runs)?;
+    let flex = JointFlexibility::new(model)?;
+    reduced_runs(model, &flex, opts, &plan, span, &mut bar, &mut runs)?;
+    let headline = tolerance_runs(model, opts, span, &mut bar, &mut runs);
     bar.finish_and_clear();
 
     // Errors, speed-ups, Pareto front.
@@ -441,6 +480,8 @@ pub fn run_main_job(
         w_plain,
         study: st,
         runs,
+        headline,
+        headline_tolerance: opts.headline_tolerance,
         paper_anchors: anchors,
         files: Vec::new(),
         total_s: 0.0,
@@ -530,6 +571,7 @@ fn full_runs(
 /// The reduced runs of the plan (step 3), each on its own basis and under its budget.
 fn reduced_runs(
     model: &Model,
+    flex: &JointFlexibility,
     opts: &ReportOptions,
     plan: &[Plan],
     span: (f64, f64),
@@ -557,25 +599,108 @@ fn reduced_runs(
         let rm = ReducedSystem::new(model, basis.phi)?;
         let build_s = t0.elapsed().as_secs_f64();
         let dim = rm.dim();
-        let o = budgeted(
-            Ok(rm),
-            model,
-            &problem,
-            ode_options(p.functional),
-            span,
-            opts.rom_budget_s,
-        );
-        runs.push(record(
-            p.kind.name(),
-            Some(g_used),
-            dim,
-            p.functional,
-            build_s,
-            o,
-        ));
+        let t_opts =
+            transient_options(&problem, ode_options(p.functional), span, opts.rom_budget_s);
+        let rec = match run_estimated(model, flex, rm, &Scene::of(model), &t_opts, true, |_, _| {})
+        {
+            Ok((run, est)) => {
+                let mut rec = record(
+                    p.kind.name(),
+                    Some(g_used),
+                    dim,
+                    p.functional,
+                    build_s,
+                    Outcome::of_run(run),
+                );
+                match est {
+                    Ok(e) => rec.estimate = Some(e),
+                    Err(e) => rec.estimate_note = Some(e.to_string()),
+                }
+                rec
+            }
+            Err(e) => record(
+                p.kind.name(),
+                Some(g_used),
+                dim,
+                p.functional,
+                build_s,
+                Outcome::of_run(Run::failed(e)),
+            ),
+        };
+        runs.push(rec);
         bar.inc(1);
     }
     Ok(())
+}
+
+/// The tolerances the job runs: [`ReportOptions::tolerances`] (only the headline one when
+/// `quick`) and the headline one, ascending, without repeats.
+fn run_tolerances(opts: &ReportOptions) -> Vec<f64> {
+    let mut tols: Vec<f64> = if opts.quick {
+        Vec::new()
+    } else {
+        opts.tolerances.clone()
+    };
+    tols.push(opts.headline_tolerance);
+    tols.sort_by(|a, b| b.total_cmp(a));
+    tols.dedup();
+    tols
+}
+
+/// The tolerance-chosen models (step 3, [`crate::studies::tolerance`]): one run each, its
+/// offline time as the build time; returns the index of the headline model's run. A model
+/// that cannot be built or run is recorded with its status.
+fn tolerance_runs(
+    model: &Model,
+    opts: &ReportOptions,
+    span: (f64, f64),
+    bar: &mut Tracker<'_>,
+    runs: &mut Vec<RunRecord>,
+) -> Option<usize> {
+    let mut headline = None;
+    for tol in run_tolerances(opts) {
+        bar.set_message(format!("adaptive, tolerance {tol:e}"));
+        let mut t_opts = ToleranceOptions::new(tol);
+        t_opts.transient = transient_options(
+            &ProblemOptions::default(),
+            ode_options(false),
+            span,
+            opts.rom_budget_s,
+        );
+        let rec = match tolerance_model(model, &t_opts) {
+            Ok(t) => {
+                let mut rec = record(
+                    "adaptive",
+                    Some(t.pairs.len()),
+                    t.rom.dim(),
+                    false,
+                    t.offline_s,
+                    Outcome::of_run(t.run),
+                );
+                rec.tolerance = Some((tol, t.met));
+                rec.estimate = Some(t.estimate);
+                rec
+            }
+            Err(e) => {
+                let mut rec = record(
+                    "adaptive",
+                    None,
+                    0,
+                    false,
+                    0.0,
+                    Outcome::of_run(Run::failed(e)),
+                );
+                rec.tolerance = Some((tol, false));
+                rec
+            }
+        };
+        if tol == opts.headline_tolerance && rec.status.finished() {
+            headline = Some(runs.len());
+        }
+        runs.push(rec);
+        bar.inc(1);
+    }
+    headline
 }
 
 /// Each finished reduced run's relative L2 errors of ‖f_c‖, ‖f_R‖ and u_y against the full run

@@ -21,8 +21,10 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::Error;
 use crate::integrate::problem::OdeStats;
-use crate::integrate::{run, Curves, TransientOptions};
+use crate::integrate::{Curves, TransientOptions};
 use crate::model::Model;
+use crate::reduction::JointFlexibility;
+use crate::studies::tolerance::{run_estimated, RunEstimate};
 use crate::system::{ReducedSystem, Scene};
 
 /// One variant of a sweep.
@@ -120,6 +122,10 @@ pub struct VariantRun {
     pub stats: OdeStats,
     /// Output curves.
     pub curves: Curves,
+    /// The run's error estimate (`null` if none could be made, see `estimate_note`).
+    pub error_estimate: Option<RunEstimate>,
+    /// Why there is no estimate.
+    pub estimate_note: Option<String>,
 }
 
 /// A whole sweep.
@@ -161,7 +167,10 @@ fn variant_system(base: &ReducedSystem, scene: &Scene, v: &Variant) -> (ReducedS
 }
 
 /// Runs every variant on the shared reduction `rom` of `model`, `parallel` across rayon's
-/// threads or one after the other. A variant that fails is recorded with its error.
+/// threads or one after the other, each with its own error estimate
+/// ([`crate::studies::tolerance::run_estimated`]: a shared basis chosen for one variant need not
+/// suit another, and the estimate says so). A variant that fails is recorded with its error;
+/// `wall_s` is the run's own integration, the estimate's cost is not in it.
 pub fn run_sweep(
     model: &Model,
     rom: &ReducedSystem,
@@ -170,25 +179,36 @@ pub fn run_sweep(
     parallel: bool,
 ) -> Result<SweepResult, Error> {
     let base = Scene::of(model);
+    let flex = JointFlexibility::new(model)?;
     let one = |v: &Variant| {
-        let t0 = Instant::now();
         let (system, scene) = variant_system(rom, &base, v);
-        let res = run(system, &scene, opts);
-        let wall_s = t0.elapsed().as_secs_f64();
-        match res {
+        let failed = |status: String| VariantRun {
+            variant: v.clone(),
+            status,
+            wall_s: 0.0,
+            stats: OdeStats::default(),
+            curves: Curves::default(),
+            error_estimate: None,
+            estimate_note: None,
+        };
+        let (r, est) = match run_estimated(model, &flex, system, &scene, opts, true, |_, _| {}) {
+            Ok(x) => x,
+            Err(e) => return failed(e.to_string()),
+        };
+        let wall_s = r.wall_s;
+        match r.into_result() {
             Ok(r) => VariantRun {
                 variant: v.clone(),
                 status: "ok".into(),
                 wall_s,
                 stats: r.stats,
                 curves: r.curves,
+                estimate_note: est.as_ref().err().map(|e| e.to_string()),
+                error_estimate: est.ok(),
             },
             Err(e) => VariantRun {
-                variant: v.clone(),
-                status: e.to_string(),
                 wall_s,
-                stats: OdeStats::default(),
-                curves: Curves::default(),
+                ..failed(e.to_string())
             },
         }
     };

@@ -63,13 +63,13 @@ use crate::system::{ReducedSystem, Scene};
 /// the tolerance.
 pub const SELECTION_MARGIN: f64 = 0.5;
 
-/// The pair law of a model's contact under a run's problem options.
-pub fn pair_law(model: &Model, problem: &ProblemOptions) -> PairLaw {
+/// The pair law of a scene's contact under a run's problem options.
+pub fn pair_law(scene: &Scene, problem: &ProblemOptions) -> PairLaw {
     PairLaw {
-        k_n: model.contact.normal_stiffness,
+        k_n: scene.contact.normal_stiffness,
         friction: problem.friction,
-        mu: model.contact.friction_coefficient,
-        k_t: model.contact.stick_stiffness,
+        mu: scene.contact.friction_coefficient,
+        k_t: scene.contact.stick_stiffness,
         tau: problem.tau,
     }
 }
@@ -140,10 +140,10 @@ pub fn integration_errors(
     })
 }
 
-/// Runs a reduced model (its trajectory recorded) and estimates its error: the reduction part
-/// always, the integration part with `check_integration` (one more run of the same model at
-/// looser tolerances). The run's own failure is in the [`Run`]; an estimate that cannot be made
-/// is the `Err` of the second value.
+/// Runs a reduced model of `model` (its trajectory recorded) under `scene` (the model's own, or
+/// a variant's law) and estimates its error: the reduction part always, the integration part
+/// with `check_integration` (one more run of the same model at looser tolerances). The run's own
+/// failure is in the [`Run`]; an estimate that cannot be made is the `Err` of the second value.
 ///
 /// # Errors
 /// The estimator cannot be set up (a reduced model without its basis Φ, or not of `model`).
@@ -151,6 +151,7 @@ pub fn run_estimated(
     model: &Model,
     flex: &JointFlexibility,
     rom: ReducedSystem,
+    scene: &Scene,
     opts: &TransientOptions,
     check_integration: bool,
     observe: impl FnMut(f64, &[f64]),
@@ -161,10 +162,10 @@ pub fn run_estimated(
         record: true,
         ..opts.clone()
     };
-    let mut run = integrate(rom, &Scene::of(model), &opts, observe);
+    let mut run = integrate(rom, scene, &opts, observe);
     let estimate = match run.trajectory.take() {
         Some(tr) if run.status.finished() => estimator.estimate(
-            &pair_law(model, &opts.problem),
+            &pair_law(scene, &opts.problem),
             RunStates {
                 t: &run.curves.t,
                 q: &tr.q,
@@ -179,7 +180,7 @@ pub fn run_estimated(
     };
     let estimate = estimate.and_then(|detail| {
         let integration = match check {
-            Some(rom) => Some(integration_errors(rom, &Scene::of(model), &opts, &run)?),
+            Some(rom) => Some(integration_errors(rom, scene, &opts, &run)?),
             None => None,
         };
         Ok(RunEstimate {
@@ -278,8 +279,15 @@ pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<Toleran
     loop {
         let round_start = Instant::now();
         let rom = reduced_on_pairs(model, &cb, &flex, &pairs)?;
-        let (run, estimate) =
-            run_estimated(model, &flex, rom.clone(), &opts.transient, false, |_, _| {})?;
+        let (run, estimate) = run_estimated(
+            model,
+            &flex,
+            rom.clone(),
+            &Scene::of(model),
+            &opts.transient,
+            false,
+            |_, _| {},
+        )?;
         let run = run.into_result()?;
         let estimate = estimate?;
         let eta = estimate.reduction.contact_force.unwrap_or(0.0);

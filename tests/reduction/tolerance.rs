@@ -12,7 +12,7 @@ use jointrom::reduction::{build_basis, BasisKind, BasisOptions, JointFlexibility
 use jointrom::studies::tolerance::{
     run_estimated, static_tolerance_model, tolerance_model, ToleranceOptions,
 };
-use jointrom::system::ReducedSystem;
+use jointrom::system::{ReducedSystem, Scene};
 
 use crate::common::{jointrom_err, model, reference_json};
 
@@ -138,6 +138,7 @@ fn estimate_tracks_the_true_error_of_fixed_models() {
             &m,
             &flex,
             rom,
+            &Scene::of(&m),
             &TransientOptions::default(),
             false,
             |_, _| {},

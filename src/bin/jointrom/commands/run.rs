@@ -10,6 +10,7 @@ use serde_json::json;
 
 use jointrom::report::main_job as report;
 use jointrom::studies::main_job::{Progress, Report, ReportOptions};
+use jointrom::studies::tolerance::check_tolerance;
 use jointrom::{Error, Interface, Model};
 
 use super::info::info_json;
@@ -33,9 +34,14 @@ pub struct RunArgs {
     /// One JSON document on stdout (results.json).
     #[arg(long)]
     json: bool,
+    /// Tolerance of the headline reduced model: the relative L2 error of |f_c|(t) it is built
+    /// for (in (0, 1)); see `transient --tolerance`.
+    #[arg(long, default_value_t = 1e-2, allow_negative_numbers = true)]
+    tolerance: f64,
 }
 
 pub fn run(a: RunArgs) -> Result<(), Error> {
+    check_tolerance(a.tolerance)?;
     let t0 = Instant::now();
     let model = Model::from_case_name(&a.case)?;
     let t_assembly = t0.elapsed().as_secs_f64();
@@ -63,6 +69,7 @@ pub fn run(a: RunArgs) -> Result<(), Error> {
     let opts = ReportOptions {
         quick: a.quick,
         stability_dir: a.stability_dir,
+        headline_tolerance: a.tolerance,
         ..Default::default()
     };
     let bar = progress_bar(opts.progress);
@@ -107,23 +114,42 @@ fn print_report(rep: &Report, dir: &Path) {
         rep.case, rep.dofs, rep.pairs, rep.g_chosen, rep.threshold, rep.end_time, rep.total_s
     );
     println!(
-        "  {:<10} {:>4} {:>5} {:<10} {:<10} {:>10} {:>10} {:>9} {:>9}",
-        "model", "g", "size", "iteration", "status", "err |f_c|", "err uy", "CPU s", "speed-up"
+        "  {:<16} {:>4} {:>5} {:<10} {:<10} {:>10} {:>10} {:>10} {:>9} {:>9}",
+        "model",
+        "g",
+        "size",
+        "iteration",
+        "status",
+        "err |f_c|",
+        "est |f_c|",
+        "err uy",
+        "CPU s",
+        "speed-up"
     );
-    for r in &rep.runs {
+    for (i, r) in rep.runs.iter().enumerate() {
         let e = |v: Option<f64>| v.map_or("-".to_string(), |x| format!("{x:.2e}"));
+        let name = match r.tolerance {
+            Some((tol, _)) => format!("adaptive {tol:.0e}"),
+            None => r.model.clone(),
+        };
         println!(
-            "  {:<10} {:>4} {:>5} {:<10} {:<10} {:>10} {:>10} {:>9.3} {:>9}",
-            r.model,
+            "{} {:<16} {:>4} {:>5} {:<10} {:<10} {:>10} {:>10} {:>10} {:>9.3} {:>9}",
+            if rep.headline == Some(i) { "*" } else { " " },
+            name,
             r.g.map_or("-".to_string(), |g| g.to_string()),
             r.size,
             r.iteration,
             r.status,
             e(r.error_fc),
+            e(r.estimate.as_ref().and_then(|x| x.total.contact_force)),
             e(r.error_uy),
             r.cpu_s,
             r.speedup.map_or("-".to_string(), |x| format!("{x:.0}x"))
         );
     }
+    println!(
+        "* headline reduced model (tolerance {:.0e} on |f_c|(t))",
+        rep.headline_tolerance
+    );
     println!("report: {}", dir.join("report.md").display());
 }

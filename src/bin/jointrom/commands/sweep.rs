@@ -9,6 +9,7 @@ use serde_json::json;
 use jointrom::integrate::TransientOptions;
 use jointrom::reduction::{build_basis, BasisKind, BasisOptions};
 use jointrom::studies::sweep::{self, SweepResult};
+use jointrom::studies::tolerance::{tolerance_model, ToleranceOptions};
 use jointrom::system::ReducedSystem;
 use jointrom::{Error, Model};
 
@@ -23,9 +24,13 @@ pub struct SweepArgs {
     /// "normal_stiffness", "stick_stiffness"}, ...]}`).
     #[arg(long)]
     variants: PathBuf,
-    /// Basis kind: tvd, tvd-plain, modes, jim, alldof.
-    #[arg(long, value_enum, default_value_t = BasisArg::Tvd)]
-    basis: BasisArg,
+    /// Basis kind: tvd, tvd-plain, modes, jim, alldof (default tvd).
+    #[arg(long, value_enum)]
+    basis: Option<BasisArg>,
+    /// Share the tolerance-chosen model instead (see `transient --tolerance`), chosen on the
+    /// case itself; each variant's own error estimate says whether it suits the variant.
+    #[arg(long, allow_negative_numbers = true)]
+    tolerance: Option<f64>,
     /// Enrichment vectors g; default: the smallest g with w(g) >= 0.999.
     #[arg(long)]
     g: Option<usize>,
@@ -43,28 +48,42 @@ pub struct SweepArgs {
 pub fn run(a: SweepArgs) -> Result<(), Error> {
     let model = Model::from_case_name(&a.case)?;
     let list = sweep::read_variants(&a.variants)?;
-    let kind = BasisKind::from(a.basis);
-    let t0 = Instant::now();
-    let b = build_basis(
-        &model,
-        kind,
-        &BasisOptions {
-            g: a.g,
-            ..BasisOptions::default()
-        },
-    )?;
-    let g_used = b.g;
-    let rom = ReducedSystem::new(&model, b.phi)?;
-    let build_s = t0.elapsed().as_secs_f64();
     let mut opts = TransientOptions::default();
     if let Some(t) = a.end_time {
         opts.end_time = Some(positive("end-time", t)?);
     }
+    let t0 = Instant::now();
+    let (kind, g_used, rom) = match a.tolerance {
+        Some(tol) => {
+            if a.basis.is_some() || a.g.is_some() {
+                return Err(Error::Invalid(
+                    "--tolerance chooses its own basis: drop --basis and --g".into(),
+                ));
+            }
+            let mut t_opts = ToleranceOptions::new(tol);
+            t_opts.transient = opts.clone();
+            let t = tolerance_model(&model, &t_opts)?;
+            ("adaptive", t.pairs.len(), t.rom)
+        }
+        None => {
+            let kind = BasisKind::from(a.basis.unwrap_or(BasisArg::Tvd));
+            let b = build_basis(
+                &model,
+                kind,
+                &BasisOptions {
+                    g: a.g,
+                    ..BasisOptions::default()
+                },
+            )?;
+            (kind.name(), b.g, ReducedSystem::new(&model, b.phi)?)
+        }
+    };
+    let build_s = t0.elapsed().as_secs_f64();
     let res = sweep::run_sweep(&model, &rom, &list, &opts, !a.sequential)?;
     if a.json {
         print_json(&json!({
             "case": model.name,
-            "basis": kind.name(),
+            "basis": kind,
             "g": g_used,
             "basis_size": rom.dim(),
             "build_s": build_s,
@@ -74,7 +93,7 @@ pub fn run(a: SweepArgs) -> Result<(), Error> {
         println!(
             "{} — {} basis, g = {g_used}, r = {} (built once, {:.3} s); {} variants on {} threads",
             model.name,
-            kind.name(),
+            kind,
             rom.dim(),
             build_s,
             res.runs.len(),
@@ -89,8 +108,13 @@ pub fn run(a: SweepArgs) -> Result<(), Error> {
 fn print_runs(res: &SweepResult) {
     for r in &res.runs {
         let last = |v: &[f64]| v.last().copied().unwrap_or(f64::NAN);
+        let est = r
+            .error_estimate
+            .as_ref()
+            .and_then(|e| e.total.contact_force)
+            .map_or("-".to_string(), |e| format!("{e:.1e}"));
         println!(
-            "  {:<20} {:<6} {:>8.3} s {:>8} steps  final |f_c| {:.4e} N  |f_R| {:.4e} N  uy {:.4e} mm",
+            "  {:<20} {:<6} {:>8.3} s {:>8} steps  final |f_c| {:.4e} N  |f_R| {:.4e} N  uy {:.4e} mm  est. |f_c| error {est}",
             r.variant.name,
             if r.status == "ok" { "ok" } else { "failed" },
             r.wall_s,

@@ -451,12 +451,13 @@ fn run_reduced(
     let flex = JointFlexibility::new(model)?;
     let mut kept = Vec::new();
     let mut k = 0usize;
-    let (res, estimate) = run_estimated(model, &flex, rom, opts, true, |t, q| {
-        if vtu_every.is_some_and(|every| k % every == 0) {
-            kept.push((t, q.to_vec()));
-        }
-        k += 1;
-    })?;
+    let (res, estimate) =
+        run_estimated(model, &flex, rom, &Scene::of(model), opts, true, |t, q| {
+            if vtu_every.is_some_and(|every| k % every == 0) {
+                kept.push((t, q.to_vec()));
+            }
+            k += 1;
+        })?;
     let res = res.into_result()?;
     Ok(Outcome {
         res,
