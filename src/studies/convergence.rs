@@ -85,7 +85,8 @@ use crate::linalg::LinalgError;
 use crate::model::{contact_static_full, Interface, Model};
 use crate::reduction::{
     alldof_vectors, build_basis, craig_bampton, final_basis, jim_vectors, trial_vector_derivatives,
-    BasisKind, BasisOptions, JimSet, TvdOptions, DEFAULT_DROP_TOL, DEFAULT_THRESHOLD,
+    BasisKind, BasisOptions, JimSet, JointFlexibility, TvdOptions, DEFAULT_DROP_TOL,
+    DEFAULT_THRESHOLD,
 };
 use crate::system::ReducedSystem;
 
@@ -834,6 +835,31 @@ pub fn run_study(model: &Model, opts: &StudyOptions) -> Result<Study, Error> {
             jim.as_ref(),
             opts,
             ("jim", "Craig–Bampton + g Joint Interface Modes"),
+        )?;
+        series.push(ConvergenceSeries { prepare_s, ..s });
+    }
+    // The tolerance rule's basis (`crate::studies::tolerance`): the attachment modes of the
+    // pairs ranked by their force in the pair-space solution (exact), largest first.
+    {
+        let t0 = Instant::now();
+        let flex = JointFlexibility::new(model)?;
+        let load = model.master_load().map(|v| v * opts.scale);
+        let forces = flex.static_contact_forces(load)?;
+        let mut order: Vec<usize> = (0..forces.len()).collect();
+        order.sort_by(|&a, &b| forces[a].abs().total_cmp(&forces[b].abs()).reverse());
+        order.truncate(opts.max_g);
+        let att = flex.attachment_modes(&order);
+        let prepare_s = t0.elapsed().as_secs_f64();
+        let s = sweep(
+            model,
+            &full.state,
+            cb.as_ref(),
+            att.as_ref(),
+            opts,
+            (
+                "adaptive",
+                "Craig–Bampton + attachment modes of the g pairs with the largest force",
+            ),
         )?;
         series.push(ConvergenceSeries { prepare_s, ..s });
     }
