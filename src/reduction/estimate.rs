@@ -87,12 +87,11 @@
 //! ([`Estimate::pair_error`]); `crate::studies::tolerance` enriches the basis with them (and ν)
 //! until the estimate meets a tolerance, and adds the integration error of the run.
 
-use faer::linalg::solvers::Solve;
+use faer::linalg::solvers::{Llt, Solve};
 use faer::{Mat, MatRef, Side};
 
 use crate::error::Error;
 use crate::joint::law::PairLaw;
-use crate::joint::statics::{active_set_newton, ContactOptions};
 use crate::joint::{NORMAL, T1, T2};
 use crate::linalg::cholesky::SparseCholesky;
 use crate::linalg::compensated::{compensated_gram, solve_refined};
@@ -453,6 +452,7 @@ impl ErrorEstimator<'_> {
         let mut curves: [Vec<f64>; 6] = Default::default();
         let mut fc_joint = Vec::with_capacity(outputs);
         let mut corr = Corrector::new(self.flex, law);
+        let mut corr_joint = Corrector::new(self.flex, law);
         let at = |j: usize| {
             move |e: Error| match e {
                 Error::LinearAlgebra(m) => Error::LinearAlgebra(
@@ -467,7 +467,7 @@ impl ErrorEstimator<'_> {
             let pc = corr.correct(&u, p).map_err(at(j))?;
             // The joint part alone (no truncated-mode dynamics): it ranks the pairs.
             let u: Vec<f64> = u_joint.col(j).iter().copied().collect();
-            let pj = corr.correct(&u, p).map_err(at(j))?;
+            let pj = corr_joint.correct(&u, p).map_err(at(j))?;
             let (mut fc, mut fr, mut fc_rom, mut fr_rom, mut fcj) = (0.0, 0.0, 0.0, 0.0, 0.0);
             for k in 0..w {
                 fc += pc[3 * k + NORMAL].powi(2);
@@ -551,12 +551,21 @@ impl ErrorEstimator<'_> {
     }
 }
 
-/// The per-output pair-space correction (module docs).
+/// The per-output pair-space correction (module docs). Consecutive outputs mostly share their
+/// active set, so each solve starts from the previous output's set and reuses its factor of
+/// `I + k_n F_AA` while the set is unchanged.
 struct Corrector<'a> {
     flex: &'a JointFlexibility,
     law: &'a PairLaw,
     w: usize,
+    /// The converged active set of the last output.
+    active: Vec<bool>,
+    /// The set and Cholesky factor of `I + k_n F_AA` last factored.
+    factor: Option<(Vec<usize>, Llt<f64>)>,
 }
+
+/// Active-set iterations per output before the projected Gauss–Seidel fallback.
+const MAX_ACTIVE_SET_ITERATIONS: usize = 50;
 
 impl<'a> Corrector<'a> {
     fn new(flex: &'a JointFlexibility, law: &'a PairLaw) -> Corrector<'a> {
@@ -564,11 +573,47 @@ impl<'a> Corrector<'a> {
             flex,
             law,
             w: flex.pairs(),
+            active: vec![false; flex.pairs()],
+            factor: None,
         }
     }
 
-    /// The corrected pair forces `p*` (3w) from `û = H f_m − G q̈` and the run's forces `p` and
-    /// slip memory `s`.
+    /// The gaps `g = ĝ − k_n F_{n,A} g_A` with `(I + k_n F_AA) g_A = ĝ_A` for the active set
+    /// `set`.
+    fn gaps(&mut self, set: &[usize], g_hat: &[f64], gaps: &mut [f64]) -> Result<(), Error> {
+        let f = &self.flex.flex;
+        let k_n = self.law.k_n;
+        let nrm = |k: usize| 3 * k + NORMAL;
+        gaps.copy_from_slice(g_hat);
+        if set.is_empty() {
+            return Ok(());
+        }
+        if self.factor.as_ref().is_none_or(|(s, _)| s != set) {
+            let a = set.len();
+            let s_mat = Mat::from_fn(a, a, |i, j| {
+                let d = if i == j { 1.0 } else { 0.0 };
+                d + k_n * f[(nrm(set[i]), nrm(set[j]))]
+            });
+            let llt = s_mat.llt(Side::Lower).map_err(|e| {
+                Error::LinearAlgebra(LinalgError::caused_by(
+                    format!("pair-space contact matrix I + k_n F_AA ({a} pairs) is not positive definite: {e:?}"),
+                    e,
+                ))
+            })?;
+            self.factor = Some((set.to_vec(), llt));
+        }
+        let (_, llt) = self.factor.as_ref().expect("factored above");
+        let rhs = Mat::from_fn(set.len(), 1, |i, _| g_hat[set[i]]);
+        let g_a = llt.solve(&rhs);
+        for (k, gk) in gaps.iter_mut().enumerate() {
+            for (i, &ki) in set.iter().enumerate() {
+                *gk -= k_n * f[(nrm(k), nrm(ki))] * g_a[(i, 0)];
+            }
+        }
+        Ok(())
+    }
+
+    /// The corrected pair forces `p*` (3w) from `û = H f_m − G q̈` and the run's forces `p`.
     fn correct(&mut self, u_hat: &[f64], p: &[f64]) -> Result<Vec<f64>, Error> {
         let w = self.w;
         let f = &self.flex.flex;
@@ -584,38 +629,40 @@ impl<'a> Corrector<'a> {
         }
         let g_hat: Vec<f64> = (0..w).map(|k| u0[3 * k + NORMAL]).collect();
         let nrm = |k: usize| 3 * k + NORMAL;
-        let state = active_set_newton(w, k_n, &ContactOptions::default(), |active, gaps| {
+        // Semismooth Newton on the active set (see `crate::joint::statics`), warm-started.
+        let mut active = std::mem::take(&mut self.active);
+        let mut gaps = vec![0.0; w];
+        let mut converged = false;
+        for _ in 0..MAX_ACTIVE_SET_ITERATIONS {
             let set: Vec<usize> = (0..w).filter(|&k| active[k]).collect();
-            let a = set.len();
-            let mut g_a = vec![0.0; a];
-            if a > 0 {
-                let s_mat = Mat::from_fn(a, a, |i, j| {
-                    let d = if i == j { 1.0 } else { 0.0 };
-                    d + k_n * f[(nrm(set[i]), nrm(set[j]))]
-                });
-                let llt = s_mat.llt(Side::Lower).map_err(|e| {
-                    Error::LinearAlgebra(LinalgError::caused_by(
-                        format!("pair-space contact matrix I + k_n F_AA ({a} pairs) is not positive definite: {e:?}"),
-                        e,
-                    ))
-                })?;
-                let rhs = Mat::from_fn(a, 1, |i, _| g_hat[set[i]]);
-                let x = llt.solve(&rhs);
-                for (i, g) in g_a.iter_mut().enumerate() {
-                    *g = x[(i, 0)];
-                }
+            self.gaps(&set, &g_hat, &mut gaps)?;
+            if let Some(k) = gaps.iter().position(|g| !g.is_finite()) {
+                return Err(Error::LinearAlgebra(
+                    format!("pair-space contact: gap of pair {k} is not finite").into(),
+                ));
             }
-            for (k, gk) in gaps.iter_mut().enumerate() {
-                let mut v = g_hat[k];
-                for (i, &ki) in set.iter().enumerate() {
-                    v -= k_n * f[(nrm(k), nrm(ki))] * g_a[i];
-                }
-                *gk = v;
+            let next: Vec<bool> = gaps.iter().map(|&g| g < 0.0).collect();
+            if next == active {
+                converged = true;
+                break;
             }
-            Ok(())
-        })?;
+            active = next;
+        }
+        let forces: Vec<f64> = if converged {
+            gaps.iter()
+                .zip(&active)
+                .map(|(&g, &a)| if a { k_n * g } else { 0.0 })
+                .collect()
+        } else {
+            // The semismooth iteration can cycle between active sets; the problem is a strictly
+            // convex QP, which projected Gauss–Seidel solves without fail.
+            let forces = projected_gauss_seidel(f, k_n, &g_hat)?;
+            active = forces.iter().map(|&p| p < 0.0).collect();
+            forces
+        };
+        self.active = active;
         let mut pc = vec![0.0; 3 * w];
-        for (k, &pk) in state.forces.iter().enumerate() {
+        for (k, &pk) in forces.iter().enumerate() {
             pc[nrm(k)] = pk;
         }
         if self.law.friction {
@@ -642,6 +689,37 @@ impl<'a> Corrector<'a> {
         }
         Ok(pc)
     }
+}
+
+/// The pair-space contact problem as the strictly convex QP it is: with compressive forces
+/// `c = −p_n ≥ 0` and gaps `g = ĝ + F_nn c`, the law `c = k_n (−g)₊` is the optimality condition
+/// of `min ½ cᵀ (F_nn + I/k_n) c + ĝᵀ c` subject to `c ≥ 0` (KKT multiplier = g). Projected
+/// Gauss–Seidel converges for any SPD matrix; it runs until no force moves by more than 1e-13
+/// of the largest (at most 100 000 sweeps, else an error). Returns `p_n = −c` (w values, N).
+fn projected_gauss_seidel(f: &Mat<f64>, k_n: f64, g_hat: &[f64]) -> Result<Vec<f64>, Error> {
+    let w = g_hat.len();
+    let nrm = |k: usize| 3 * k + NORMAL;
+    let diag: Vec<f64> = (0..w).map(|k| f[(nrm(k), nrm(k))] + 1.0 / k_n).collect();
+    let mut c = vec![0.0; w];
+    for _ in 0..100_000 {
+        let (mut moved, mut largest) = (0.0f64, 0.0f64);
+        for k in 0..w {
+            let mut grad = g_hat[k] + c[k] / k_n;
+            for (j, cj) in c.iter().enumerate() {
+                grad += f[(nrm(k), nrm(j))] * cj;
+            }
+            let next = (c[k] - grad / diag[k]).max(0.0);
+            moved = moved.max((next - c[k]).abs());
+            largest = largest.max(next);
+            c[k] = next;
+        }
+        if moved <= 1e-13 * largest || largest == 0.0 {
+            return Ok(c.iter().map(|v| -v).collect());
+        }
+    }
+    Err(Error::LinearAlgebra(
+        "pair-space contact: projected Gauss–Seidel did not converge in 100 000 sweeps".into(),
+    ))
 }
 
 /// `‖a − b‖ / ‖b‖` over all entries (`None` if `b` is zero).

@@ -238,6 +238,10 @@ pub struct Round {
     pub truncation: Option<f64>,
     /// Wall time of the round's run, s.
     pub wall_s: f64,
+    /// Wall time of the round's basis and reduced system, s.
+    pub basis_s: f64,
+    /// Wall time of the round's estimate, s.
+    pub estimate_s: f64,
 }
 
 /// The tolerance-chosen reduced model and its run.
@@ -246,6 +250,9 @@ pub struct ToleranceModel {
     pub pairs: Vec<usize>,
     /// The chosen number of fixed-interface modes ν.
     pub nu: usize,
+    /// Wall time of the setup (the joint flexibility with its factorization and modes,
+    /// Craig–Bampton), s.
+    pub setup_s: f64,
     /// The reduced system of the result (a fresh copy, not the one that ran).
     pub rom: ReducedSystem,
     /// The result's run (the last round).
@@ -274,11 +281,13 @@ pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<Toleran
     let flex = JointFlexibility::new(model)?;
     let mut nu = opts.nu;
     let mut cb = craig_bampton(model, nu)?;
+    let setup_s = start.elapsed().as_secs_f64();
     let mut pairs: Vec<usize> = Vec::new();
     let mut rounds = Vec::new();
     loop {
         let round_start = Instant::now();
         let rom = reduced_on_pairs(model, &cb, &flex, &pairs)?;
+        let basis_s = round_start.elapsed().as_secs_f64();
         let (run, estimate) = run_estimated(
             model,
             &flex,
@@ -300,6 +309,8 @@ pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<Toleran
             joint: d.joint,
             truncation: d.truncation,
             wall_s: run.wall_s,
+            basis_s,
+            estimate_s: round_start.elapsed().as_secs_f64() - basis_s - run.wall_s,
         });
         let mut changed = false;
         if eta > tol && rounds.len() < opts.max_rounds {
@@ -327,6 +338,7 @@ pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<Toleran
             return Ok(ToleranceModel {
                 pairs,
                 nu,
+                setup_s,
                 rom,
                 run,
                 met: estimate.total.contact_force.unwrap_or(0.0) <= tol,

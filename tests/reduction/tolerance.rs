@@ -116,17 +116,23 @@ fn tolerance_model_meets_the_stored_full_reference() {
     }
 }
 
-/// The estimate of a fixed model (the paper's a-priori TVD and Craig–Bampton alone, g = 0) is
-/// within a factor 2 of the true ‖f_c‖(t) error against the stored full run, from 4 % to 20×.
+/// The estimate of a fixed model (the paper's a-priori TVD, Craig–Bampton alone, g = 0, and the
+/// plain-POD TVD with g = 25, whose pair-space contact problem makes the semismooth Newton
+/// iteration cycle at t = 3e-4 s, so the projected Gauss–Seidel fallback serves it) is within a
+/// factor 2 of the true ‖f_c‖(t) error against the stored full run, from 1 % to 20×.
 #[test]
 fn estimate_tracks_the_true_error_of_fixed_models() {
     let m = model("friction_bar");
     let (_, reference) = reference_json("friction_bar_full_friction_on");
     let flex = JointFlexibility::new(&m).unwrap();
-    for g in [Some(0), None] {
+    for (kind, g) in [
+        (BasisKind::Tvd, Some(0)),
+        (BasisKind::Tvd, None),
+        (BasisKind::TvdPlain, Some(25)),
+    ] {
         let basis = build_basis(
             &m,
-            BasisKind::Tvd,
+            kind,
             &BasisOptions {
                 g,
                 ..Default::default()

@@ -293,6 +293,7 @@ fn run_tolerance(
         "met": t.met,
         "pairs": t.pairs,
         "nu": t.nu,
+        "setup_s": t.setup_s,
         "rounds": t.rounds,
     });
     if !t.met {
