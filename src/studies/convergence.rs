@@ -617,6 +617,38 @@ pub struct SpanReference {
     pub solve_s: f64,
 }
 
+/// The tolerance rule's basis ([`crate::studies::tolerance`]) as a convergence series: the
+/// attachment modes of the pairs ranked by their force in the pair-space solution (exact),
+/// largest first.
+fn adaptive_series(
+    model: &Model,
+    full: &ContactState,
+    cb: MatRef<'_, f64>,
+    opts: &StudyOptions,
+) -> Result<ConvergenceSeries, Error> {
+    let t0 = Instant::now();
+    let flex = JointFlexibility::new(model)?;
+    let load = model.master_load().map(|v| v * opts.scale);
+    let forces = flex.static_contact_forces(load)?;
+    let mut order: Vec<usize> = (0..forces.len()).collect();
+    order.sort_by(|&a, &b| forces[a].abs().total_cmp(&forces[b].abs()).reverse());
+    order.truncate(opts.max_g);
+    let att = flex.attachment_modes(&order);
+    let prepare_s = t0.elapsed().as_secs_f64();
+    let s = sweep(
+        model,
+        full,
+        cb,
+        att.as_ref(),
+        opts,
+        (
+            "adaptive",
+            "Craig–Bampton + attachment modes of the g pairs with the largest force",
+        ),
+    )?;
+    Ok(ConvergenceSeries { prepare_s, ..s })
+}
+
 /// See [`SpanReference`].
 fn span_reference(
     model: &Model,
@@ -838,31 +870,7 @@ pub fn run_study(model: &Model, opts: &StudyOptions) -> Result<Study, Error> {
         )?;
         series.push(ConvergenceSeries { prepare_s, ..s });
     }
-    // The tolerance rule's basis (`crate::studies::tolerance`): the attachment modes of the
-    // pairs ranked by their force in the pair-space solution (exact), largest first.
-    {
-        let t0 = Instant::now();
-        let flex = JointFlexibility::new(model)?;
-        let load = model.master_load().map(|v| v * opts.scale);
-        let forces = flex.static_contact_forces(load)?;
-        let mut order: Vec<usize> = (0..forces.len()).collect();
-        order.sort_by(|&a, &b| forces[a].abs().total_cmp(&forces[b].abs()).reverse());
-        order.truncate(opts.max_g);
-        let att = flex.attachment_modes(&order);
-        let prepare_s = t0.elapsed().as_secs_f64();
-        let s = sweep(
-            model,
-            &full.state,
-            cb.as_ref(),
-            att.as_ref(),
-            opts,
-            (
-                "adaptive",
-                "Craig–Bampton + attachment modes of the g pairs with the largest force",
-            ),
-        )?;
-        series.push(ConvergenceSeries { prepare_s, ..s });
-    }
+    series.push(adaptive_series(model, &full.state, cb.as_ref(), opts)?);
     // All joint DOF (paper Section 5.1): the exact limit, one column per pair.
     spans.push(span_reference(
         model,
