@@ -188,20 +188,20 @@ impl Tvd {
 /// eigen-solver's residual for the modes. So round-off in a gap is a fraction of s_j, whatever
 /// the gaps are, and `tol · s_j` is a round-off bound for every vector. Relative to the largest
 /// gap instead (the rule before issue 14), a vector that opens no gap compares round-off with
-/// round-off: its active sets were the signs of round-off, and the multilayer sheet's reduced
-/// `‖f_c‖` moved by 13 % (g = 12) when K and M were rewritten with 15 digits. Translations only:
+/// round-off: its active sets were the signs of round-off, and multiplying the multilayer
+/// sheet's K and M entrywise by `1 ± 1e-15` moved its reduced `‖f_c‖` by 2.5e-2 … 1.1e-1
+/// (`tests/reduction/roundoff.rs`). Translations only:
 /// gaps are in mm, rotations in rad (on the built-in cases the largest entry of every base
 /// vector is a translation anyway).
 ///
-/// # Why `tol = 1e-9` (measured; Craig–Bampton ν = 10, `|g_z| / s_j` of all 16 × w gaps)
-/// | case | round-off gaps | physical gaps |
-/// |---|---|---|
-/// | friction bar | 96 (the centre-line pairs under the vectors antisymmetric in z), ≤ 1.5e-11 | ≥ 1.6e-5 |
-/// | multilayer sheet | 3 × 86 (in-plane constraint modes ux, uz, ry: ≤ 9.5e-14) + 10, ≤ 1.7e-11 | ≥ 1.1e-7 |
-///
-/// No gap lies between 2e-11 and 1.1e-7; 1e-9 is ~2 decades from either side. The multilayer's
-/// welded sheets move nearly together, so its physical gaps start at 1.1e-7 s_j: the old
-/// 1e-6 against this scale would count 42 of them as zero.
+/// # Why `tol = 1e-9`
+/// Measured on the built-in cases (Craig–Bampton, ν = 10; counts in `docs/measurements.md`,
+/// section `reduction::tvd`): the round-off gaps are ≤ 2e-11 s_j (every gap of the multilayer's
+/// in-plane constraint modes ux, uz, ry, ≤ 1e-13 s_j; the friction bar's centre-line pairs
+/// under the vectors antisymmetric in z), the physical ones ≥ 1.6e-5 s_j (friction bar) and
+/// ≥ 1.1e-7 s_j (multilayer), and no gap lies in between: 1e-9 is ~2 decades from either side.
+/// The multilayer's welded sheets move nearly together, so its physical gaps start at
+/// 1.1e-7 s_j: the old 1e-6 against this scale would count 42 of them as zero.
 pub fn active_pairs(gaps: &[f64], scale: f64, k: f64, opts: &TvdOptions) -> Vec<bool> {
     let zero = opts.tol * scale;
     gaps.iter()

@@ -8,3 +8,4 @@ mod cli_basis;
 mod competitors;
 mod export;
 mod reduction;
+mod roundoff;
