@@ -250,6 +250,20 @@ impl Model {
         self.dof_map.master
     }
 
+    /// The independent DOF that are a node's own translation `x, y, z` (mm), the master's
+    /// included, ascending: not the rotations (rad), not the rigid followers' dependent DOF.
+    pub fn translation_dofs(&self) -> Vec<usize> {
+        let mut out: Vec<usize> = self
+            .dof_map
+            .nodes
+            .iter()
+            .flat_map(|node| node[..3].iter().filter_map(|d| d.as_free()))
+            .collect();
+        out.sort_unstable();
+        out.dedup();
+        out
+    }
+
     /// The lowest `count` eigenmodes with the master node free or clamped.
     pub fn modes(&self, count: usize, interface: Interface) -> Result<Modes, Error> {
         match interface {

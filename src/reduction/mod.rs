@@ -15,8 +15,9 @@
 //!    (eqs. 16, 18: the static response to the pseudoforce of eq. 19; by default the inertia
 //!    terms of eq. 15 are neglected, as in the paper's Algorithm 2, and [`TvdOptions::inertia`]
 //!    includes them for the fixed-interface modes) — `2 (v + s)²` candidates, each normalized
-//!    to `φᵀKφ = 1`. Gaps are compared with zero relative to φ_j's own scale (see
-//!    [`active_pairs`]) because eigen-solver noise makes some "zero" gaps 1e-8 of a mode.
+//!    to `φᵀKφ = 1`. Gaps are compared with zero relative to φ_j's displacement scale (its
+//!    largest translation, see [`active_pairs`]): a vector that opens no gap (an in-plane
+//!    constraint mode) has round-off gaps, and their signs must not decide its active sets.
 //! 3. [`pod()`]: the POD of the TVD (eqs. 20–25), K-weighted (the paper's choice: the POMs
 //!    approximate the deformation energy of the TVD space) or plain, with the energy ratio
 //!    `w(g)` (eq. 26) to choose the number g of joint modes `Φ̃_T` (eq. 23 scaling).
@@ -64,4 +65,7 @@ pub use competitors::{
 pub use craig_bampton::craig_bampton;
 pub use estimate::{CurveErrors, ErrorEstimator, Estimate, JointFlexibility, RunStates};
 pub use pod::{pod, pod_tvd, sigma_zero, Pod, DEFAULT_THRESHOLD, ZERO_EIGENVALUE};
-pub use tvd::{active_pairs, trial_vector_derivatives, Tvd, TvdFactor, TvdIndex, TvdOptions};
+pub use tvd::{
+    active_pairs, displacement_scales, trial_vector_derivatives, Tvd, TvdFactor, TvdIndex,
+    TvdOptions,
+};

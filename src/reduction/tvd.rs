@@ -67,14 +67,17 @@ use crate::model::Model;
 
 use crate::linalg::compensated::solve_refined_steps;
 
-/// Options of [`trial_vector_derivatives`]. Defaults: `tol = 1e-6`, `zero_gap_active = true`,
-/// `tangential = false`.
+/// Options of [`trial_vector_derivatives`]. Defaults: `tol = 1e-9`, `zero_gap_active = true`,
+/// `tangential = false`, `inertia = false`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TvdOptions {
-    /// Relative zero of a gap: under trial vector φ_j a pair gap with
-    /// `|g_z| ≤ tol · max_pairs |g|` counts as exactly zero (eigen-solver noise is ~1e-8–1e-7
-    /// of a mode's size, see [`active_pairs`]). Also the relative zero of a pseudoforce column (see
-    /// [`Tvd::negligible_columns`]).
+    /// Relative zero of a gap and of a pseudoforce, relative to the trial vector's displacement
+    /// scale `s_j` (its largest translation, [`displacement_scales`]): under φ_j a pair gap with
+    /// `|g_z| ≤ tol · s_j` counts as exactly zero ([`active_pairs`]), and a pseudoforce column of
+    /// φ_i with `‖p‖∞ ≤ tol · k · s_i` is dropped ([`Tvd::negligible_columns`]). The default
+    /// 1e-9 lies in the empty band between the round-off of the built-in cases' base vectors
+    /// (≤ 2e-11 s_j) and their smallest physical gaps (≥ 1.1e-7 s_j); measured in
+    /// [`active_pairs`].
     pub tol: f64,
     /// Whether an exactly-zero gap (in the sense of `tol`) is active. `true` is the paper's
     /// rule `g ≤ 0` (Algorithm 2, line 9); `false` makes only penetrating pairs (`g < 0`) active.
@@ -91,7 +94,7 @@ pub struct TvdOptions {
 impl Default for TvdOptions {
     fn default() -> Self {
         TvdOptions {
-            tol: 1e-6,
+            tol: 1e-9,
             zero_gap_active: true,
             tangential: false,
             inertia: false,
@@ -125,8 +128,12 @@ pub struct Tvd {
     /// Candidates whose pseudoforce is exactly zero (no active pair, or φ_i exactly zero on all
     /// active rows); dropped.
     pub zero_columns: usize,
-    /// Candidates whose pseudoforce is nonzero but below `tol` relative to φ_i's own joint scale
-    /// (`‖f‖∞ ≤ tol · k_n · max_rows |B φ_i|`): round-off, dropped too.
+    /// Candidates whose pseudoforce is nonzero but zero in the sense of [`TvdOptions::tol`]:
+    /// `‖p‖∞ ≤ tol · k · s_i` (k = k_n, or `max(k_n, k_t)` with [`TvdOptions::tangential`]; s_i
+    /// φ_i's largest translation, [`displacement_scales`]), i.e. φ_i's joint displacement on
+    /// every active row is round-off; dropped too. On the multilayer sheet these are the 96
+    /// columns of its in-plane constraint modes (i = ux, uz, ry), whose gaps are ≤ 1e-13 s_i: kept,
+    /// they were K-normalized round-off carrying 96/512 of the POD's energy.
     pub negligible_columns: usize,
     /// For each base vector j, the active pairs for `k = −1` and `k = +1`.
     pub active: Vec<[Vec<bool>; 2]>,
@@ -163,18 +170,39 @@ impl Tvd {
 }
 
 /// The active pairs under the scaled trial vector `k · φ_j`, given its normal gaps `g = B_n φ_j`
-/// (w values).
+/// (w values, mm per unit of the base) and its displacement scale `scale = s_j`, the largest
+/// translation of φ_j (mm per unit of the base; [`displacement_scales`]).
 ///
-/// A gap is "zero" when `|g_z| ≤ tol · max_z |g_z|`; a zero gap is active iff
-/// `zero_gap_active`. Otherwise pair z is active iff `k g_z < 0` (penetration). When all gaps are
-/// exactly zero (`max |g| = 0`, e.g. an in-plane constraint mode) every gap is zero and the same
-/// rule applies: all pairs are active for both signs if `zero_gap_active`, none otherwise.
+/// A gap is "zero" when `|g_z| ≤ tol · s_j`; a zero gap is active iff `zero_gap_active`.
+/// Otherwise pair z is active iff `k g_z < 0` (penetration). A vector that opens no gap (all
+/// gaps zero, e.g. an in-plane constraint mode, whose gaps are round-off) has all pairs active
+/// for both signs if `zero_gap_active` (the paper's `g ≤ 0`), none otherwise — whatever the
+/// signs of its round-off.
 ///
-/// On the built-in cases "zero" catches symmetry zeros (centre-line pairs under the vectors
-/// antisymmetric in z) and the weld pairs' true but tiny gaps; the counts, and what the rule
-/// changes, are in `docs/measurements.md`, section `reduction::tvd`.
-pub fn active_pairs(gaps: &[f64], k: f64, opts: &TvdOptions) -> Vec<bool> {
-    let scale = gaps.iter().fold(0.0f64, |a, g| a.max(g.abs()));
+/// # Why the displacement scale
+/// A gap is a difference of translations, `g_z = b_z φ_j = n · (u_upper − u_lower)` (a row of
+/// B has unit-normal weights on the two nodes' translations; a rigid follower node adds the
+/// master's rotation times its offset in mm). Its computed value carries the error of those
+/// translations, `|δg_z| ≤ ‖b_z‖₁ max|δu|`, and φ_j is computed to an error relative to its
+/// own size: `max|δu| ≲ c ε s_j` for the constraint modes (backward-stable solve with K), the
+/// eigen-solver's residual for the modes. So round-off in a gap is a fraction of s_j, whatever
+/// the gaps are, and `tol · s_j` is a round-off bound for every vector. Relative to the largest
+/// gap instead (the rule before issue 14), a vector that opens no gap compares round-off with
+/// round-off: its active sets were the signs of round-off, and multiplying the multilayer
+/// sheet's K and M entrywise by `1 ± 1e-15` moved its reduced `‖f_c‖` by 2.5e-2 … 1.1e-1
+/// (`tests/reduction/roundoff.rs`). Translations only:
+/// gaps are in mm, rotations in rad (on the built-in cases the largest entry of every base
+/// vector is a translation anyway).
+///
+/// # Why `tol = 1e-9`
+/// Measured on the built-in cases (Craig–Bampton, ν = 10; counts in `docs/measurements.md`,
+/// section `reduction::tvd`): the round-off gaps are ≤ 2e-11 s_j (every gap of the multilayer's
+/// in-plane constraint modes ux, uz, ry, ≤ 1e-13 s_j; the friction bar's centre-line pairs
+/// under the vectors antisymmetric in z), the physical ones ≥ 1.6e-5 s_j (friction bar) and
+/// ≥ 1.1e-7 s_j (multilayer), and no gap lies in between: 1e-9 is ~2 decades from either side.
+/// The multilayer's welded sheets move nearly together, so its physical gaps start at
+/// 1.1e-7 s_j: the old 1e-6 against this scale would count 42 of them as zero.
+pub fn active_pairs(gaps: &[f64], scale: f64, k: f64, opts: &TvdOptions) -> Vec<bool> {
     let zero = opts.tol * scale;
     gaps.iter()
         .map(|&g| {
@@ -187,6 +215,16 @@ pub fn active_pairs(gaps: &[f64], k: f64, opts: &TvdOptions) -> Vec<bool> {
         .collect()
 }
 
+/// The displacement scale of each base vector, `s_j = max |φ_j|` over the model's translation
+/// DOF ([`Model::translation_dofs`]; mm per unit of the base): the reference of the zero gaps
+/// and negligible pseudoforces ([`active_pairs`], [`TvdOptions::tol`]).
+pub fn displacement_scales(model: &Model, base: MatRef<'_, f64>) -> Vec<f64> {
+    let dofs = model.translation_dofs();
+    (0..base.ncols())
+        .map(|j| dofs.iter().fold(0.0f64, |a, &d| a.max(base[(d, j)].abs())))
+        .collect()
+}
+
 /// Trial vector derivatives of `base` (Algorithm 2): for each trial vector φ_j and sign
 /// `k = ±1` the active pairs of `k φ_j` ([`active_pairs`]) define
 /// `∂K/∂q_{k,j} = Σ_active k_n b_nᵀ b_n (+ k_t (b_t1ᵀ b_t1 + b_t2ᵀ b_t2))`, and for every φ_i the
@@ -195,8 +233,8 @@ pub fn active_pairs(gaps: &[f64], k: f64, opts: &TvdOptions) -> Vec<bool> {
 /// (master free, the paper's K) serves all kept right-hand sides: `K φ_{i,k,j} = f_{i,k,j}`
 /// (eqs. 16/18), through the joint flexibility columns `K⁻¹ B_uᵀ` (module docs). With
 /// [`TvdOptions::inertia`] the fixed-interface modes use eq. (15) instead. Columns are ordered
-/// j, then k = −1, +1, then i; zero pseudoforces are dropped and counted; each kept column is
-/// normalized w.r.t. K (Algorithm 2, line 20).
+/// j, then k = −1, +1, then i; zero and negligible pseudoforces are dropped and counted; each
+/// kept column is normalized w.r.t. K (Algorithm 2, line 20).
 pub fn trial_vector_derivatives(
     model: &Model,
     base: MatRef<'_, f64>,
@@ -270,6 +308,8 @@ struct TvdRun<'a> {
     base: MatRef<'a, f64>,
     /// `B φ` of every base vector (3w × nb).
     bphi: Mat<f64>,
+    /// The displacement scale of every base vector ([`displacement_scales`]).
+    scales: Vec<f64>,
     /// The joint rows that receive stiffness, B_u (m of them): each pair's normal row, or all
     /// three with [`TvdOptions::tangential`].
     used: Vec<usize>,
@@ -311,6 +351,7 @@ impl<'a> TvdRun<'a> {
             model,
             base,
             bphi,
+            scales: displacement_scales(model, base),
             used,
         }
     }
@@ -318,16 +359,12 @@ impl<'a> TvdRun<'a> {
     /// The pseudoforces `p_u = D_{k,j} B_u φ_i` of all `2 nb²` candidates, columns ordered j,
     /// then k = −1, +1, then i; zero and negligible ones dropped and counted.
     fn candidates(&self, opts: &TvdOptions) -> Candidates {
-        let (bphi, used) = (&self.bphi, &self.used);
+        let (bphi, used, scales) = (&self.bphi, &self.used, &self.scales);
         let w = self.model.joint.pairs();
         let kn = self.model.contact.normal_stiffness;
         let kt = self.model.contact.stick_stiffness;
         let nb = self.base.ncols();
         let stiff = |r: usize| if r % 3 == NORMAL { kn } else { kt };
-        // Joint scale of each φ_i over the rows that receive stiffness.
-        let joint_scale: Vec<f64> = (0..nb)
-            .map(|i| used.iter().fold(0.0f64, |a, &r| a.max(bphi[(r, i)].abs())))
-            .collect();
         let max_stiff = if opts.tangential { kn.max(kt) } else { kn };
 
         let mut out = Candidates {
@@ -341,8 +378,8 @@ impl<'a> TvdRun<'a> {
         for j in 0..nb {
             let gaps: Vec<f64> = (0..w).map(|z| bphi[(3 * z + NORMAL, j)]).collect();
             let act = [
-                active_pairs(&gaps, -1.0, opts),
-                active_pairs(&gaps, 1.0, opts),
+                active_pairs(&gaps, scales[j], -1.0, opts),
+                active_pairs(&gaps, scales[j], 1.0, opts),
             ];
             for (ki, k) in [-1i8, 1].into_iter().enumerate() {
                 for i in 0..nb {
@@ -358,7 +395,8 @@ impl<'a> TvdRun<'a> {
                         out.zero_columns += 1;
                         continue;
                     }
-                    if pmax <= opts.tol * max_stiff * joint_scale[i] {
+                    // Every active entry of φ_i is a zero in the sense of `active_pairs`.
+                    if pmax <= opts.tol * max_stiff * scales[i] {
                         out.negligible_columns += 1;
                         continue;
                     }

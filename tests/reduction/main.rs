@@ -8,4 +8,5 @@ mod cli_basis;
 mod competitors;
 mod export;
 mod reduction;
+mod roundoff;
 mod tolerance;
