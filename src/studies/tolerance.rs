@@ -7,7 +7,7 @@
 //! span of the pair attachment modes `K⁻¹ b_kᵀ`, and the POD ranks those directions by global
 //! strain energy, not by how much they change the gaps of the pairs that carry force: on the
 //! friction bar the a-priori g (w ≥ 0.999) misses ‖f_c‖(t) by 4 % and the multilayer sheet's by
-//! 53 % (measured, README). No threshold of w(g) fixes that.
+//! 41 % (measured, README). No threshold of w(g) fixes that.
 //!
 //! ## The basis
 //!
