@@ -206,4 +206,25 @@ fn tolerance_bad_input_is_named() {
         "tvd",
     ]);
     assert!(e.contains("--tolerance"), "{e}");
+    let e = jointrom_err(["transient", "friction_bar", "--strict"]);
+    assert!(e.contains("--tolerance"), "{e}");
+}
+
+/// A tolerance the model cannot meet (the multilayer at 1e-3: the integration part of the
+/// estimate is above it at the paper's rtol) is a warning with the best model, and an error
+/// with `--strict`.
+#[test]
+fn unmet_tolerance_warns_and_strict_fails() {
+    let e = jointrom_err([
+        "transient",
+        "multilayer_sheet",
+        "--tolerance",
+        "1e-3",
+        "--strict",
+        "--json",
+    ]);
+    assert!(
+        e.contains("--strict") && e.contains("exceeds --tolerance"),
+        "{e}"
+    );
 }

@@ -37,6 +37,10 @@ pub struct TransientArgs {
     /// TOL (in (0, 1); e.g. 1e-2), with --model adaptive (the default with this flag).
     #[arg(long, allow_negative_numbers = true)]
     tolerance: Option<f64>,
+    /// With --tolerance: exit non-zero (after printing the best model's run) when the estimate
+    /// does not meet the tolerance. Without it a miss is a warning.
+    #[arg(long, requires = "tolerance")]
+    strict: bool,
     /// `--model pod`: end of the full-FE training run, s (default: the run's end time).
     #[arg(long)]
     train_end: Option<f64>,
@@ -183,6 +187,23 @@ pub fn run(a: TransientArgs) -> Result<(), Error> {
         print_json(&doc);
     } else {
         print_summary(&a, &model, &o, total_s);
+    }
+    let met = o
+        .tolerance
+        .as_ref()
+        .and_then(|t| t["met"].as_bool())
+        .unwrap_or(true);
+    if a.strict && !met {
+        return Err(Error::Invalid(format!(
+            "--strict: the estimated |f_c| error {:e} of the best model exceeds --tolerance {:e} \
+             (the result above is that model's)",
+            o.estimate
+                .as_ref()
+                .and_then(|e| e.as_ref().ok())
+                .and_then(|e| e.total.contact_force)
+                .unwrap_or(f64::NAN),
+            a.tolerance.unwrap_or(f64::NAN)
+        )));
     }
     Ok(())
 }
