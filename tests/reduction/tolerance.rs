@@ -14,7 +14,7 @@ use jointrom::studies::tolerance::{
 };
 use jointrom::system::{ReducedSystem, Scene};
 
-use crate::common::{jointrom_err, model, reference_json};
+use crate::common::{jointrom_err, jointrom_json, model, reference_json};
 
 /// A reference curve of a stored full run.
 fn curve(reference: &Value, key: &str) -> Vec<f64> {
@@ -226,5 +226,26 @@ fn unmet_tolerance_warns_and_strict_fails() {
     assert!(
         e.contains("--strict") && e.contains("exceeds --tolerance"),
         "{e}"
+    );
+}
+
+/// Every reduced static run reports its error, exact: `static --basis tvd` against the full
+/// model's contact statics.
+#[test]
+fn reduced_static_reports_its_exact_error() {
+    let v = jointrom_json(["static", "friction_bar", "--basis", "tvd", "--json"]);
+    let m = model("friction_bar");
+    let full = contact_static_full(&m, m.master_load(), &ContactOptions::default()).unwrap();
+    let exact = full.state.contact_force_norm;
+    let got = v["contact_force_norm"].as_f64().unwrap();
+    let reported = v["error_estimate"]["contact_force"].as_f64().unwrap();
+    let truth = (got - exact).abs() / exact;
+    assert!(
+        truth > 1e-3,
+        "the a-priori TVD model should miss the statics ({truth})"
+    );
+    assert!(
+        (reported - truth).abs() <= 1e-9,
+        "reported {reported}, true {truth}"
     );
 }

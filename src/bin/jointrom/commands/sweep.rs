@@ -87,6 +87,7 @@ pub fn run(a: SweepArgs) -> Result<(), Error> {
             "g": g_used,
             "basis_size": rom.dim(),
             "build_s": build_s,
+            "offline_s": build_s,
             "sweep": res,
         }));
     } else {
