@@ -113,5 +113,41 @@ fn quick_report_on_the_friction_bar() {
                     && r.error_fc.is_some_and(|er| r.cpu_s < c && er < e))
         );
     }
+    // Every reduced run carries its own error estimate; where the true error is well above the
+    // integration floor (> 1e-2) the estimate is within a factor 2 of it. The headline model is
+    // the tolerance-chosen one and meets its tolerance against the full run.
+    for r in rep
+        .runs
+        .iter()
+        .filter(|r| r.model != "full" && r.status.finished())
+    {
+        let est = r
+            .estimate
+            .as_ref()
+            .and_then(|e| e.total.contact_force)
+            .unwrap_or_else(|| {
+                panic!(
+                    "{} g = {:?}: no estimate ({:?})",
+                    r.model, r.g, r.estimate_note
+                )
+            });
+        let truth = r.error_fc.unwrap();
+        if truth > 1e-2 {
+            let eff = est / truth;
+            assert!(
+                (0.5..=2.0).contains(&eff),
+                "{} g = {:?}: estimate {est}, true {truth}",
+                r.model,
+                r.g
+            );
+        }
+    }
+    let h = &rep.runs[rep.headline.expect("a headline model")];
+    assert_eq!(h.model, "adaptive");
+    assert!(
+        h.error_fc.unwrap() <= rep.headline_tolerance,
+        "headline error {:?}",
+        h.error_fc
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }
