@@ -1,0 +1,58 @@
+//! Error-controlled reduction benchmarks (issue 14): the tolerance-chosen model
+//! (`jointrom::studies::tolerance`, TOL = 1e-2) against the full FE run, with friction, at the
+//! paper's tolerances, on both built-in scenes.
+//!
+//! Each scene is first run once over its whole window (0.2 s friction bar, 0.05 s multilayer) in
+//! this process: the full run's wall time, the chosen model's offline (basis, enrichment rounds)
+//! and online (its run) wall times and their ratio to the full run are printed — the issue's
+//! target is offline + online ≤ 10 % of the full run. Criterion then times the whole tolerance
+//! build and run over a 0.02 s window with 10 samples. Measured figures: README,
+//! "Error-controlled reduction".
+
+use std::time::Duration;
+
+use criterion::{criterion_group, criterion_main, Criterion};
+use jointrom::integrate::{run, TransientOptions};
+use jointrom::studies::tolerance::{tolerance_model, ToleranceOptions};
+use jointrom::system::{FullSystem, Scene};
+use jointrom::Model;
+
+fn tolerance(c: &mut Criterion) {
+    let mut group = c.benchmark_group("tolerance");
+    group.sample_size(10);
+    group.warm_up_time(Duration::from_millis(500));
+    group.measurement_time(Duration::from_secs(5));
+    for name in ["friction_bar", "multilayer_sheet"] {
+        let model = Model::from_case_name(name).expect("built-in case assembles");
+        let full = run(
+            FullSystem::new(&model).expect("full system"),
+            &Scene::of(&model),
+            &TransientOptions::default(),
+        )
+        .expect("full run");
+        let t = tolerance_model(&model, &ToleranceOptions::new(1e-2)).expect("tolerance model");
+        let ratio = 100.0 * (t.offline_s + t.run.wall_s) / full.wall_s;
+        println!(
+            "{name}: full {:.3} s wall ({} steps); TOL 1e-2: r = {} ({} pairs, nu = {}), \
+             offline {:.3} s + online {:.3} s = {ratio:.1} % of full ({} steps), estimate {:.2e}",
+            full.wall_s,
+            full.stats.steps,
+            t.rom.dim(),
+            t.pairs.len(),
+            t.nu,
+            t.offline_s,
+            t.run.wall_s,
+            t.run.stats.steps,
+            t.estimate.total.contact_force.unwrap_or(0.0)
+        );
+        let mut opts = ToleranceOptions::new(1e-2);
+        opts.transient.end_time = Some(0.02);
+        group.bench_function(format!("{name}_tol_1e-2_0.02s"), |b| {
+            b.iter(|| tolerance_model(&model, &opts).expect("tolerance model"))
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, tolerance);
+criterion_main!(benches);
