@@ -613,39 +613,56 @@ fn reduced_runs(
         let g_used = basis.g;
         let rm = ReducedSystem::new(model, basis.phi)?;
         let build_s = t0.elapsed().as_secs_f64();
-        let dim = rm.dim();
         let t_opts =
             transient_options(&problem, ode_options(p.functional), span, opts.rom_budget_s);
-        let rec = match run_estimated(model, flex, rm, &Scene::of(model), &t_opts, true, |_, _| {})
-        {
-            Ok((run, est)) => {
-                let mut rec = record(
-                    p.kind.name(),
-                    Some(g_used),
-                    dim,
-                    p.functional,
-                    build_s,
-                    Outcome::of_run(run),
-                );
-                match est {
-                    Ok(e) => rec.estimate = Some(e),
-                    Err(e) => rec.estimate_note = Some(e.to_string()),
-                }
-                rec
-            }
-            Err(e) => record(
-                p.kind.name(),
-                Some(g_used),
-                dim,
-                p.functional,
-                build_s,
-                Outcome::of_run(Run::failed(e)),
-            ),
-        };
+        let rec = estimated_record(
+            model,
+            flex,
+            rm,
+            &t_opts,
+            (p.kind.name(), g_used, p.functional, build_s),
+        );
         runs.push(rec);
         bar.inc(1);
     }
     Ok(())
+}
+
+/// The record of a reduced run with its error estimate; `(model, g, functional, build_s)` label
+/// it. A run that cannot start is recorded with its status.
+fn estimated_record(
+    model: &Model,
+    flex: &JointFlexibility,
+    rm: ReducedSystem,
+    t_opts: &TransientOptions,
+    (name, g, functional, build_s): (&str, usize, bool, f64),
+) -> RunRecord {
+    let dim = rm.dim();
+    match run_estimated(model, flex, rm, &Scene::of(model), t_opts, true, |_, _| {}) {
+        Ok((run, est)) => {
+            let mut rec = record(
+                name,
+                Some(g),
+                dim,
+                functional,
+                build_s,
+                Outcome::of_run(run),
+            );
+            match est {
+                Ok(e) => rec.estimate = Some(e),
+                Err(e) => rec.estimate_note = Some(e.to_string()),
+            }
+            rec
+        }
+        Err(e) => record(
+            name,
+            Some(g),
+            dim,
+            functional,
+            build_s,
+            Outcome::of_run(Run::failed(e)),
+        ),
+    }
 }
 
 /// Snapshots of the full run kept for the POD-snapshot competitor.
@@ -695,32 +712,7 @@ fn snapshot_runs(
         let build_s = t0.elapsed().as_secs_f64();
         let rec = match built {
             Ok((g_used, rm)) => {
-                let dim = rm.dim();
-                match run_estimated(model, flex, rm, &Scene::of(model), &t_opts, true, |_, _| {}) {
-                    Ok((run, est)) => {
-                        let mut rec = record(
-                            "pod",
-                            Some(g_used),
-                            dim,
-                            false,
-                            build_s,
-                            Outcome::of_run(run),
-                        );
-                        match est {
-                            Ok(e) => rec.estimate = Some(e),
-                            Err(e) => rec.estimate_note = Some(e.to_string()),
-                        }
-                        rec
-                    }
-                    Err(e) => record(
-                        "pod",
-                        Some(g_used),
-                        dim,
-                        false,
-                        build_s,
-                        Outcome::of_run(Run::failed(e)),
-                    ),
-                }
+                estimated_record(model, flex, rm, &t_opts, ("pod", g_used, false, build_s))
             }
             Err(e) => record(
                 "pod",
