@@ -1,12 +1,14 @@
 //! Linear algebra under everything else: symmetric sparse storage and products ([`sparse`]), the
 //! sparse SPD Cholesky factorization ([`cholesky`]), compensated double-double arithmetic for the
 //! ill-conditioned shell stiffness ([`compensated`]) and the generalized symmetric eigenproblem
-//! ([`eigen`]). Depends on nothing of jointrom but its error type.
+//! ([`eigen`]), and the blocked dense matrix–vector kernels of the reduced model's steps
+//! ([`kernels`]). Depends on nothing of jointrom but its error type.
 
 pub mod cholesky;
 pub mod compensated;
 pub mod eigen;
 mod error;
+pub mod kernels;
 pub mod sparse;
 
 pub use cholesky::{solve_spd, SparseCholesky};

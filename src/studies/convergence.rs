@@ -158,10 +158,10 @@ pub fn reduced_contact_static(
 ) -> Result<ReducedStatic, Error> {
     let w = model.joint.pairs();
     let r = rm.dim();
-    let b_n = Mat::from_fn(w, r, |i, j| rm.b_phi[(3 * i + NORMAL, j)]);
+    let b_n = Mat::from_fn(w, r, |i, j| rm.b_phi()[(3 * i + NORMAL, j)]);
     let f: Vec<f64> = rm.reduced_load().iter().map(|v| v * scale).collect();
     let (eta, state) = contact_static_reduced(
-        rm.k.as_ref(),
+        rm.k().as_ref(),
         b_n.as_ref(),
         &f,
         model.contact.normal_stiffness,
@@ -221,7 +221,7 @@ pub fn reduced_contact_static_damped(
     let w = model.joint.pairs();
     let r = rm.dim();
     let k_n = model.contact.normal_stiffness;
-    let b = Mat::from_fn(w, r, |i, j| rm.b_phi[(3 * i + NORMAL, j)]);
+    let b = Mat::from_fn(w, r, |i, j| rm.b_phi()[(3 * i + NORMAL, j)]);
     let f: Vec<f64> = rm.reduced_load().iter().map(|v| v * scale).collect();
     let gaps_of = |eta: &[f64]| -> Vec<f64> {
         (0..w)
@@ -231,7 +231,7 @@ pub fn reduced_contact_static_damped(
     let energy = |eta: &[f64]| -> f64 {
         let mut e = 0.0;
         for i in 0..r {
-            let ki: f64 = (0..r).map(|j| rm.k[(i, j)] * eta[j]).sum();
+            let ki: f64 = (0..r).map(|j| rm.k()[(i, j)] * eta[j]).sum();
             e += eta[i] * (0.5 * ki - f[i]);
         }
         e + 0.5 * k_n * gaps_of(eta).iter().map(|g| g.min(0.0).powi(2)).sum::<f64>()
@@ -242,7 +242,7 @@ pub fn reduced_contact_static_damped(
     for it in 1..=max_steps {
         let active: Vec<bool> = gaps_of(&eta).iter().map(|&g| g < 0.0).collect();
         active_counts.push(active.iter().filter(|&&a| a).count());
-        let mut h = rm.k.to_owned();
+        let mut h = rm.k().to_owned();
         for i in (0..w).filter(|&i| active[i]) {
             for c in 0..r {
                 let bc = k_n * b[(i, c)];

@@ -6,13 +6,15 @@ use faer::linalg::cholesky::llt::factor::{
     cholesky_in_place, cholesky_in_place_scratch, LltRegularization,
 };
 use faer::linalg::cholesky::llt::solve::solve_in_place_with_conj;
-use faer::{Conj, Mat, MatMut, Par};
+use faer::linalg::matmul::matmul;
+use faer::{Accum, Conj, Mat, MatMut, Par};
 
 use super::SecondOrderSystem;
 use crate::case::LoadSpec;
 use crate::error::Error;
 use crate::joint::JointOperator;
 use crate::linalg::compensated::compensated_gram;
+use crate::linalg::kernels;
 use crate::linalg::LinalgError;
 use crate::linalg::SymCsc;
 use crate::model::Model;
@@ -23,13 +25,19 @@ pub struct ReducedSystem {
     /// The basis Φ (n × r), mm or rad per unit coordinate; `None` for a reduced model read from
     /// a file (which carries the operators below, not Φ).
     pub phi: Option<Mat<f64>>,
-    /// `K̃ = ΦᵀKΦ` (r × r), N/mm per unit coordinate².
-    pub k: Mat<f64>,
+    /// `K̃ = ΦᵀKΦ` (r × r), N/mm per unit coordinate² (read with [`ReducedSystem::k`]).
+    k: Mat<f64>,
     /// `M̃ = ΦᵀMΦ` (r × r), t per unit coordinate²; the identity for an M-orthonormal basis.
-    pub m: Mat<f64>,
+    m: Mat<f64>,
     /// `BΦ` (3w × r), rows normal, t1, t2 per pair (as [`crate::joint::JointOperator`]), mm per
     /// unit coordinate.
-    pub b_phi: Mat<f64>,
+    b_phi: Mat<f64>,
+    /// `K̃`, `M̃` and `BΦ` column by column, and `BΦ` row by row: contiguous copies for
+    /// [`kernels`] (`y = A x` on columns, `y += Aᵀ p` on rows).
+    k_cols: Vec<f64>,
+    m_cols: Vec<f64>,
+    b_cols: Vec<f64>,
+    b_rows: Vec<f64>,
     /// Rows of Φ at the six master DOF (6 × r: ux, uy, uz (mm), rx, ry, rz (rad) per unit).
     pub phi_master: Mat<f64>,
     /// Largest absolute entry of each basis column (mm or rad per unit coordinate): the
@@ -42,9 +50,29 @@ pub struct ReducedSystem {
     m_llt: Mat<f64>,
     newton: Mat<f64>,
     newton_ok: bool,
-    /// Scratch: one pair's `K_c (BΦ)_pair` (3 × r).
+    /// Scratch of the Newton setup: the rows of `BΦ` of the pairs with a non-zero `K_c` block
+    /// (`active`) and `K_c (BΦ)` on them (`kcb`), up to 3w × r.
+    active: Mat<f64>,
     kcb: Mat<f64>,
     mem: MemBuffer,
+}
+
+/// A dense matrix's rows, concatenated.
+fn row_major(a: &Mat<f64>) -> Vec<f64> {
+    let mut out = Vec::with_capacity(a.nrows() * a.ncols());
+    for i in 0..a.nrows() {
+        out.extend((0..a.ncols()).map(|j| a[(i, j)]));
+    }
+    out
+}
+
+/// A dense matrix's columns, concatenated.
+fn col_major(a: &Mat<f64>) -> Vec<f64> {
+    let mut out = Vec::with_capacity(a.nrows() * a.ncols());
+    for j in 0..a.ncols() {
+        out.extend(a.col(j).iter().copied());
+    }
+    out
 }
 
 impl ReducedSystem {
@@ -188,9 +216,14 @@ impl ReducedSystem {
                 ))
             })?;
         }
+        let w3 = b_phi.nrows();
         Ok(ReducedSystem {
             r,
             phi,
+            k_cols: col_major(&k),
+            m_cols: col_major(&m),
+            b_cols: col_major(&b_phi),
+            b_rows: row_major(&b_phi),
             k,
             m,
             m_identity,
@@ -201,7 +234,8 @@ impl ReducedSystem {
             load,
             newton: Mat::zeros(r, r),
             newton_ok: false,
-            kcb: Mat::zeros(3, r),
+            active: Mat::zeros(w3, r),
+            kcb: Mat::zeros(w3, r),
             mem,
         })
     }
@@ -209,6 +243,22 @@ impl ReducedSystem {
     /// Reduced dimension r.
     pub fn dim(&self) -> usize {
         self.r
+    }
+
+    /// `K̃ = ΦᵀKΦ` (r × r), N/mm per unit coordinate².
+    pub fn k(&self) -> &Mat<f64> {
+        &self.k
+    }
+
+    /// `M̃ = ΦᵀMΦ` (r × r), t per unit coordinate² (the identity for an M-orthonormal basis).
+    pub fn m(&self) -> &Mat<f64> {
+        &self.m
+    }
+
+    /// `BΦ` (3w × r), rows normal, t1, t2 per pair (as [`crate::joint::JointOperator`]), mm per
+    /// unit coordinate.
+    pub fn b_phi(&self) -> &Mat<f64> {
+        &self.b_phi
     }
 
     /// `Φᵀ f_master` (r): the generalized forces of the final master load (N, N·mm per unit
@@ -230,6 +280,10 @@ impl Clone for ReducedSystem {
             k: self.k.clone(),
             m: self.m.clone(),
             b_phi: self.b_phi.clone(),
+            k_cols: self.k_cols.clone(),
+            m_cols: self.m_cols.clone(),
+            b_cols: self.b_cols.clone(),
+            b_rows: self.b_rows.clone(),
             phi_master: self.phi_master.clone(),
             column_size: self.column_size.clone(),
             load: self.load,
@@ -237,7 +291,8 @@ impl Clone for ReducedSystem {
             m_llt: self.m_llt.clone(),
             newton: Mat::zeros(self.r, self.r),
             newton_ok: false,
-            kcb: Mat::zeros(3, self.r),
+            active: Mat::zeros(self.b_phi.nrows(), self.r),
+            kcb: Mat::zeros(self.b_phi.nrows(), self.r),
             mem: MemBuffer::new(cholesky_in_place_scratch::<f64>(
                 self.r,
                 Par::Seq,
@@ -255,10 +310,14 @@ impl SecondOrderSystem for ReducedSystem {
         self.b_phi.nrows() / 3
     }
     fn mul_k_into(&self, q: &[f64], out: &mut [f64]) {
-        dense_mul(&self.k, q, out);
+        kernels::mul_col_major(&self.k_cols, q, out);
     }
     fn mul_m_into(&self, x: &[f64], out: &mut [f64]) {
-        dense_mul(&self.m, x, out);
+        if self.m_identity {
+            out.copy_from_slice(x);
+        } else {
+            kernels::mul_col_major(&self.m_cols, x, out);
+        }
     }
     fn solve_m_in_place(&mut self, x: &mut [f64]) {
         if self.m_identity {
@@ -280,12 +339,10 @@ impl SecondOrderSystem for ReducedSystem {
         }
     }
     fn joint_apply_into(&self, q: &[f64], out: &mut [f64]) {
-        dense_mul(&self.b_phi, q, out);
+        kernels::mul_col_major(&self.b_cols, q, out);
     }
     fn joint_transpose_add(&self, p: &[f64], out: &mut [f64]) {
-        for (c, o) in out.iter_mut().enumerate() {
-            *o += dot(col(&self.b_phi, c), p);
-        }
+        kernels::mul_t_add_row_major(&self.b_rows, p, out);
     }
     fn newton_factor(&mut self, gamma: f64, kc: &[f64]) -> Result<(), Error> {
         let r = self.r;
@@ -296,26 +353,37 @@ impl SecondOrderSystem for ReducedSystem {
                 self.newton[(i, j)] = self.m[(i, j)] + g2 * self.k[(i, j)];
             }
         }
+        // γ² (BΦ)ᵀ K_c (BΦ) over the pairs with a non-zero block, as one matrix product of the
+        // gathered rows A (3a × r) and K_c A.
+        let mut rows = 0;
         for pair in 0..self.pairs() {
             let block = &kc[9 * pair..9 * pair + 9];
             if block.iter().all(|&x| x == 0.0) {
                 continue;
             }
-            for a in 0..3 {
-                for c in 0..r {
-                    self.kcb[(a, c)] = (0..3)
-                        .map(|b| block[3 * a + b] * self.b_phi[(3 * pair + b, c)])
-                        .sum();
+            for c in 0..r {
+                let b = [
+                    self.b_phi[(3 * pair, c)],
+                    self.b_phi[(3 * pair + 1, c)],
+                    self.b_phi[(3 * pair + 2, c)],
+                ];
+                for a in 0..3 {
+                    self.active[(rows + a, c)] = b[a];
+                    self.kcb[(rows + a, c)] =
+                        block[3 * a] * b[0] + block[3 * a + 1] * b[1] + block[3 * a + 2] * b[2];
                 }
             }
-            for j in 0..r {
-                for i in j..r {
-                    let v: f64 = (0..3)
-                        .map(|a| self.b_phi[(3 * pair + a, i)] * self.kcb[(a, j)])
-                        .sum();
-                    self.newton[(i, j)] += g2 * v;
-                }
-            }
+            rows += 3;
+        }
+        if rows > 0 {
+            matmul(
+                self.newton.as_mut(),
+                Accum::Add,
+                self.active.as_ref().subrows(0, rows).transpose(),
+                self.kcb.as_ref().subrows(0, rows),
+                g2,
+                Par::Seq,
+            );
         }
         cholesky_in_place(
             self.newton.as_mut(),
@@ -352,51 +420,5 @@ impl SecondOrderSystem for ReducedSystem {
     }
     fn coordinate_size_into(&self, out: &mut [f64]) {
         out.copy_from_slice(&self.column_size);
-    }
-}
-
-/// Column `j` of a dense matrix as a slice (faer's `Mat` stores columns contiguously).
-fn col(a: &Mat<f64>, j: usize) -> &[f64] {
-    a.col(j)
-        .try_as_col_major()
-        .expect("columns of an owned Mat are contiguous")
-        .as_slice()
-}
-
-/// `a · b` with eight independent partial sums (so the loop vectorizes), compiled for
-/// AVX-512 / AVX2 as well and dispatched at run time.
-#[multiversion::multiversion(targets("x86_64+avx512f+avx512vl", "x86_64+avx2"))]
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    let mut acc = [0.0f64; 8];
-    let ca = a.chunks_exact(8);
-    let cb = b.chunks_exact(8);
-    let (ra, rb) = (ca.remainder(), cb.remainder());
-    for (x, y) in ca.zip(cb) {
-        for k in 0..8 {
-            acc[k] += x[k] * y[k];
-        }
-    }
-    let mut tail = 0.0;
-    for (x, y) in ra.iter().zip(rb) {
-        tail += x * y;
-    }
-    ((acc[0] + acc[4]) + (acc[1] + acc[5])) + ((acc[2] + acc[6]) + (acc[3] + acc[7])) + tail
-}
-
-/// `out += s · a` (vectorized; see [`dot`]).
-#[multiversion::multiversion(targets("x86_64+avx512f+avx512vl", "x86_64+avx2"))]
-fn axpy(s: f64, a: &[f64], out: &mut [f64]) {
-    for (o, &v) in out.iter_mut().zip(a) {
-        *o += v * s;
-    }
-}
-
-/// `out = A x` for a dense matrix, column by column.
-fn dense_mul(a: &Mat<f64>, x: &[f64], out: &mut [f64]) {
-    out.fill(0.0);
-    for (j, &xj) in x.iter().enumerate().take(a.ncols()) {
-        if xj != 0.0 {
-            axpy(xj, col(a, j), out);
-        }
     }
 }

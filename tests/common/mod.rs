@@ -257,13 +257,13 @@ pub fn reduced_contact(
     k_n: f64,
 ) -> Result<(Vec<f64>, ContactState), Error> {
     let r = red.dim();
-    let w = red.b_phi.nrows() / 3;
-    let b_n_phi = faer::Mat::from_fn(w, r, |i, j| red.b_phi[(3 * i + NORMAL, j)]);
+    let w = red.b_phi().nrows() / 3;
+    let b_n_phi = faer::Mat::from_fn(w, r, |i, j| red.b_phi()[(3 * i + NORMAL, j)]);
     let f_red: Vec<f64> = (0..r)
         .map(|c| (0..6).map(|d| red.phi_master[(d, c)] * load[d]).sum())
         .collect();
     contact_static_reduced(
-        red.k.as_ref(),
+        red.k().as_ref(),
         b_n_phi.as_ref(),
         &f_red,
         k_n,

@@ -277,12 +277,12 @@ fn assert_equilibrium(model: &Model, rm: &ReducedSystem, scale: f64, eta: &[f64]
     let r = rm.dim();
     let k_n = model.contact.normal_stiffness;
     let load = rm.reduced_load();
-    let b = |i: usize, j: usize| rm.b_phi[(3 * i + NORMAL, j)];
+    let b = |i: usize, j: usize| rm.b_phi()[(3 * i + NORMAL, j)];
     let gaps: Vec<f64> = (0..w)
         .map(|i| (0..r).map(|j| b(i, j) * eta[j]).sum())
         .collect();
     let mut res: Vec<f64> = (0..r)
-        .map(|i| (0..r).map(|j| rm.k[(i, j)] * eta[j]).sum::<f64>() - scale * load[i])
+        .map(|i| (0..r).map(|j| rm.k()[(i, j)] * eta[j]).sum::<f64>() - scale * load[i])
         .collect();
     for i in 0..w {
         if gaps[i] < 0.0 {
