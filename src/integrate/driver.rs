@@ -43,6 +43,10 @@ pub struct TransientOptions {
     /// [`crate::reduction::estimate`]); `false` by default.
     #[serde(skip)]
     pub record: bool,
+    /// Time every callback ([`Run::profile`]): costs two clock reads per callback; `false` by
+    /// default.
+    #[serde(skip)]
+    pub profile: bool,
 }
 
 impl Default for TransientOptions {
@@ -57,6 +61,7 @@ impl Default for TransientOptions {
             end_time: None,
             budget_s: None,
             record: false,
+            profile: false,
         }
     }
 }
@@ -243,9 +248,30 @@ pub struct Run {
     /// [`TransientOptions::record`].
     #[serde(skip)]
     pub trajectory: Option<Trajectory>,
+    /// Wall time per kind of callback, with [`TransientOptions::profile`].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub profile: Option<Profile>,
     /// The error that ended a run that did not finish.
     #[serde(skip)]
     pub failure: Option<Error>,
+}
+
+/// Where a run's wall time went ([`TransientOptions::profile`]): the problem's callbacks, timed
+/// one by one, and the rest — CVODE's own work (prediction, error test, step and order
+/// selection, vector operations) and the output sampling.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct Profile {
+    /// Right-hand sides: calls and wall time, s.
+    pub rhs_calls: u64,
+    pub rhs_s: f64,
+    /// Newton setups (linearization and factorization).
+    pub setup_calls: u64,
+    pub setup_s: f64,
+    /// Newton solves (including the active-set refreshes they trigger).
+    pub solve_calls: u64,
+    pub solve_s: f64,
+    /// The run's wall time minus the callbacks, s.
+    pub other_s: f64,
 }
 
 impl Run {
@@ -269,6 +295,7 @@ impl Run {
             curves: Curves::default(),
             final_state: Vec::new(),
             trajectory: None,
+            profile: None,
             failure: Some(e),
         }
     }
@@ -322,6 +349,19 @@ struct Deadline<P> {
     inner: P,
     deadline: Option<Instant>,
     exceeded: bool,
+    profile: Option<Profile>,
+}
+
+/// `f()` timed into `slot` (calls, seconds) when profiling.
+fn timed<T>(profile: bool, slot: (&mut u64, &mut f64), f: impl FnOnce() -> T) -> T {
+    if !profile {
+        return f();
+    }
+    let start = Instant::now();
+    let out = f();
+    *slot.0 += 1;
+    *slot.1 += start.elapsed().as_secs_f64();
+    out
 }
 
 impl<P: OdeProblem> OdeProblem for Deadline<P> {
@@ -335,7 +375,16 @@ impl<P: OdeProblem> OdeProblem for Deadline<P> {
                 return Err(CallbackError::Fatal("wall-clock budget exceeded".into()));
             }
         }
-        self.inner.rhs(t, y, ydot)
+        let mut p = self.profile.take();
+        let on = p.is_some();
+        let mut none = (0, 0.0);
+        let slot = match &mut p {
+            Some(p) => (&mut p.rhs_calls, &mut p.rhs_s),
+            None => (&mut none.0, &mut none.1),
+        };
+        let out = timed(on, slot, || self.inner.rhs(t, y, ydot));
+        self.profile = p;
+        out
     }
     fn num_roots(&self) -> usize {
         self.inner.num_roots()
@@ -357,7 +406,16 @@ impl<P: OdeProblem> OdeProblem for Deadline<P> {
         jok: bool,
         gamma: f64,
     ) -> Result<bool, CallbackError> {
-        self.inner.newton_setup(t, y, fy, jok, gamma)
+        let mut p = self.profile.take();
+        let on = p.is_some();
+        let mut none = (0, 0.0);
+        let slot = match &mut p {
+            Some(p) => (&mut p.setup_calls, &mut p.setup_s),
+            None => (&mut none.0, &mut none.1),
+        };
+        let out = timed(on, slot, || self.inner.newton_setup(t, y, fy, jok, gamma));
+        self.profile = p;
+        out
     }
     fn newton_solve(
         &mut self,
@@ -367,7 +425,16 @@ impl<P: OdeProblem> OdeProblem for Deadline<P> {
         z: &mut [f64],
         gamma: f64,
     ) -> Result<(), CallbackError> {
-        self.inner.newton_solve(t, y, r, z, gamma)
+        let mut p = self.profile.take();
+        let on = p.is_some();
+        let mut none = (0, 0.0);
+        let slot = match &mut p {
+            Some(p) => (&mut p.solve_calls, &mut p.solve_s),
+            None => (&mut none.0, &mut none.1),
+        };
+        let out = timed(on, slot, || self.inner.newton_solve(t, y, r, z, gamma));
+        self.profile = p;
+        out
     }
 }
 
@@ -415,6 +482,7 @@ impl<S: SecondOrderSystem> Driver<S> {
                 .budget_s
                 .map(|b| Instant::now() + Duration::from_secs_f64(b)),
             exceeded: false,
+            profile: opts.profile.then(Profile::default),
         };
         let cv = Cvode::new(problem, 0.0, &y0, &opts.ode)?;
         Ok(Driver {
@@ -460,16 +528,23 @@ impl<S: SecondOrderSystem> Driver<S> {
             Some(Error::Chatter { .. }) => RunStatus::Chatter { t: t_reached },
             Some(e) => RunStatus::of_error(e, t_reached, self.cv.problem().exceeded),
         };
+        let mut stats = self.cv.stats();
+        stats.newton_refreshes = self.cv.problem().inner.refreshes();
+        let profile = self.cv.problem().profile.clone().map(|mut p| {
+            p.other_s = wall_s - p.rhs_s - p.setup_s - p.solve_s;
+            p
+        });
         Run {
             status,
             t_reached,
-            stats: self.cv.stats(),
+            stats,
             wall_s,
             cpu_s,
             events: self.events,
             curves: self.curves,
             final_state: self.cv.y().to_vec(),
             trajectory: self.trajectory,
+            profile,
             failure,
         }
     }

@@ -11,6 +11,6 @@ pub mod sundials;
 
 pub use crate::system::Scene;
 pub use driver::{
-    integrate, run, thread_cpu_s, Curves, Run, RunStatus, Trajectory, TransientOptions,
+    integrate, run, thread_cpu_s, Curves, Profile, Run, RunStatus, Trajectory, TransientOptions,
 };
 pub use mechanical::{EnergySample, MechanicalOde, ProblemOptions};

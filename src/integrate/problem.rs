@@ -148,7 +148,14 @@ pub struct OdeOptions {
     pub max_step: f64,
     /// Initial step size, s (0: the integrator's estimate).
     pub init_step: f64,
+    /// Smallest step-size growth CVODE acts on after a successful step (its `eta_max_fx` of
+    /// `CVodeSetEtaFixedStepBounds`; ≥ 1). CVODE's default 1.5 keeps `h` until it could grow by
+    /// 50 %; smaller values let `h` follow the error estimate more closely.
+    pub step_growth: f64,
 }
+
+/// CVODE's own [`OdeOptions::step_growth`] (`eta_max_fx` = 1.5).
+pub const CVODE_STEP_GROWTH: f64 = 1.5;
 
 impl Default for OdeOptions {
     fn default() -> Self {
@@ -164,6 +171,7 @@ impl Default for OdeOptions {
             stab_lim_det: false,
             max_step: 0.0,
             init_step: 0.0,
+            step_growth: CVODE_STEP_GROWTH,
         }
     }
 }
@@ -209,4 +217,7 @@ pub struct OdeStats {
     pub last_step: f64,
     /// Stability-limit order reductions.
     pub stab_lim_order_reductions: u64,
+    /// Newton matrices refactored inside a Newton iteration by the problem itself (the
+    /// mechanical problem's active-set refresh; not counted in `linear_setups`).
+    pub newton_refreshes: u64,
 }

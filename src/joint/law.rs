@@ -120,6 +120,31 @@ impl PairLaw {
         }
     }
 
+    /// The branch [`PairLaw::eval`] takes at `(u, s)`, without the forces (no square root).
+    #[inline]
+    pub fn state(&self, u: [f64; 3], s: [f64; 2]) -> PairState {
+        if u[0] >= 0.0 {
+            return PairState::Open;
+        }
+        if !self.friction {
+            return PairState::Stick;
+        }
+        let (e1, e2) = (u[1] - s[0], u[2] - s[1]);
+        let c = self.radius(u[0]);
+        if e1 * e1 + e2 * e2 <= c * c {
+            PairState::Stick
+        } else {
+            PairState::Slip
+        }
+    }
+
+    /// `|e| − c`, mm: how far the elastic slip `e = u_t − s` lies outside (> 0) or inside the
+    /// stick radius `c = μ k_n (−g)₊ / k_t`.
+    #[inline]
+    pub fn cone_distance(&self, u: [f64; 3], s: [f64; 2]) -> f64 {
+        (u[1] - s[0]).hypot(u[2] - s[1]) - self.radius(u[0])
+    }
+
     /// Evaluates the law at kinematics `u = [g, u_t1, u_t2]` (mm) and memory `s` (mm; ignored
     /// with friction off).
     #[inline]

@@ -340,6 +340,7 @@ fn transient_options(
         end_time: Some(span.0),
         budget_s: Some(budget_s),
         record: false,
+        profile: false,
     }
 }
 

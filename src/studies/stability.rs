@@ -199,6 +199,9 @@ pub struct SweepOptions {
     pub budget_s: f64,
     /// Tolerance factor of the references (> 1).
     pub reference_factor: f64,
+    /// The Newton iteration's active-set refresh margin of every run, mm (`None`: off; see
+    /// [`ProblemOptions::refresh`]).
+    pub refresh: Option<f64>,
     /// Budget of a reference run, s.
     pub reference_budget_s: f64,
     /// Run the references (errors are `None` without).
@@ -229,6 +232,7 @@ impl Default for SweepOptions {
             max_steps: 20_000,
             budget_s: 20.0,
             reference_factor: 100.0,
+            refresh: ProblemOptions::default().refresh,
             reference_budget_s: 60.0,
             references: true,
             basis: BasisOptions::default(),
@@ -624,6 +628,7 @@ impl Pass<'_> {
                     friction,
                     events: false,
                     velocity_scale: opts.velocity_scale,
+                    refresh: opts.refresh,
                     ..ProblemOptions::default()
                 },
                 ode: OdeOptions {
@@ -638,6 +643,7 @@ impl Pass<'_> {
                 output_step: opts.full_output_step.min(end),
                 budget_s: Some(opts.reference_budget_s),
                 record: false,
+                profile: false,
             };
             let o = system_run(self.model, prep, &spec);
             self.progress(&format!(
@@ -691,6 +697,7 @@ impl Pass<'_> {
                                 friction,
                                 events,
                                 velocity_scale: opts.velocity_scale,
+                                refresh: opts.refresh,
                                 ..ProblemOptions::default()
                             },
                             ode: OdeOptions {
@@ -705,6 +712,7 @@ impl Pass<'_> {
                             output_step: dt.min(end),
                             budget_s: Some(opts.budget_s),
                             record: false,
+                            profile: false,
                         };
                         let o = system_run(self.model, prep, &spec);
                         let cell = Cell {

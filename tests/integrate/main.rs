@@ -6,5 +6,6 @@ mod common;
 
 mod cvode;
 mod friction;
+mod refresh;
 mod system;
 mod transient_reference;

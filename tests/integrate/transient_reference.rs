@@ -101,8 +101,11 @@ fn rom_errors(friction: bool, g: Option<usize>, r: &Reference) -> (usize, f64, f
     (g_used, fc, uy, fr)
 }
 
-/// The full model over the first 0.01 s reproduces the stored curves (same defaults); the
-/// default-vs-tight difference of the reference over this window bounds the tolerance.
+/// The full model over the first 0.01 s reproduces the stored curves with the settings they were
+/// made with (the defaults of then: no active-set refresh); the default-vs-tight difference of
+/// the reference over this window bounds the tolerance. (With the refresh the early forces,
+/// ≤ 0.08 N here, move by up to 7 % in this window — both runs are within atol = 1e-6 mm of
+/// gap, i.e. 0.01 N of force per pair; over 0.2 s the refresh run is within 1e-3.)
 #[test]
 fn full_model_short_window_reproduces_the_stored_reference() {
     let model = common::model("friction_bar");
@@ -112,7 +115,9 @@ fn full_model_short_window_reproduces_the_stored_reference() {
     ] {
         let r = reference(name);
         let sys = FullSystem::new(&model).unwrap();
-        let res = run(sys, &Scene::of(&model), &options(friction, Some(0.01))).unwrap();
+        let mut opts = options(friction, Some(0.01));
+        opts.problem.refresh = None;
+        let res = run(sys, &Scene::of(&model), &opts).unwrap();
         assert_eq!(res.curves.t.len(), 101);
         let (fc, uy, fr) = errors(&res.curves, &r);
         eprintln!(

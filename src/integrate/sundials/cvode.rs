@@ -44,8 +44,8 @@ use sundials_sys::{
     CVodeGetNumLinSolvSetups, CVodeGetNumNonlinSolvConvFails, CVodeGetNumNonlinSolvIters,
     CVodeGetNumPrecEvals, CVodeGetNumPrecSolves, CVodeGetNumRhsEvals, CVodeGetNumStabLimOrderReds,
     CVodeGetNumSteps, CVodeGetRootInfo, CVodeInit, CVodeReInit, CVodeRootInit, CVodeSStolerances,
-    CVodeSVtolerances, CVodeSetEpsLin, CVodeSetErrHandlerFn, CVodeSetInitStep,
-    CVodeSetLinearSolver, CVodeSetMaxNumSteps, CVodeSetMaxOrd, CVodeSetMaxStep,
+    CVodeSVtolerances, CVodeSetEpsLin, CVodeSetErrHandlerFn, CVodeSetEtaFixedStepBounds,
+    CVodeSetInitStep, CVodeSetLinearSolver, CVodeSetMaxNumSteps, CVodeSetMaxOrd, CVodeSetMaxStep,
     CVodeSetNoInactiveRootWarn, CVodeSetNonlinearSolver, CVodeSetPreconditioner,
     CVodeSetRootDirection, CVodeSetStabLimDet, CVodeSetStopTime, CVodeSetUserData, SUNDenseMatrix,
     SUNLinSol_Dense, SUNNonlinSol_FixedPoint, CV_ADAMS, CV_BDF, CV_NORMAL, CV_ROOT_RETURN,
@@ -379,6 +379,10 @@ impl<P: OdeProblem> Cvode<P> {
             if opts.init_step > 0.0 {
                 self.check_cv("CVodeSetInitStep", CVodeSetInitStep(m, opts.init_step))?;
             }
+            self.check_cv(
+                "CVodeSetEtaFixedStepBounds",
+                CVodeSetEtaFixedStepBounds(m, 0.0, opts.step_growth),
+            )?;
             if opts.stab_lim_det {
                 self.check_cv("CVodeSetStabLimDet", CVodeSetStabLimDet(m, 1))?;
             }
@@ -692,6 +696,7 @@ impl<P: OdeProblem> Cvode<P> {
             last_order: if order > 0 { order } else { b.last_order },
             last_step: if step != 0.0 { step } else { b.last_step },
             stab_lim_order_reductions: b.stab_lim_order_reductions + c(CVodeGetNumStabLimOrderReds),
+            newton_refreshes: 0,
         }
     }
 
@@ -803,6 +808,9 @@ fn validate<P: OdeProblem>(problem: &P, t0: f64, y0: &[f64], o: &OdeOptions) -> 
             o.init_step.to_string(),
             "finite and ≥ 0 (0: estimated)",
         );
+    }
+    if !(o.step_growth.is_finite() && o.step_growth >= 1.0) {
+        return bad("step_growth", o.step_growth.to_string(), "finite and ≥ 1");
     }
     if o.stab_lim_det && o.method != Method::Bdf {
         return bad("stab_lim_det", "true".into(), "false with Adams (BDF only)");

@@ -75,6 +75,14 @@ pub struct TransientArgs {
     /// BDF stability-limit detection, on or off.
     #[arg(long, value_enum)]
     stab_lim_det: Option<OnOff>,
+    /// Active-set refresh inside Newton iterations: a margin in mm (a pair past its switch by
+    /// more than this re-linearizes and refactors the Newton matrix), or `off`. Default 1e-8.
+    #[arg(long)]
+    refresh: Option<String>,
+    /// Smallest step-size growth CVODE acts on after a successful step (≥ 1; CVODE's own
+    /// default 1.5).
+    #[arg(long)]
+    step_growth: Option<f64>,
     /// End time, s (default: the case's).
     #[arg(long)]
     end_time: Option<f64>,
@@ -238,6 +246,28 @@ fn transient_options(a: &TransientArgs) -> Result<TransientOptions, Error> {
     }
     if let Some(s) = a.stab_lim_det {
         o.ode.stab_lim_det = s.is_on();
+    }
+    if let Some(r) = &a.refresh {
+        o.problem.refresh = if r == "off" {
+            None
+        } else {
+            match r.parse::<f64>() {
+                Ok(m) if m.is_finite() && m >= 0.0 => Some(m),
+                _ => {
+                    return Err(Error::Invalid(format!(
+                        "--refresh must be `off` or a margin in mm (finite, >= 0), got `{r}`"
+                    )))
+                }
+            }
+        };
+    }
+    if let Some(g) = a.step_growth {
+        if !(g.is_finite() && g >= 1.0) {
+            return Err(Error::Invalid(format!(
+                "--step-growth must be finite and >= 1, got {g}"
+            )));
+        }
+        o.ode.step_growth = g;
     }
     if let Some(t) = a.end_time {
         o.end_time = Some(positive("end-time", t)?);
