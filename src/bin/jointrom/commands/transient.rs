@@ -75,6 +75,10 @@ pub struct TransientArgs {
     /// BDF stability-limit detection, on or off.
     #[arg(long, value_enum)]
     stab_lim_det: Option<OnOff>,
+    /// Time every callback of the run: JSON `"profile"` (right-hand sides, Newton setups and
+    /// solves, the rest = CVODE's own work), at two clock reads per callback.
+    #[arg(long)]
+    profile: bool,
     /// Active-set refresh inside Newton iterations: a margin in mm (a pair past its switch by
     /// more than this re-linearizes and refactors the Newton matrix), or `off`. Default 1e-8.
     #[arg(long)]
@@ -181,6 +185,7 @@ pub fn run(a: TransientArgs) -> Result<(), Error> {
         "curves": c,
         "energy_balance": c.balance(),
         "training": o.training,
+        "profile": o.res.profile,
     });
     if let Some(dir) = &a.vtu {
         let (times, states): (Vec<f64>, Vec<Vec<f64>>) =
@@ -247,6 +252,7 @@ fn transient_options(a: &TransientArgs) -> Result<TransientOptions, Error> {
     if let Some(s) = a.stab_lim_det {
         o.ode.stab_lim_det = s.is_on();
     }
+    o.profile = a.profile;
     if let Some(r) = &a.refresh {
         o.problem.refresh = if r == "off" {
             None
