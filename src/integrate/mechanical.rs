@@ -252,6 +252,12 @@ pub struct MechanicalOde<S: SecondOrderSystem> {
     refresh: Option<f64>,
     /// Re-linearizations inside Newton iterations (active-set refreshes).
     refreshes: u64,
+    /// The last right-hand side's `q`, slip states and joint kinematics `B q`: CVODE's Newton
+    /// iteration evaluates the right-hand side at the iterate it then solves at, so the
+    /// refresh check reuses the product when the iterate is the same.
+    rhs_q: Vec<f64>,
+    rhs_s: Vec<f64>,
+    rhs_u: Vec<f64>,
     /// Slip memory in mm (the states times `s_scale`).
     s_phys: Vec<f64>,
     s_scale: f64,
@@ -312,6 +318,9 @@ impl<S: SecondOrderSystem> MechanicalOde<S> {
             branch: vec![PairState::Open; w],
             refresh: opts.refresh,
             refreshes: 0,
+            rhs_q: vec![f64::NAN; n],
+            rhs_s: vec![f64::NAN; if opts.friction { 2 * w } else { 0 }],
+            rhs_u: vec![0.0; 3 * w],
             s_phys: vec![0.0; if opts.friction { 2 * w } else { 0 }],
             s_scale: opts.slip_scale,
             e_scale: opts.energy_scale,
@@ -531,7 +540,12 @@ impl<S: SecondOrderSystem> MechanicalOde<S> {
         margin: f64,
     ) -> Result<(), CallbackError> {
         let slip_margin = margin * self.s_scale;
-        self.sys.joint_apply_into(&y[..self.n], &mut self.u);
+        let (n, ns) = (self.n, self.ns());
+        if y[..n] == self.rhs_q[..] && y[2 * n..2 * n + ns] == self.rhs_s[..] {
+            self.u.copy_from_slice(&self.rhs_u);
+        } else {
+            self.sys.joint_apply_into(&y[..n], &mut self.u);
+        }
         self.load_slip(y);
         let switched = (0..self.w).any(|k| {
             let uk = [self.u[3 * k], self.u[3 * k + 1], self.u[3 * k + 2]];
@@ -620,6 +634,9 @@ impl<S: SecondOrderSystem> OdeProblem for MechanicalOde<S> {
         let (q, rest) = y.split_at(n);
         let v = &rest[..n];
         self.sys.joint_apply_into(q, &mut self.u);
+        self.rhs_q.copy_from_slice(q);
+        self.rhs_s.copy_from_slice(&y[2 * n..2 * n + ns]);
+        self.rhs_u.copy_from_slice(&self.u);
         let tot = evaluate_pairs(
             &self.law,
             &self.u,
