@@ -66,13 +66,6 @@ pub struct PairLaw {
     pub tau: f64,
 }
 
-/// `√(a² + b²)` without `hypot`'s overflow guard: the elastic slips here are mm-sized or far
-/// smaller (squares ≥ 1e-300 only below 1e-150 mm), and libm's `hypot` was 5 % of a reduced run.
-#[inline]
-fn norm2(a: f64, b: f64) -> f64 {
-    (a * a + b * b).sqrt()
-}
-
 /// Which branch of the law a pair is on.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum PairState {
@@ -149,7 +142,7 @@ impl PairLaw {
     /// stick radius `c = μ k_n (−g)₊ / k_t`.
     #[inline]
     pub fn cone_distance(&self, u: [f64; 3], s: [f64; 2]) -> f64 {
-        norm2(u[1] - s[0], u[2] - s[1]) - self.radius(u[0])
+        (u[1] - s[0]).hypot(u[2] - s[1]) - self.radius(u[0])
     }
 
     /// Evaluates the law at kinematics `u = [g, u_t1, u_t2]` (mm) and memory `s` (mm; ignored
@@ -171,7 +164,7 @@ impl PairLaw {
             };
         }
         let e = [u[1] - s[0], u[2] - s[1]];
-        let r = norm2(e[0], e[1]);
+        let r = e[0].hypot(e[1]);
         let c = self.radius(g);
         if g >= 0.0 {
             return PairResponse {
@@ -211,7 +204,7 @@ impl PairLaw {
             return t;
         }
         let e = [u[1] - s[0], u[2] - s[1]];
-        let r = norm2(e[0], e[1]);
+        let r = e[0].hypot(e[1]);
         let c = self.radius(g);
         let inv_tau = 1.0 / self.tau;
         if g >= 0.0 {
@@ -245,7 +238,7 @@ impl PairLaw {
     #[inline]
     pub fn switch(&self, u: [f64; 3], s: [f64; 2]) -> f64 {
         let e = [u[1] - s[0], u[2] - s[1]];
-        self.k_t * (self.radius(u[0]) - norm2(e[0], e[1]))
+        self.k_t * (self.radius(u[0]) - e[0].hypot(e[1]))
     }
 
     /// Stored (penalty) energy `½ k_n min(g, 0)² + ½ k_t min(|e|, c)²`, N·mm.
@@ -254,7 +247,7 @@ impl PairLaw {
         let gn = u[0].min(0.0);
         let mut w = 0.5 * self.k_n * gn * gn;
         if self.friction && u[0] < 0.0 {
-            let r = norm2(u[1] - s[0], u[2] - s[1]).min(self.radius(u[0]));
+            let r = (u[1] - s[0]).hypot(u[2] - s[1]).min(self.radius(u[0]));
             w += 0.5 * self.k_t * r * r;
         }
         w
