@@ -6,7 +6,7 @@ rule.
 Prints violations and exits non-zero if there are any. Doc comments are ignored."""
 import glob, os, re, sys
 
-ORDER = ["error", "linalg", "case", "mesh", "element", "assembly", "joint", "model", "system",
+ORDER = ["error", "files", "linalg", "case", "mesh", "element", "assembly", "joint", "model", "system",
          "reduction", "integrate", "studies", "report"]
 root = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "src")
 

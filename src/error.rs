@@ -9,10 +9,20 @@ pub use crate::linalg::LinalgError;
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum Error {
-    /// A case file could not be read.
-    #[error("{file}: cannot read: {source}")]
+    /// An input file could not be read: the file and the OS error; the message says which kind
+    /// (no such file, a folder, a link loop, a name too long, over the input budget, ...).
+    #[error("{}: cannot read: {}", file.display(), crate::files::describe(source))]
     Io {
         file: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    /// An output could not be written: the file or folder, what failed (`write`, `create
+    /// folder`, `rename into place`) and the OS error, named by kind as for [`Error::Io`].
+    #[error("{}: cannot {action}: {}", file.display(), crate::files::describe(source))]
+    Write {
+        file: PathBuf,
+        action: &'static str,
         #[source]
         source: std::io::Error,
     },

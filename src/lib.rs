@@ -62,5 +62,7 @@ pub mod report;
 
 pub mod error;
 
+pub mod files;
+
 pub use error::Error;
 pub use model::{Interface, Model};

@@ -336,10 +336,7 @@ impl Case {
 
     /// Reads, parses and validates a case file; [`Error::Io`] if it cannot be read.
     pub fn from_file(path: &Path) -> Result<Case, Error> {
-        let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
-            file: path.to_path_buf(),
-            source,
-        })?;
+        let text = crate::files::read_text(path)?;
         Case::from_json_str(&text, &path.display().to_string())
     }
 

@@ -197,10 +197,7 @@ pub fn map_file(arg: &str) -> Result<Option<PathBuf>, Error> {
     if !path.is_file() {
         return Ok(None);
     }
-    let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
-        file: path.to_path_buf(),
-        source,
-    })?;
+    let text = crate::files::read_text(path)?;
     if !text.contains(SCHEMA) {
         return Ok(None);
     }
@@ -400,10 +397,7 @@ pub fn load(map_path: &Path) -> Result<Model, Error> {
 /// Reads the map at `map_path` (named `file` in messages) and checks its schema, version, name,
 /// contact law, load and end time.
 fn read_map(map_path: &Path, file: &str) -> Result<MatrixMap, Error> {
-    let text = std::fs::read_to_string(map_path).map_err(|source| Error::Io {
-        file: map_path.to_path_buf(),
-        source,
-    })?;
+    let text = crate::files::read_text(map_path)?;
     let map: MatrixMap = crate::case::parse_object(&text, file, "a matrix map")?;
     if map.schema != SCHEMA {
         return Err(field_err(
@@ -828,17 +822,14 @@ fn union_pattern(
 /// ids and coordinates, the rows of each node DOF, master node, rigid followers, pairs with
 /// their frames, cells, load, contact law and end time. Returns the three paths.
 pub fn write(model: &Model, dir: &Path) -> Result<Vec<PathBuf>, Error> {
-    let io = |file: &Path| {
-        let file = file.to_path_buf();
-        move |source| Error::Io { file, source }
-    };
-    std::fs::create_dir_all(dir).map_err(io(dir))?;
+    crate::files::create_dir(dir)?;
     let k_path = dir.join("K.mtx");
     let m_path = dir.join("M.mtx");
     let map_path = dir.join("model.json");
     for (a, path) in [(&model.stiffness, &k_path), (&model.mass, &m_path)] {
-        sprs::io::write_matrix_market_sym(path, &a.to_sprs(), sprs::io::SymmetryMode::Symmetric)
-            .map_err(io(path))?;
+        crate::files::write_atomic_with(path, |tmp| {
+            sprs::io::write_matrix_market_sym(tmp, &a.to_sprs(), sprs::io::SymmetryMode::Symmetric)
+        })?;
     }
     let geo = &model.geometry;
     let mut follower = vec![false; geo.nodes.len()];
@@ -927,7 +918,7 @@ pub fn write(model: &Model, dir: &Path) -> Result<Vec<PathBuf>, Error> {
         contact: model.contact,
         end_time: model.end_time,
     };
-    std::fs::write(&map_path, map_text(&map)).map_err(io(&map_path))?;
+    crate::files::write_atomic(&map_path, map_text(&map))?;
     Ok(vec![k_path, m_path, map_path])
 }
 

@@ -163,18 +163,12 @@ impl RomFile {
     /// Writes the file (pretty JSON).
     pub fn write(&self, path: &Path) -> Result<(), Error> {
         let text = serde_json::to_string_pretty(self).expect("the reduced model serialises");
-        std::fs::write(path, text).map_err(|e| Error::Io {
-            file: path.to_path_buf(),
-            source: e,
-        })
+        crate::files::write_atomic(path, text)
     }
 
     /// Reads and checks a file (errors name the file and the field).
     pub fn read(path: &Path) -> Result<RomFile, Error> {
-        let text = std::fs::read_to_string(path).map_err(|e| Error::Io {
-            file: path.to_path_buf(),
-            source: e,
-        })?;
+        let text = crate::files::read_text(path)?;
         let bad = |field: &str, msg: String| Error::Document {
             file: path.to_path_buf(),
             path: field.to_string(),

@@ -164,15 +164,19 @@ impl LineChart {
     /// Writes the chart as SVG.
     pub fn write_svg(&self, path: &Path) -> Result<(), Error> {
         ensure_font()?;
-        let root = SVGBackend::new(path, self.size).into_drawing_area();
-        self.draw(root).map_err(|e| chart_error(path, e))
+        crate::files::write_atomic_with(path, |tmp| {
+            let root = SVGBackend::new(tmp, self.size).into_drawing_area();
+            self.draw(root).map_err(|e| chart_error(path, e))
+        })
     }
 
     /// Writes the chart as PNG (the format follows the extension; use `.png`).
     pub fn write_png(&self, path: &Path) -> Result<(), Error> {
         ensure_font()?;
-        let root = BitMapBackend::new(path, self.size).into_drawing_area();
-        self.draw(root).map_err(|e| chart_error(path, e))
+        crate::files::write_atomic_with(path, |tmp| {
+            let root = BitMapBackend::new(tmp, self.size).into_drawing_area();
+            self.draw(root).map_err(|e| chart_error(path, e))
+        })
     }
 
     fn drawable(&self, x: f64, y: f64) -> bool {
@@ -412,10 +416,11 @@ fn load_font() -> Result<(), String> {
 }
 
 pub(crate) fn chart_error(path: &Path, reason: String) -> Error {
-    Error::Io {
-        file: path.to_path_buf(),
-        source: std::io::Error::other(format!("cannot draw chart: {reason}")),
-    }
+    crate::files::write_err(
+        path,
+        "write",
+        std::io::Error::other(format!("cannot draw chart: {reason}")),
+    )
 }
 
 fn xs_bounds(series: &[Series], log: bool) -> (f64, f64) {

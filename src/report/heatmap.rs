@@ -99,10 +99,14 @@ impl HeatMap {
         ensure_font()?;
         self.check().map_err(Error::Invalid)?;
         let size = self.size();
-        self.draw(SVGBackend::new(&svg, size).into_drawing_area())
-            .map_err(|e| draw_error(&svg, e))?;
-        self.draw(BitMapBackend::new(&png, size).into_drawing_area())
-            .map_err(|e| draw_error(&png, e))?;
+        crate::files::write_atomic_with(&svg, |tmp| {
+            self.draw(SVGBackend::new(tmp, size).into_drawing_area())
+                .map_err(|e| draw_error(&svg, e))
+        })?;
+        crate::files::write_atomic_with(&png, |tmp| {
+            self.draw(BitMapBackend::new(tmp, size).into_drawing_area())
+                .map_err(|e| draw_error(&png, e))
+        })?;
         Ok([svg, png])
     }
 
@@ -222,8 +226,9 @@ pub fn sequential(x: f64) -> [u8; 3] {
 }
 
 fn draw_error(path: &Path, reason: String) -> Error {
-    Error::Io {
-        file: path.to_path_buf(),
-        source: std::io::Error::other(format!("cannot draw heat map: {reason}")),
-    }
+    crate::files::write_err(
+        path,
+        "write",
+        std::io::Error::other(format!("cannot draw heat map: {reason}")),
+    )
 }

@@ -40,10 +40,7 @@ pub fn run_report_observed(
     observer: &mut dyn FnMut(&Progress),
 ) -> Result<Report, Error> {
     let t_all = Instant::now();
-    std::fs::create_dir_all(dir).map_err(|e| Error::Io {
-        file: dir.to_path_buf(),
-        source: e,
-    })?;
+    crate::files::create_dir(dir)?;
     let mut report = run_main_job(model, opts, extra, observer)?;
     write_report(model, dir, opts, &mut report, t_all)?;
     Ok(report)
@@ -65,10 +62,7 @@ pub fn write_report(
     let case = report.case.clone();
     // The static study's charts.
     let study_dir = dir.join("study");
-    std::fs::create_dir_all(&study_dir).map_err(|e| Error::Io {
-        file: study_dir.clone(),
-        source: e,
-    })?;
+    crate::files::create_dir(&study_dir)?;
     for f in crate::report::convergence::write_charts(&report.study, &study_dir)? {
         report.files.push(relative(dir, &f));
     }
@@ -93,10 +87,7 @@ pub fn write_report(
             let src = stab.join(format!("{name}.{ext}"));
             if src.is_file() {
                 let dst = dir.join(format!("{name}.{ext}"));
-                std::fs::copy(&src, &dst).map_err(|e| Error::Io {
-                    file: dst.clone(),
-                    source: e,
-                })?;
+                crate::files::write_atomic_with(&dst, |tmp| std::fs::copy(&src, tmp).map(|_| ()))?;
                 stability_files.push(relative(dir, &dst));
             }
         }
@@ -118,10 +109,7 @@ pub fn write_report(
 }
 
 fn write(path: &Path, text: &str) -> Result<(), Error> {
-    std::fs::write(path, text).map_err(|e| Error::Io {
-        file: path.to_path_buf(),
-        source: e,
-    })
+    crate::files::write_atomic(path, text)
 }
 
 fn relative(dir: &Path, f: &Path) -> String {

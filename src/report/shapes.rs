@@ -52,10 +52,7 @@ pub fn shapes(model: &Model, nu: usize, count: usize) -> Result<Shapes, Error> {
 /// Writes `craig_bampton.vtu`, `tvd.vtu`, `joint_modes.vtu` and the picture of the first (up
 /// to) four joint modes (`joint_modes.png`, `.svg`) into `dir`; returns the paths.
 pub fn write_shapes(model: &Model, s: &Shapes, dir: &Path) -> Result<Vec<PathBuf>, Error> {
-    std::fs::create_dir_all(dir).map_err(|e| Error::Io {
-        file: dir.to_path_buf(),
-        source: e,
-    })?;
+    crate::files::create_dir(dir)?;
     let mut files = Vec::new();
     for (name, m) in [
         ("craig_bampton", &s.craig_bampton),
@@ -136,20 +133,24 @@ pub fn render_joint_modes(
     let png = stem.with_extension("png");
     let svg = stem.with_extension("svg");
     let size = (1000, 700);
-    draw_panels(
-        BitMapBackend::new(&png, size).into_drawing_area(),
-        &model.name,
-        &pos,
-        &gaps,
-    )
-    .map_err(|e| chart_error(&png, e))?;
-    draw_panels(
-        SVGBackend::new(&svg, size).into_drawing_area(),
-        &model.name,
-        &pos,
-        &gaps,
-    )
-    .map_err(|e| chart_error(&svg, e))?;
+    crate::files::write_atomic_with(&png, |tmp| {
+        draw_panels(
+            BitMapBackend::new(tmp, size).into_drawing_area(),
+            &model.name,
+            &pos,
+            &gaps,
+        )
+        .map_err(|e| chart_error(&png, e))
+    })?;
+    crate::files::write_atomic_with(&svg, |tmp| {
+        draw_panels(
+            SVGBackend::new(tmp, size).into_drawing_area(),
+            &model.name,
+            &pos,
+            &gaps,
+        )
+        .map_err(|e| chart_error(&svg, e))
+    })?;
     Ok(vec![png, svg])
 }
 

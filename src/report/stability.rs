@@ -281,16 +281,10 @@ fn ramp_legend(lo: f64, hi: f64, unit: &str) -> Vec<(String, [u8; 3])> {
 /// Writes `dir/stability.json`, `dir/stability.md` and the heat maps
 /// `dir/stability_{status,wall,error}.{svg,png}`; returns the files written.
 pub fn write_outputs(sweep: &Sweep, dir: &Path, charts: bool) -> Result<Vec<PathBuf>, Error> {
-    std::fs::create_dir_all(dir).map_err(|e| Error::Io {
-        file: dir.to_path_buf(),
-        source: e,
-    })?;
+    crate::files::create_dir(dir)?;
     let write = |name: &str, text: String| -> Result<PathBuf, Error> {
         let p = dir.join(name);
-        std::fs::write(&p, text).map_err(|e| Error::Io {
-            file: p.clone(),
-            source: e,
-        })?;
+        crate::files::write_atomic(&p, text)?;
         Ok(p)
     };
     let mut files = vec![

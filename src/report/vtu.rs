@@ -27,13 +27,6 @@ const VTK_QUAD: u8 = 9;
 /// VTK cell type of a 2-node line.
 const VTK_LINE: u8 = 3;
 
-fn io(path: &Path) -> impl FnOnce(std::io::Error) -> Error + '_ {
-    move |e| Error::Io {
-        file: path.to_path_buf(),
-        source: e,
-    }
-}
-
 /// The XML of one file: the mesh and, per shape, its two point arrays.
 fn document(model: &Model, shapes: &[(String, Vec<f64>)]) -> String {
     let geo = &model.geometry;
@@ -173,7 +166,7 @@ pub fn write_shapes(
     path: &Path,
 ) -> Result<(), Error> {
     let fields = expand_columns(model, prefix, shapes)?;
-    std::fs::write(path, document(model, &fields)).map_err(io(path))
+    crate::files::write_atomic(path, document(model, &fields))
 }
 
 /// Writes a transient displacement field: `states[k]` (model DOF) at `times[k]` (s) as
@@ -194,7 +187,7 @@ pub fn write_series(
             states.len()
         )));
     }
-    std::fs::create_dir_all(dir).map_err(io(dir))?;
+    crate::files::create_dir(dir)?;
     let mut pvd = String::from(
         "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"1.0\">\n<Collection>\n",
     );
@@ -214,7 +207,7 @@ pub fn write_series(
         let name = format!("{prefix}_{k:04}.vtu");
         let file = dir.join(&name);
         let doc = document(model, &[(prefix.to_string(), model.dof_map.expand(q))]);
-        std::fs::write(&file, doc).map_err(io(&file))?;
+        crate::files::write_atomic(&file, doc)?;
         let _ = writeln!(
             pvd,
             "<DataSet timestep=\"{t:e}\" group=\"\" part=\"0\" file=\"{name}\"/>"
@@ -222,6 +215,6 @@ pub fn write_series(
     }
     pvd.push_str("</Collection>\n</VTKFile>\n");
     let path = dir.join(format!("{prefix}.pvd"));
-    std::fs::write(&path, pvd).map_err(io(&path))?;
+    crate::files::write_atomic(&path, pvd)?;
     Ok(path)
 }

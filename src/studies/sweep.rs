@@ -55,10 +55,7 @@ struct VariantFile {
 
 /// Reads and checks a variant file (errors name the file and the field).
 pub fn read_variants(path: &Path) -> Result<Vec<Variant>, Error> {
-    let text = std::fs::read_to_string(path).map_err(|e| Error::Io {
-        file: path.to_path_buf(),
-        source: e,
-    })?;
+    let text = crate::files::read_text(path)?;
     let bad = |field: String, msg: String| Error::Document {
         file: path.to_path_buf(),
         path: field,

@@ -34,16 +34,10 @@ pub fn positive(flag: &str, v: f64) -> Result<f64, Error> {
 
 /// Creates `dir` and its parents.
 pub fn create_dir(dir: &Path) -> Result<(), Error> {
-    std::fs::create_dir_all(dir).map_err(|e| Error::Io {
-        file: dir.to_path_buf(),
-        source: e,
-    })
+    jointrom::files::create_dir(dir)
 }
 
 /// Writes `text` to `file`.
 pub fn write_file(file: &Path, text: impl AsRef<[u8]>) -> Result<(), Error> {
-    std::fs::write(file, text).map_err(|e| Error::Io {
-        file: file.to_path_buf(),
-        source: e,
-    })
+    jointrom::files::write_atomic(file, text)
 }
