@@ -192,6 +192,16 @@ impl Read for BoundedReader {
 /// Creates `dir` and its parents ([`Error::Write`] with action `create folder` on failure, e.g.
 /// when a part of the path is a file).
 pub fn create_dir(dir: &Path) -> Result<(), Error> {
+    if dir.exists() && !dir.is_dir() {
+        return Err(write_err(
+            dir,
+            "create folder",
+            std::io::Error::new(
+                std::io::ErrorKind::AlreadyExists,
+                "exists and is not a folder",
+            ),
+        ));
+    }
     std::fs::create_dir_all(dir).map_err(|e| write_err(dir, "create folder", e))
 }
 

@@ -355,7 +355,14 @@ impl Case {
     /// [`Error::Io`] (not found) whose message lists the built-in cases.
     pub fn load(arg: &str) -> Result<Case, Error> {
         let path = Path::new(arg);
-        if path.exists() {
+        // Anything at that path (even a dangling or looping link), or a path the OS refuses for
+        // another reason than "not found" (a name too long, a parent that is a file), is read as
+        // a file, so the error says what is wrong with it.
+        let not_found = matches!(
+            std::fs::symlink_metadata(path),
+            Err(ref e) if e.kind() == std::io::ErrorKind::NotFound
+        );
+        if !not_found {
             return Case::from_file(path);
         }
         if let Some(case) = Case::builtin(arg) {
