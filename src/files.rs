@@ -11,6 +11,10 @@
 //! - **names are contained**: a model or variant name becomes a file or folder name only through
 //!   [`safe_name`] (no `/`, no `..`, no absolute path, no control characters) and is printed only
 //!   through [`printable`] (control characters escaped);
+//! - **a failed command leaves nothing half-done**: a program that calls [`journal_start`]
+//!   has every file and folder this module creates recorded, and [`journal_rollback`] removes
+//!   them again (files it replaced keep their new, complete content); the `jointrom` binary
+//!   rolls back whenever a command fails;
 //! - **messages say what happened**: [`Error::Io`] (reading) and [`Error::Write`] (creating,
 //!   writing, renaming) carry the file and the OS error, and their text names the kind — no such
 //!   file, a folder where a file was expected, a parent that is not a folder, a symbolic-link
@@ -36,6 +40,25 @@ pub fn input_budget() -> u64 {
         .and_then(|v| v.trim().parse::<u64>().ok())
         .filter(|&v| v > 0)
         .unwrap_or(DEFAULT_INPUT_BUDGET)
+}
+
+/// Default bound on the size of a model, DOF (6 per node of a case's mesh, or rows of a
+/// user's matrices): 2·10⁶. Building a case's model takes about 4 GB per 10⁶ DOF today (181 000
+/// nodes: 4.1 GB for `info`), so this keeps a model inside a 24 GB machine; the check comes
+/// before anything is allocated, and `JOINTROM_MAX_DOF` raises it.
+pub const DEFAULT_DOF_BUDGET: usize = 2_000_000;
+
+/// The environment variable that overrides [`DEFAULT_DOF_BUDGET`] (a positive integer).
+pub const DOF_BUDGET_VAR: &str = "JOINTROM_MAX_DOF";
+
+/// The largest model jointrom builds, DOF: `JOINTROM_MAX_DOF` if set to a positive integer,
+/// else [`DEFAULT_DOF_BUDGET`].
+pub fn dof_budget() -> usize {
+    std::env::var(DOF_BUDGET_VAR)
+        .ok()
+        .and_then(|v| v.trim().parse::<usize>().ok())
+        .filter(|&v| v > 0)
+        .unwrap_or(DEFAULT_DOF_BUDGET)
 }
 
 /// What a file-system error means, in words (used by [`Error::Io`] and [`Error::Write`]).
@@ -189,6 +212,54 @@ impl Read for BoundedReader {
     }
 }
 
+/// What this process created since [`journal_start`] (`None`: not recording).
+static JOURNAL: std::sync::Mutex<Option<Vec<Created>>> = std::sync::Mutex::new(None);
+
+enum Created {
+    File(PathBuf),
+    Dir(PathBuf),
+}
+
+fn record(c: Created) {
+    if let Ok(mut j) = JOURNAL.lock() {
+        if let Some(list) = j.as_mut() {
+            list.push(c);
+        }
+    }
+}
+
+/// Starts recording every file and folder this module creates (and forgets an earlier record).
+pub fn journal_start() {
+    if let Ok(mut j) = JOURNAL.lock() {
+        *j = Some(Vec::new());
+    }
+}
+
+/// Stops recording and keeps what was created.
+pub fn journal_commit() {
+    if let Ok(mut j) = JOURNAL.lock() {
+        *j = None;
+    }
+}
+
+/// Stops recording and removes what was created since [`journal_start`], newest first (folders
+/// only if empty then); returns how many files and folders were removed.
+pub fn journal_rollback() -> usize {
+    let list = match JOURNAL.lock() {
+        Ok(mut j) => j.take().unwrap_or_default(),
+        Err(_) => return 0,
+    };
+    let mut removed = 0;
+    for c in list.iter().rev() {
+        let ok = match c {
+            Created::File(p) => std::fs::remove_file(p).is_ok(),
+            Created::Dir(p) => std::fs::remove_dir(p).is_ok(),
+        };
+        removed += usize::from(ok);
+    }
+    removed
+}
+
 /// Creates `dir` and its parents ([`Error::Write`] with action `create folder` on failure, e.g.
 /// when a part of the path is a file).
 pub fn create_dir(dir: &Path) -> Result<(), Error> {
@@ -202,7 +273,16 @@ pub fn create_dir(dir: &Path) -> Result<(), Error> {
             ),
         ));
     }
-    std::fs::create_dir_all(dir).map_err(|e| write_err(dir, "create folder", e))
+    let missing: Vec<PathBuf> = dir
+        .ancestors()
+        .take_while(|a| !a.as_os_str().is_empty() && !a.exists())
+        .map(Path::to_path_buf)
+        .collect();
+    std::fs::create_dir_all(dir).map_err(|e| write_err(dir, "create folder", e))?;
+    for d in missing.into_iter().rev() {
+        record(Created::Dir(d));
+    }
+    Ok(())
 }
 
 /// Writes `bytes` to `path` atomically: a temporary file in the same folder, flushed, then
@@ -248,8 +328,13 @@ pub fn write_atomic_with<E: Into<WriteFailure>>(
             WriteFailure::Error(err) => err,
         });
     }
+    let existed = path.exists();
     tmp.persist(path)
-        .map_err(|e| write_err(path, "rename into place", e.error))
+        .map_err(|e| write_err(path, "rename into place", e.error))?;
+    if !existed {
+        record(Created::File(path.to_path_buf()));
+    }
+    Ok(())
 }
 
 /// How a writer given to [`write_atomic_with`] failed: an OS error, or a jointrom error that

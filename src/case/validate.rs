@@ -6,10 +6,6 @@ use std::collections::HashMap;
 use super::{Case, ContactSpec, LoadSpec};
 use crate::error::Error;
 
-/// At most this many nodes in the whole mesh, sheets and master node (keeps absurd element
-/// counts from overflowing or exhausting memory).
-pub(crate) const MAX_NODES: usize = 10_000_000;
-
 /// Where errors go: the file label.
 pub(crate) struct Ctx<'a> {
     pub(crate) file: &'a str,
@@ -98,7 +94,7 @@ pub(crate) fn check_contact_load(
 }
 
 /// Every sheet's own fields: a unique non-empty name, finite extents of positive length, a finite
-/// y, a positive thickness, element counts ≥ 1 and a node count within [`MAX_NODES`].
+/// y, a positive thickness, element counts ≥ 1 and a model within the DOF budget ([`crate::files::dof_budget`]); sheets stacked without a joint are refused.
 pub(crate) fn check_sheets(case: &Case, ctx: &Ctx) -> Result<(), Error> {
     if case.sheets.is_empty() {
         return Err(ctx.err("sheets", "no sheets: a case needs at least one"));
@@ -144,22 +140,66 @@ pub(crate) fn check_sheets(case: &Case, ctx: &Ctx) -> Result<(), Error> {
             }
         }
         let [nx, nz] = sheet.elements;
-        // Sheet nodes so far, plus the master node, must stay within MAX_NODES.
+        // Sheet nodes so far, plus the master node, 6 DOF each, within the model-size budget
+        // (checked before anything is allocated).
+        let budget = crate::files::dof_budget();
         let total = nx
             .checked_add(1)
             .zip(nz.checked_add(1))
             .and_then(|(a, b)| a.checked_mul(b))
             .and_then(|n| n.checked_add(first + 1));
-        if total.is_none_or(|n| n > MAX_NODES) {
+        if total.is_none_or(|n| n > budget / 6) {
             return Err(ctx.err(
                 format!("{p}.elements"),
                 format!(
-                    "{nx} × {nz} elements: the mesh would have more than the {MAX_NODES} nodes \
-                     allowed"
+                    "{nx} × {nz} elements: the mesh would have more than {budget} DOF, the \
+                     model-size budget (set {} to allow more; about 4 GB per 10⁶ DOF)",
+                    crate::files::DOF_BUDGET_VAR
                 ),
             ));
         }
         first += (nx + 1) * (nz + 1);
+    }
+    check_stacking(case, ctx)
+}
+
+/// Two sheets whose plan views overlap may not lie in one plane or cut into each other, and two
+/// that touch (mid-surfaces half their thicknesses apart) must be joined by a `joints` entry:
+/// sheets laid on top of each other without a joint pass through each other without a force.
+fn check_stacking(case: &Case, ctx: &Ctx) -> Result<(), Error> {
+    let overlap = |a: [f64; 2], b: [f64; 2]| a[1].min(b[1]) - a[0].max(b[0]) > 0.0;
+    for (j, b) in case.sheets.iter().enumerate() {
+        for (i, a) in case.sheets.iter().enumerate().take(j) {
+            if !(overlap(a.x, b.x) && overlap(a.z, b.z)) {
+                continue;
+            }
+            let gap = (b.y - a.y).abs();
+            let touch = 0.5 * (a.thickness + b.thickness);
+            let joined = case.joints.iter().any(|jt| {
+                (jt.lower == a.name && jt.upper == b.name)
+                    || (jt.lower == b.name && jt.upper == a.name)
+            });
+            let names = format!("`{}` (sheets[{i}]) and `{}`", a.name, b.name);
+            if gap < touch * (1.0 - 1e-9) {
+                return Err(ctx.err(
+                    format!("sheets[{j}].y"),
+                    format!(
+                        "{names} overlap in plan and their mid-surfaces are {gap} mm apart, \
+                         less than half their thicknesses ({touch} mm): the sheets cut into \
+                         each other"
+                    ),
+                ));
+            }
+            if gap <= touch * (1.0 + 1e-9) && !joined {
+                return Err(ctx.err(
+                    format!("sheets[{j}]"),
+                    format!(
+                        "{names} lie on top of each other without a joint between them: add \
+                         {{\"lower\": ..., \"upper\": ...}} to `joints`, or move them apart"
+                    ),
+                ));
+            }
+        }
     }
     Ok(())
 }

@@ -113,6 +113,60 @@ impl Curves {
     }
 }
 
+/// The largest energy-balance residual a run may have, relative to its energy scale
+/// ([`Curves::energy_check`]): clean runs measure 2e-7–2e-5 (friction bar full FE and TVD,
+/// Newton and functional; multilayer), a run with k_n = 1e15 N/mm 0.57 (functional) and 1.0
+/// (Newton), so a miss by 1 % is a run whose numbers cannot be trusted.
+pub const ENERGY_BALANCE_TOLERANCE: f64 = 1e-2;
+
+/// The energy balance of a run in one number: `max_t |E_kin + E_strain + E_pair + D − W|`
+/// against the run's energy scale `max_t max(|W|, E_kin + E_strain + E_pair + D)`.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct EnergyCheck {
+    /// Largest |balance| over the outputs, N·mm (= mJ).
+    pub max_residual: f64,
+    /// The run's energy scale, N·mm.
+    pub energy_scale: f64,
+    /// `max_residual / energy_scale` (0 for a run without energy).
+    pub residual_ratio: f64,
+    /// [`ENERGY_BALANCE_TOLERANCE`].
+    pub tolerance: f64,
+    /// `residual_ratio <= tolerance`.
+    pub ok: bool,
+}
+
+impl Curves {
+    /// The run's [`EnergyCheck`].
+    pub fn energy_check(&self) -> EnergyCheck {
+        let mut max_residual = 0.0f64;
+        let mut energy_scale = 0.0f64;
+        for (i, b) in self.balance().into_iter().enumerate() {
+            let stored = self.kinetic[i] + self.strain[i] + self.pair[i] + self.dissipated[i];
+            energy_scale = energy_scale.max(self.external_work[i].abs()).max(stored);
+            // NaN (a run gone wrong) counts as the largest residual.
+            max_residual = if b.is_nan() {
+                f64::INFINITY
+            } else {
+                max_residual.max(b.abs())
+            };
+        }
+        let residual_ratio = if energy_scale > 0.0 {
+            max_residual / energy_scale
+        } else if max_residual > 0.0 {
+            f64::INFINITY
+        } else {
+            0.0
+        };
+        EnergyCheck {
+            max_residual,
+            energy_scale,
+            residual_ratio,
+            tolerance: ENERGY_BALANCE_TOLERANCE,
+            ok: residual_ratio <= ENERGY_BALANCE_TOLERANCE,
+        }
+    }
+}
+
 /// The states of a run at its output times ([`TransientOptions::record`]), each block stored
 /// output after output.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -301,6 +355,29 @@ impl Run {
     }
 }
 
+/// The most output points a run keeps (`end_time / output_step`): 10⁶ samples of every curve
+/// are ~100 MB with the energies; beyond that a typo (`--output-step 1e-300`, `--end-time
+/// 1e308`) would run forever with growing memory.
+pub const MAX_OUTPUTS: f64 = 1e6;
+
+/// Wall-clock budget of one command-line integration unless `--max-wall` says otherwise, s
+/// (an hour: the full FE friction bar's 0.2 s takes 3–7 s, the slowest stored stability cell
+/// 20 s).
+pub const DEFAULT_MAX_WALL_S: f64 = 3600.0;
+
+/// The number of output intervals of a run over `[0, end]` every `output_step` (both s), or an
+/// error past [`MAX_OUTPUTS`].
+pub fn output_count(end: f64, output_step: f64) -> Result<usize, Error> {
+    let n = (end / output_step - 1e-9).ceil().max(1.0);
+    if !(n <= MAX_OUTPUTS) {
+        return Err(Error::Invalid(format!(
+            "end time {end:e} s / output step {output_step:e} s = {n:e} output points, more than \
+             the {MAX_OUTPUTS:e} a run keeps: raise --output-step or lower --end-time"
+        )));
+    }
+    Ok(n as usize)
+}
+
 /// Roots in a row at the same time after which a run is [`RunStatus::Chatter`].
 pub const MAX_STALLED_ROOTS: usize = 1000;
 
@@ -348,6 +425,8 @@ pub fn run<S: SecondOrderSystem>(
 struct Deadline<P> {
     inner: P,
     deadline: Option<Instant>,
+    /// The budget behind `deadline`, s.
+    budget_s: f64,
     exceeded: bool,
     profile: Option<Profile>,
 }
@@ -372,7 +451,10 @@ impl<P: OdeProblem> OdeProblem for Deadline<P> {
         if let Some(d) = self.deadline {
             if Instant::now() > d {
                 self.exceeded = true;
-                return Err(CallbackError::Fatal("wall-clock budget exceeded".into()));
+                return Err(CallbackError::Fatal(format!(
+                    "wall-clock budget of {} s exceeded (--max-wall)",
+                    self.budget_s
+                )));
             }
         }
         let mut p = self.profile.take();
@@ -466,6 +548,14 @@ impl<S: SecondOrderSystem> Driver<S> {
                 opts.output_step
             )));
         }
+        output_count(end, opts.output_step)?;
+        if let Some(b) = opts.budget_s {
+            if !(b.is_finite() && b > 0.0) {
+                return Err(Error::Invalid(format!(
+                    "the wall-clock budget must be finite and positive, got {b} s"
+                )));
+            }
+        }
         let mut ode = MechanicalOde::new(system, &scene.contact, &opts.problem)?;
         let dim = ode.coords();
         let y0 = ode.initial_state();
@@ -481,6 +571,7 @@ impl<S: SecondOrderSystem> Driver<S> {
             deadline: opts
                 .budget_s
                 .map(|b| Instant::now() + Duration::from_secs_f64(b)),
+            budget_s: opts.budget_s.unwrap_or(f64::INFINITY),
             exceeded: false,
             profile: opts.profile.then(Profile::default),
         };
@@ -503,7 +594,7 @@ impl<S: SecondOrderSystem> Driver<S> {
         observe(0.0, &self.y0[..self.dim]);
         let wall = Instant::now();
         let cpu0 = thread_cpu_s();
-        let outputs = (self.end / self.output_step - 1e-9).ceil().max(1.0) as usize;
+        let outputs = output_count(self.end, self.output_step).unwrap_or(1);
         let mut failure = None;
         for k in 1..=outputs {
             let tout = (k as f64 * self.output_step).min(self.end);

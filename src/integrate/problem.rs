@@ -140,7 +140,8 @@ pub struct OdeOptions {
     pub atol: f64,
     /// Maximum order (BDF ≤ 5, Adams ≤ 12).
     pub max_order: usize,
-    /// Maximum number of internal steps per `solve_to` call.
+    /// Maximum number of internal steps of the whole run (all `solve_to` calls together,
+    /// across `reinit`); CVODE then returns `CV_TOO_MUCH_WORK`.
     pub max_steps: usize,
     /// BDF stability-limit detection (`CVodeSetStabLimDet`).
     pub stab_lim_det: bool,

@@ -3,7 +3,8 @@
 //!
 //! NASTRAN (DMAP `OUTPUT4`/pyNastran), Abaqus (`*MATRIX GENERATE`) and ANSYS (`HBMAT`/APDL Math)
 //! all export stiffness and mass matrices; converted to MatrixMarket (`%%MatrixMarket matrix
-//! coordinate real symmetric|general`, 1-based indices) they are read here with `sprs`. The map
+//! coordinate real symmetric|general`, 1-based indices) they are read here by the strict
+//! reader of [`super::mtx`]. The map
 //! says what the rows mean. Any command that takes a CASE takes the map's path instead:
 //!
 //! ```text
@@ -29,6 +30,8 @@
 //! | `load` | object | as in a case file: `master` (`fx, fy, fz` N, `mx, my, mz` N·mm) and `ramp` |
 //! | `contact` | object | as in a case file: `normal_stiffness`, `friction_coefficient`, `stick_stiffness` |
 //! | `end_time` | number | simulated span, s |
+//! | `max_pair_distance` | number, optional | mm; a pair whose nodes lie farther apart is refused (default 10 × the median pair distance, at least 10⁻³ × the bounding-box diagonal) |
+//! | `duplicates` | `"reject"` (default) \| `"sum"`, optional | an entry a MatrixMarket file gives twice: an error naming both lines, or added up |
 //!
 //! Rows that no node names stay in the model as internal DOF (e.g. scalar points). The kept
 //! rows are renumbered in ascending order with the master node's six moved last (the convention
@@ -39,7 +42,9 @@
 //! mismatched sizes, non-finite or non-symmetric entries (|a_ij − a_ji| > 1e-12 max|a|), a
 //! non-positive diagonal (a DOF without stiffness or mass), duplicate node ids, a row named
 //! twice, out of range or both named and fixed, a master node without six rows, a pair naming an
-//! unknown node or without translation rows along its frame, a frame that is not orthonormal
+//! unknown node or without translation rows along its frame, a pair at the master node or a
+//! rigid follower, a pair given twice, a pair whose nodes lie farther apart than
+//! `max_pair_distance`, a frame that is not orthonormal
 //! (tolerance 1e-6), cells with unknown nodes; the contact law, load and end time as in a case.
 //! An indefinite K (unsupported structure) is reported by the first factorization.
 //!
@@ -110,6 +115,34 @@ pub struct MatrixMap {
     pub contact: ContactSpec,
     /// Simulated span, s.
     pub end_time: f64,
+    /// The largest distance between the two nodes of a joint pair, mm (default: 10 × the
+    /// median pair distance, at least 10⁻³ × the model's bounding-box diagonal).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_pair_distance: Option<f64>,
+    /// What to do with an entry a MatrixMarket file gives twice: `"reject"` (default) or
+    /// `"sum"` (exporters that write element contributions unassembled).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub duplicates: Option<DuplicatePolicy>,
+}
+
+/// The map's `duplicates` field.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum DuplicatePolicy {
+    /// An entry given twice is an error naming both lines.
+    #[default]
+    Reject,
+    /// Entries given twice are added up.
+    Sum,
+}
+
+impl From<DuplicatePolicy> for super::mtx::Duplicates {
+    fn from(p: DuplicatePolicy) -> Self {
+        match p {
+            DuplicatePolicy::Reject => super::mtx::Duplicates::Reject,
+            DuplicatePolicy::Sum => super::mtx::Duplicates::Sum,
+        }
+    }
 }
 
 /// A node of the map.
@@ -201,11 +234,14 @@ pub fn map_file(arg: &str) -> Result<Option<PathBuf>, Error> {
     if !text.contains(SCHEMA) {
         return Ok(None);
     }
+    // A file that names the schema but does not parse is a broken map, reported by the map's
+    // reader (not as a case file).
     Ok(match serde_json::from_str::<Peek>(&text) {
         Ok(Peek {
             schema: Some(s), ..
         }) if s == SCHEMA => Some(path.to_path_buf()),
-        _ => None,
+        Ok(_) => None,
+        Err(_) => Some(path.to_path_buf()),
     })
 }
 
@@ -218,75 +254,7 @@ fn field_err(file: &str, path: impl Into<String>, reason: impl Into<String>) -> 
     }
 }
 
-/// One stored entry (row, column, value), 0-based.
-type Triplet = (usize, usize, f64);
-
-/// Reads a MatrixMarket file into (size, triplets as (row, col, value), 0-based), checking
-/// square, finite and symmetric.
-fn read_mtx(path: &Path) -> Result<(usize, Vec<Triplet>), Error> {
-    let file = path.display().to_string();
-    if !path.is_file() {
-        return Err(Error::Io {
-            file: path.to_path_buf(),
-            source: std::io::Error::new(std::io::ErrorKind::NotFound, "no such file"),
-        });
-    }
-    let tri: sprs::TriMat<f64> = sprs::io::read_matrix_market(path).map_err(|e| match e {
-        sprs::io::IoError::Io(source) => Error::Io {
-            file: path.to_path_buf(),
-            source,
-        },
-        other => field_err(
-            &file,
-            "$",
-            format!(
-                "not a readable MatrixMarket `coordinate real` matrix ({other}); expected a \
-                 header `%%MatrixMarket matrix coordinate real symmetric|general`, a size line \
-                 `rows cols entries` and lines `row col value` with 1-based indices"
-            ),
-        ),
-    })?;
-    let (rows, cols) = tri.shape();
-    if rows != cols {
-        return Err(field_err(
-            &file,
-            "size",
-            format!("the matrix is {rows} × {cols}; K and M must be square"),
-        ));
-    }
-    let csc: sprs::CsMat<f64> = tri.to_csc();
-    let mut out = Vec::with_capacity(csc.nnz());
-    let mut max = 0.0f64;
-    for (&v, (i, j)) in csc.iter() {
-        if !v.is_finite() {
-            return Err(field_err(
-                &file,
-                format!("entry ({}, {})", i + 1, j + 1),
-                format!("not a finite number: {v}"),
-            ));
-        }
-        max = max.max(v.abs());
-        out.push((i, j, v));
-    }
-    let tol = SYMMETRY_TOLERANCE * max;
-    for &(i, j, v) in &out {
-        if i != j {
-            let t = csc.get(j, i).copied().unwrap_or(0.0);
-            if (v - t).abs() > tol {
-                return Err(field_err(
-                    &file,
-                    format!("entry ({}, {})", i + 1, j + 1),
-                    format!(
-                        "the matrix is not symmetric: a({0}, {1}) = {v:e} but a({1}, {0}) = {t:e}",
-                        i + 1,
-                        j + 1
-                    ),
-                ));
-            }
-        }
-    }
-    Ok((rows, out))
-}
+use super::mtx::Triplet;
 
 fn frame_check(file: &str, path: &str, f: &FrameSpec) -> Result<(), Error> {
     let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
@@ -325,8 +293,9 @@ pub fn load(map_path: &Path) -> Result<Model, Error> {
     let dir = map_path.parent().unwrap_or(Path::new("."));
     let k_path = dir.join(&map.stiffness);
     let m_path = dir.join(&map.mass);
-    let (nk, k_trip) = read_mtx(&k_path)?;
-    let (nm, m_trip) = read_mtx(&m_path)?;
+    let dup = map.duplicates.unwrap_or_default().into();
+    let (nk, k_trip) = super::mtx::read(&k_path, dup)?;
+    let (nm, m_trip) = super::mtx::read(&m_path, dup)?;
     if nk != nm {
         return Err(field_err(
             &file,
@@ -657,10 +626,87 @@ impl MapReader<'_> {
             frame_check(self.file, "pair_frame", f)?;
         }
         let mut pairs = Vec::with_capacity(map.pairs.len());
+        let mut seen = HashMap::with_capacity(map.pairs.len());
         for (k, p) in map.pairs.iter().enumerate() {
-            pairs.push(self.pair(&format!("pairs[{k}]"), p, dof_map)?);
+            let path = format!("pairs[{k}]");
+            for id in [p.lower, p.upper] {
+                if id == map.master_node || map.rigid_followers.contains(&id) {
+                    return Err(field_err(
+                        self.file,
+                        &path,
+                        format!(
+                            "node {id} is the master node or tied rigidly to it: the master \
+                             introduces the load and is not a joint node"
+                        ),
+                    ));
+                }
+            }
+            let key = (p.lower.min(p.upper), p.lower.max(p.upper));
+            if let Some(first) = seen.insert(key, k) {
+                return Err(field_err(
+                    self.file,
+                    &path,
+                    format!(
+                        "the pair ({}, {}) is pairs[{first}] again",
+                        p.lower, p.upper
+                    ),
+                ));
+            }
+            pairs.push(self.pair(&path, p, dof_map)?);
         }
+        self.check_pair_distances(&pairs)?;
         Ok(pairs)
+    }
+
+    /// Joint pairs join nodes that face each other across a thin gap: a pair whose nodes are
+    /// farther apart than `max_pair_distance` (default: 10 × the median pair distance, at least
+    /// 10⁻³ × the model's bounding-box diagonal) is a mistake in the map, not a joint.
+    fn check_pair_distances(&self, pairs: &[PairFrame]) -> Result<(), Error> {
+        let xyz = |i: usize| self.map.nodes[i].xyz;
+        let dist = |p: &PairFrame| {
+            let (a, b) = (xyz(p.lower), xyz(p.upper));
+            ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
+        };
+        let limit = match self.map.max_pair_distance {
+            Some(l) if l.is_finite() && l > 0.0 => l,
+            Some(l) => {
+                return Err(field_err(
+                    self.file,
+                    "max_pair_distance",
+                    format!("must be finite and positive (mm), got {l}"),
+                ))
+            }
+            None => {
+                let mut d: Vec<f64> = pairs.iter().map(dist).collect();
+                d.sort_by(f64::total_cmp);
+                let median = d[d.len() / 2];
+                let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+                for n in &self.map.nodes {
+                    for a in 0..3 {
+                        lo[a] = lo[a].min(n.xyz[a]);
+                        hi[a] = hi[a].max(n.xyz[a]);
+                    }
+                }
+                let diag = (0..3).map(|a| (hi[a] - lo[a]).powi(2)).sum::<f64>().sqrt();
+                (10.0 * median).max(1e-3 * diag)
+            }
+        };
+        for (k, p) in pairs.iter().enumerate() {
+            let d = dist(p);
+            if d > limit {
+                return Err(field_err(
+                    self.file,
+                    format!("pairs[{k}]"),
+                    format!(
+                        "nodes {} and {} are {d:.4} mm apart, more than the {limit:.4} mm a \
+                         joint pair may span (10 × the median pair distance; set \
+                         `max_pair_distance` (mm) if the joint really has such gaps)",
+                        self.map.nodes[p.lower].id, self.map.nodes[p.upper].id
+                    ),
+                ));
+            }
+        }
+        Ok(())
     }
 
     /// One joint pair (at `path`): two distinct nodes, an orthonormal frame (its own or the
@@ -917,6 +963,8 @@ pub fn write(model: &Model, dir: &Path) -> Result<Vec<PathBuf>, Error> {
         load: model.load,
         contact: model.contact,
         end_time: model.end_time,
+        duplicates: None,
+        max_pair_distance: None,
     };
     crate::files::write_atomic(&map_path, map_text(&map))?;
     Ok(vec![k_path, m_path, map_path])

@@ -16,6 +16,7 @@
 mod contact;
 mod load;
 pub mod matrices;
+pub mod mtx;
 
 pub use contact::contact_static_full;
 

@@ -93,10 +93,18 @@ pub fn build_basis(model: &Model, kind: BasisKind, opts: &BasisOptions) -> Resul
     let (w, g, tvd_total, tvd_nonzero, joint_modes) = if need_tvd {
         let tvd = trial_vector_derivatives(model, cb.as_ref(), &opts.tvd)?;
         let p = pod_tvd(model, &tvd, kind != BasisKind::TvdPlain)?;
-        let g = opts
-            .g
-            .unwrap_or_else(|| p.choose_g(opts.threshold))
-            .min(p.lambda.len());
+        // One rule for every command: a g beyond the POD's modes is an error, never clamped.
+        let available = p.lambda.len();
+        let g = match opts.g {
+            Some(g) if g > available => {
+                return Err(Error::Invalid(format!(
+                    "--g {g}: the POD of the TVD has only {available} modes on {}",
+                    crate::files::printable(&model.name)
+                )))
+            }
+            Some(g) => g,
+            None => p.choose_g(opts.threshold).min(available),
+        };
         let jm = p.leading(g).to_owned();
         (p.w, g, tvd.total, tvd.nonzero(), jm)
     } else {

@@ -26,6 +26,12 @@ pub fn craig_bampton(model: &Model, nu: usize) -> Result<Mat<f64>, Error> {
         )));
     }
     let m = n - 6;
+    if nu > m {
+        return Err(Error::Invalid(format!(
+            "--nu {nu}: the model has only {m} interior DOF, so at most {m} fixed-interface \
+             modes"
+        )));
+    }
     let master = model.master_dofs();
     for (c, &d) in master.iter().enumerate() {
         if d != m + c {

@@ -33,7 +33,11 @@
 //! with elastic stick `k_t (u_t − s)` capped at `μ|p_n|` (see `crate::joint::law`).
 //!
 //! [`RomFile::read`] checks the schema, the version, every dimension and that every number is
-//! finite, naming the file and the field at fault; [`RomFile::system`] turns it into a
+//! finite, and the mechanics: r ≥ 1, w ≥ 1, M̃ symmetric positive definite, K̃ symmetric positive
+//! semidefinite, a positive ramp duration, positive k_n, k_t, τ and coordinate sizes, μ ≥ 0,
+//! and `reduced_loads` equal to `master_rows` (read and checked: the two are the same
+//! numbers, written twice for readers that want the load vectors by name), naming the file and
+//! the field at fault; [`RomFile::system`] turns it into a
 //! [`ReducedSystem`] that `crate::integrate::mechanical::run` integrates — the same curves as the model it
 //! was exported from (bit for bit: JSON numbers round-trip exactly).
 
@@ -195,6 +199,12 @@ impl RomFile {
             ));
         }
         let (r, w) = (f.dimension, f.pairs);
+        if r == 0 {
+            return Err(bad("dimension", "must be at least 1".into()));
+        }
+        if w == 0 {
+            return Err(bad("pairs", "must be at least 1 (a joint pair)".into()));
+        }
         let check = |field: &str, m: &[Vec<f64>], nr: usize| -> Result<(), Error> {
             if m.len() != nr {
                 return Err(bad(field, format!("expected {nr} rows, got {}", m.len())));
@@ -243,7 +253,83 @@ impl RomFile {
         for (i, s) in f.coordinate_size.iter().enumerate() {
             positive(&format!("coordinate_size[{i}]"), *s)?;
         }
+        positive("load_ramp.duration", f.load_ramp.duration)?;
+        let m = &f.master_load;
+        for (k, v) in [m.fx, m.fy, m.fz, m.mx, m.my, m.mz].into_iter().enumerate() {
+            if !v.is_finite() {
+                let key = ["fx", "fy", "fz", "mx", "my", "mz"][k];
+                return Err(bad(
+                    &format!("master_load.{key}"),
+                    format!("not finite: {v}"),
+                ));
+            }
+        }
+        f.check_physics().map_err(|(field, msg)| bad(field, msg))?;
         Ok(f)
+    }
+
+    /// The mechanics a reduced model must have: M̃ symmetric positive definite, K̃ symmetric
+    /// positive semidefinite (a negated or indefinite stiffness makes a run blow up to 10⁸⁷ mm
+    /// instead of failing), `reduced_loads` equal to `master_rows` (a unit master load along
+    /// DOF d enters as Φᵀe_d, which is row d of Φ at the master node; the file carries both so a
+    /// reader need not know that, and jointrom uses `master_rows`). Symmetry within 1e-10 of
+    /// the largest entry; semidefinite: no eigenvalue below −1e-10 × the largest.
+    fn check_physics(&self) -> Result<(), (&'static str, String)> {
+        let r = self.dimension;
+        let mat = |m: &[Vec<f64>]| Mat::from_fn(r, r, |i, j| m[i][j]);
+        let (m, k) = (mat(&self.mass), mat(&self.stiffness));
+        for (field, a) in [("mass", &m), ("stiffness", &k)] {
+            let max = (0..r)
+                .flat_map(|i| (0..r).map(move |j| (i, j)))
+                .fold(0.0f64, |acc, (i, j)| acc.max(a[(i, j)].abs()));
+            for i in 0..r {
+                for j in 0..i {
+                    if (a[(i, j)] - a[(j, i)]).abs() > 1e-10 * max {
+                        return Err((
+                            field,
+                            format!(
+                                "not symmetric: [{i}][{j}] = {:e} but [{j}][{i}] = {:e}",
+                                a[(i, j)],
+                                a[(j, i)]
+                            ),
+                        ));
+                    }
+                }
+            }
+        }
+        if m.llt(faer::Side::Lower).is_err() {
+            return Err((
+                "mass",
+                "not positive definite (its Cholesky factorization fails)".into(),
+            ));
+        }
+        let eig = k
+            .self_adjoint_eigenvalues(faer::Side::Lower)
+            .map_err(|e| ("stiffness", format!("eigenvalues failed: {e:?}")))?;
+        let top = eig.iter().fold(0.0f64, |a, &l| a.max(l.abs()));
+        if let Some(low) = eig.iter().copied().find(|&l| l < -1e-10 * top) {
+            return Err((
+                "stiffness",
+                format!(
+                    "not positive semidefinite: eigenvalue {low:e} N/mm (largest {top:e}); a \
+                     stiffness must not push the structure away from rest"
+                ),
+            ));
+        }
+        for (d, (a, b)) in self.master_rows.iter().zip(&self.reduced_loads).enumerate() {
+            let scale = a.iter().fold(0.0f64, |s, v| s.max(v.abs()));
+            if let Some(j) = (0..r).find(|&j| (a[j] - b[j]).abs() > 1e-12 * scale.max(1e-300)) {
+                return Err((
+                    "reduced_loads",
+                    format!(
+                        "row {d} differs from master_rows[{d}] at column {j} ({:e} vs {:e}): \
+                         the reduced load of a unit master load is Φᵀe_d, the master row itself",
+                        b[j], a[j]
+                    ),
+                ));
+            }
+        }
+        Ok(())
     }
 
     /// The reduced system jointrom integrates.

@@ -329,7 +329,7 @@ pub fn stability_study(
     let t0 = Instant::now();
     let model = Model::from_case_name(case)?;
     let sweep = run_sweep_model(&model, t0.elapsed().as_secs_f64(), opts)?;
-    let dir = out.join(&sweep.case);
+    let dir = out.join(crate::files::safe_name(&sweep.case));
     let files = write_outputs(&sweep, &dir, charts)?;
     let mut by_status = std::collections::BTreeMap::<String, usize>::new();
     for c in &sweep.cells {

@@ -31,8 +31,9 @@
 //!
 //! ## Bounded cost
 //!
-//! A cell cannot run away: CVODE's `max_steps` caps the steps per output interval (a cell over it
-//! fails with `CV_TOO_MUCH_WORK`), and a wall-clock budget per cell is enforced from inside the
+//! A cell cannot run away: `max_steps` caps the steps of the cell's whole run (a cell over it
+//! fails with `CV_TOO_MUCH_WORK`; 2·10⁶ by default, the 20 000 per output interval of the stored
+//! map's 100 intervals), and a wall-clock budget per cell is enforced from inside the
 //! right-hand side (a wrapper problem returns a fatal callback error once the budget is spent, so
 //! CVODE stops at once; the cell is reported as `budget` with the time reached).
 //!
@@ -57,8 +58,8 @@
 //! - `budget` with **Newton at k_n = 1e6** (w(g) ROM, full model): the contact oscillation at
 //!   `√(k_n/m)` must be resolved to the tolerance, an accuracy limit that a stable implicit
 //!   method does not remove.
-//! - `CV_TOO_MUCH_WORK`: more than `max_steps` steps within one output interval, the same step
-//!   bounds as above met with a small cap.
+//! - `CV_TOO_MUCH_WORK`: more than `max_steps` steps in the run, the same step bounds as above
+//!   met with a small cap.
 
 //! ## Outputs
 //!
@@ -193,7 +194,7 @@ pub struct SweepOptions {
     /// Velocity tolerance per displacement tolerance, 1/s
     /// ([`crate::integrate::mechanical::ProblemOptions::velocity_scale`]).
     pub velocity_scale: f64,
-    /// CVODE's maximum steps per output interval.
+    /// Maximum internal steps of a cell's run (all output intervals together).
     pub max_steps: usize,
     /// Wall-clock budget per cell, s.
     pub budget_s: f64,
@@ -229,7 +230,7 @@ impl Default for SweepOptions {
             rtol: 1e-8,
             atol: 1e-6,
             velocity_scale: crate::integrate::mechanical::DEFAULT_VELOCITY_SCALE,
-            max_steps: 20_000,
+            max_steps: 2_000_000,
             budget_s: 20.0,
             reference_factor: 100.0,
             refresh: ProblemOptions::default().refresh,
@@ -636,7 +637,7 @@ impl Pass<'_> {
                     rtol: opts.rtol / opts.reference_factor,
                     atol: opts.atol / opts.reference_factor,
                     max_order: 5,
-                    max_steps: opts.max_steps.max(100_000),
+                    max_steps: opts.max_steps.max(10_000_000),
                     ..OdeOptions::default()
                 },
                 end_time: Some(end),

@@ -24,9 +24,21 @@ fn main() -> ExitCode {
             }
         }
     };
+    // Every output a failing command created is removed again: a failed export or report
+    // leaves no partial files.
+    jointrom::files::journal_start();
     match commands::run(cli.command) {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(e) => fail(&e),
+        Ok(()) => {
+            jointrom::files::journal_commit();
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            let removed = jointrom::files::journal_rollback();
+            if removed > 0 {
+                eprintln!("jointrom: removed {removed} partial output(s) of the failed command");
+            }
+            fail(&e)
+        }
     }
 }
 

@@ -159,6 +159,10 @@ pub struct Cvode<P: OdeProblem> {
     roots_found: u64,
     /// `y` before the current `solve_to` (restored if CVODE cannot report its state).
     saved_y: Vec<f64>,
+    /// Internal steps allowed over the whole run (`OdeOptions::max_steps`), across `solve_to`
+    /// calls and `reinit`: CVODE's own limit counts per call, so a run with many output
+    /// intervals could take that many steps in each of them.
+    max_steps: u64,
 }
 
 impl<P: OdeProblem> Cvode<P> {
@@ -208,6 +212,7 @@ impl<P: OdeProblem> Cvode<P> {
             ls_counters_stale: false,
             roots_found: 0,
             saved_y: Vec::with_capacity(n),
+            max_steps: opts.max_steps as u64,
         };
         let atol_vector = cvode.atol_vector(&context, opts.atol)?;
         cvode.init(t0, opts, atol_vector.as_ref())?;
@@ -431,6 +436,16 @@ impl<P: OdeProblem> Cvode<P> {
         }
         self.saved_y.clear();
         self.saved_y.extend_from_slice(self.y.as_slice());
+        // The run's remaining steps (at least one, so that CVODE itself reports
+        // CV_TOO_MUCH_WORK when the budget is spent).
+        let left = self
+            .max_steps
+            .saturating_sub(self.current_stats().steps)
+            .max(1);
+        let left = c_long::try_from(left).unwrap_or(c_long::MAX);
+        // SAFETY: memory live and owned by `self`.
+        let f = unsafe { CVodeSetMaxNumSteps(self.mem.as_raw(), left) };
+        self.check_cv("CVodeSetMaxNumSteps", f)?;
         let mut t = self.t;
         // SAFETY: the memory and `y` are live and owned by `self`; no Rust reference to the
         // shared state or to `y`'s data is held across the call (callbacks reach them through

@@ -64,7 +64,7 @@ pub fn run(a: ExportArgs) -> Result<(), Error> {
         file.write(&a.out)?;
         println!(
             "{}: adaptive basis for tolerance {tol:e} ({} pairs, nu = {}), r = {}, estimated |f_c| error {:.2e}{} → {}",
-            model.name,
+            jointrom::files::printable(&model.name),
             t.pairs.len(),
             t.nu,
             file.dimension,
@@ -94,7 +94,7 @@ pub fn run(a: ExportArgs) -> Result<(), Error> {
     file.write(&a.out)?;
     println!(
         "{}: {} basis, g = {}, r = {} → {}",
-        model.name,
+        jointrom::files::printable(&model.name),
         kind.name(),
         file.basis.g,
         file.dimension,

@@ -34,7 +34,7 @@ pub fn run(a: ExportMatricesArgs) -> Result<(), Error> {
     } else {
         println!(
             "{}: {} DOF, {} joint pairs → {}",
-            model.name,
+            jointrom::files::printable(&model.name),
             model.dofs(),
             model.pair_count(),
             files

@@ -22,7 +22,10 @@ pub fn run(a: InfoArgs) -> Result<(), Error> {
     if a.json {
         print_json(&v);
     } else {
-        println!("case            {}", model.name);
+        println!(
+            "case            {}",
+            jointrom::files::printable(&model.name)
+        );
         println!("DOF             {}", model.dofs());
         println!("joint pairs     {}", model.pair_count());
         println!("joint DOF       {}", model.joint_dofs());

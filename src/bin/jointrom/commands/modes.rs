@@ -41,7 +41,7 @@ pub fn run(a: ModesArgs) -> Result<(), Error> {
     } else {
         println!(
             "{} — {} lowest modes, master {} ({:.1} ms):",
-            model.name,
+            jointrom::files::printable(&model.name),
             a.count,
             match iface {
                 Interface::Fixed => "clamped (fixed interface)",

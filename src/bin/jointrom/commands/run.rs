@@ -65,7 +65,7 @@ pub fn run(a: RunArgs) -> Result<(), Error> {
         "timing_s".into(),
         json!({"assembly": t_assembly, "modes": t_modes}),
     );
-    let dir = a.out.join(&model.name);
+    let dir = a.out.join(jointrom::files::safe_name(&model.name));
     let opts = ReportOptions {
         quick: a.quick,
         stability_dir: a.stability_dir,

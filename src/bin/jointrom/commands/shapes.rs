@@ -25,7 +25,7 @@ pub struct ShapesArgs {
 pub fn run(a: ShapesArgs) -> Result<(), Error> {
     let model = Model::from_case_name(&a.case)?;
     let s = shapes::shapes(&model, a.nu, a.count)?;
-    let dir = a.out.join(&model.name);
+    let dir = a.out.join(jointrom::files::safe_name(&model.name));
     for f in shapes::write_shapes(&model, &s, &dir)? {
         println!("{}", f.display());
     }

@@ -68,8 +68,8 @@ pub struct StabilityArgs {
     /// Velocity tolerance per displacement tolerance, 1/s (1: the paper's one number).
     #[arg(long, default_value_t = jointrom::integrate::mechanical::DEFAULT_VELOCITY_SCALE)]
     pub velocity_scale: f64,
-    /// CVODE maximum steps per output interval.
-    #[arg(long, default_value_t = 20_000)]
+    /// Maximum internal steps of a cell's whole run.
+    #[arg(long, default_value_t = 2_000_000)]
     pub max_steps: usize,
     /// Wall-clock budget per cell, s.
     #[arg(long, default_value_t = 20.0)]

@@ -88,7 +88,10 @@ pub fn run(a: StaticArgs) -> Result<(), Error> {
     } else {
         "with contact (frictionless)"
     };
-    println!("{} — static {kind}, load × {scale}:", model.name);
+    println!(
+        "{} — static {kind}, load × {scale}:",
+        jointrom::files::printable(&model.name)
+    );
     let u = &v["master_displacement"];
     print_master_displacement(|k| u[k].as_f64().unwrap_or(f64::NAN));
     if !a.linear {
@@ -162,7 +165,7 @@ fn tolerance_static(
     }
     println!(
         "{} — reduced static with contact (frictionless), adaptive basis for tolerance {tol:e} ({} pairs, {} columns), load × {scale}:",
-        model.name, t.pairs.len(), t.basis_size
+        jointrom::files::printable(&model.name), t.pairs.len(), t.basis_size
     );
     print_master_displacement(|k| t.solution.master_displacement[k]);
     println!(
@@ -229,7 +232,7 @@ fn reduced_static(
     }
     println!(
         "{} — reduced static with contact (frictionless), basis {} (g = {}, {} columns), load × {scale}:",
-        model.name, r.basis, r.g, r.basis_size
+        jointrom::files::printable(&model.name), r.basis, r.g, r.basis_size
     );
     print_master_displacement(|k| r.solution.master_displacement[k]);
     println!(

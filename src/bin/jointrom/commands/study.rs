@@ -44,7 +44,7 @@ pub fn run(a: StudyArgs) -> Result<(), Error> {
         ..study::StudyOptions::default()
     };
     let s = study::run_study(&model, &opts)?;
-    let dir = a.out.join(&model.name);
+    let dir = a.out.join(jointrom::files::safe_name(&model.name));
     create_dir(&dir)?;
     let t0 = Instant::now();
     let charts = if a.no_charts {

@@ -43,6 +43,9 @@ pub struct SweepArgs {
     /// One JSON document on stdout (with the curves).
     #[arg(long)]
     json: bool,
+    /// Wall-clock budget of each variant's integration, s.
+    #[arg(long, default_value_t = jointrom::integrate::driver::DEFAULT_MAX_WALL_S)]
+    max_wall: f64,
 }
 
 pub fn run(a: SweepArgs) -> Result<(), Error> {
@@ -51,7 +54,9 @@ pub fn run(a: SweepArgs) -> Result<(), Error> {
     let mut opts = TransientOptions::default();
     if let Some(t) = a.end_time {
         opts.end_time = Some(positive("end-time", t)?);
+        jointrom::integrate::driver::output_count(t, opts.output_step)?;
     }
+    opts.budget_s = Some(positive("max-wall", a.max_wall)?);
     let t0 = Instant::now();
     let (kind, g_used, rom) = match a.tolerance {
         Some(tol) => {
@@ -93,7 +98,7 @@ pub fn run(a: SweepArgs) -> Result<(), Error> {
     } else {
         println!(
             "{} — {} basis, g = {g_used}, r = {} (built once, {:.3} s); {} variants on {} threads",
-            model.name,
+            jointrom::files::printable(&model.name),
             kind,
             rom.dim(),
             build_s,
@@ -101,6 +106,33 @@ pub fn run(a: SweepArgs) -> Result<(), Error> {
             res.threads
         );
         print_runs(&res);
+    }
+    for r in &res.runs {
+        let check = r.curves.energy_check();
+        if r.status == "ok" && !check.ok {
+            eprintln!(
+                "jointrom: warning: variant `{}`: energy balance off by {:.3e} of its energy \
+                 (tolerance {:e}): not trustworthy",
+                jointrom::files::printable(&r.variant.name),
+                check.residual_ratio,
+                check.tolerance
+            );
+        }
+    }
+    // The table (or JSON) above shows every variant; a failed one fails the command.
+    let failed: Vec<String> = res
+        .runs
+        .iter()
+        .filter(|r| r.status != "ok")
+        .map(|r| format!("`{}`", jointrom::files::printable(&r.variant.name)))
+        .collect();
+    if !failed.is_empty() {
+        return Err(Error::Invalid(format!(
+            "{} of {} sweep variants failed: {}",
+            failed.len(),
+            res.runs.len(),
+            failed.join(", ")
+        )));
     }
     Ok(())
 }
@@ -116,7 +148,7 @@ fn print_runs(res: &SweepResult) {
             .map_or("-".to_string(), |e| format!("{e:.1e}"));
         println!(
             "  {:<20} {:<6} {:>8.3} s {:>8} steps  final |f_c| {:.4e} N  |f_R| {:.4e} N  uy {:.4e} mm  est. |f_c| error {est}",
-            r.variant.name,
+            jointrom::files::printable(&r.variant.name),
             if r.status == "ok" { "ok" } else { "failed" },
             r.wall_s,
             r.stats.steps,

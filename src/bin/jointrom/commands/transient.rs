@@ -93,6 +93,10 @@ pub struct TransientArgs {
     /// Output spacing, s.
     #[arg(long, default_value_t = 1e-4)]
     output_step: f64,
+    /// Wall-clock budget of the integration, s: a run that has not finished by then stops with
+    /// an error (and the curves up to the time reached in --json/--out).
+    #[arg(long, default_value_t = jointrom::integrate::driver::DEFAULT_MAX_WALL_S)]
+    max_wall: f64,
     /// One JSON document on stdout (with the curves).
     #[arg(long)]
     json: bool,
@@ -184,9 +188,19 @@ pub fn run(a: TransientArgs) -> Result<(), Error> {
         "error_estimate": estimate_json(&o.estimate),
         "curves": c,
         "energy_balance": c.balance(),
+        "energy_check": c.energy_check(),
         "training": o.training,
         "profile": o.res.profile,
     });
+    let check = c.energy_check();
+    if !check.ok {
+        eprintln!(
+            "jointrom: warning: energy balance off by {:.3e} of the run's energy ({:.3e} N·mm \
+             of {:.3e}; tolerance {:e}): the results are not trustworthy — check k_n and the \
+             iteration (see `energy_check` in the JSON)",
+            check.residual_ratio, check.max_residual, check.energy_scale, check.tolerance
+        );
+    }
     if let Some(dir) = &a.vtu {
         let (times, states): (Vec<f64>, Vec<Vec<f64>>) =
             std::mem::take(&mut o.frames).into_iter().unzip();
@@ -279,6 +293,10 @@ fn transient_options(a: &TransientArgs) -> Result<TransientOptions, Error> {
         o.end_time = Some(positive("end-time", t)?);
     }
     o.output_step = positive("output-step", a.output_step)?;
+    if let Some(t) = o.end_time {
+        jointrom::integrate::driver::output_count(t, o.output_step)?;
+    }
+    o.budget_s = Some(positive("max-wall", a.max_wall)?);
     Ok(o)
 }
 
@@ -591,7 +609,7 @@ fn print_summary(a: &TransientArgs, model: &Model, o: &Outcome, total_s: f64) {
     let s = &res.stats;
     println!(
         "{} — model {} (n = {}{}), friction {}, events {}",
-        model.name,
+        jointrom::files::printable(&model.name),
         model_name(a),
         o.basis_size,
         o.g.map(|g| format!(", g = {g}")).unwrap_or_default(),
