@@ -378,6 +378,37 @@ pub fn output_count(end: f64, output_step: f64) -> Result<usize, Error> {
     Ok(n as usize)
 }
 
+/// The first output quantity of `s` that is NaN or infinite, by name: an integrator can step
+/// on with finite coordinates while a pair force overflows (k_n = 1e300 N/mm), and such a run
+/// must not count as finished.
+fn non_finite(s: &super::mechanical::EnergySample) -> Option<&'static str> {
+    let named = [
+        ("contact force norm", s.contact_force_norm),
+        ("friction force norm", s.friction_force_norm),
+        ("kinetic energy", s.kinetic),
+        ("strain energy", s.strain),
+        ("pair energy", s.pair),
+        ("external work", s.external_work),
+        ("dissipated energy", s.dissipated),
+    ];
+    named
+        .iter()
+        .find(|(_, v)| !v.is_finite())
+        .map(|(n, _)| *n)
+        .or_else(|| {
+            (0..6).find(|&k| !s.master[k].is_finite()).map(|k| {
+                [
+                    "master ux",
+                    "master uy",
+                    "master uz",
+                    "master rx",
+                    "master ry",
+                    "master rz",
+                ][k]
+            })
+        })
+}
+
 /// Roots in a row at the same time after which a run is [`RunStatus::Chatter`].
 pub const MAX_STALLED_ROOTS: usize = 1000;
 
@@ -606,6 +637,13 @@ impl<S: SecondOrderSystem> Driver<S> {
             let y = self.cv.y().to_vec();
             let s = self.cv.problem_mut().inner.sample(t, &y);
             self.curves.push(&s);
+            if let Some(what) = non_finite(&s) {
+                failure = Some(Error::Invalid(format!(
+                    "the run's {what} is not finite at t = {t} s (an overflow: check k_n, k_t \
+                     and the load)"
+                )));
+                break;
+            }
             if let Some(tr) = &mut self.trajectory {
                 tr.push(&y[..self.dim], &self.cv.problem().inner);
             }
