@@ -94,7 +94,8 @@ pub(crate) fn check_contact_load(
 }
 
 /// Every sheet's own fields: a unique non-empty name, finite extents of positive length, a finite
-/// y, a positive thickness, element counts ≥ 1 and a model within the DOF budget ([`crate::files::dof_budget`]); sheets stacked without a joint are refused.
+/// y, a positive thickness, element counts ≥ 1 and a model within the DOF budget
+/// ([`crate::files::dof_budget`]).
 pub(crate) fn check_sheets(case: &Case, ctx: &Ctx) -> Result<(), Error> {
     if case.sheets.is_empty() {
         return Err(ctx.err("sheets", "no sheets: a case needs at least one"));
@@ -160,13 +161,14 @@ pub(crate) fn check_sheets(case: &Case, ctx: &Ctx) -> Result<(), Error> {
         }
         first += (nx + 1) * (nz + 1);
     }
-    check_stacking(case, ctx)
+    Ok(())
 }
 
-/// Two sheets whose plan views overlap may not lie in one plane or cut into each other, and two
-/// that touch (mid-surfaces half their thicknesses apart) must be joined by a `joints` entry:
-/// sheets laid on top of each other without a joint pass through each other without a force.
-fn check_stacking(case: &Case, ctx: &Ctx) -> Result<(), Error> {
+/// Two sheets whose plan views overlap may not cut into each other (mid-surfaces closer than
+/// half their thicknesses), and two that touch must be joined by a `joints` entry or a weld:
+/// sheets laid on top of each other with nothing between them pass through each other without
+/// a force.
+pub(crate) fn check_stacking(case: &Case, ctx: &Ctx) -> Result<(), Error> {
     // A joint naming an unknown sheet is reported by the joints' own check, more precisely.
     let known = |n: &str| case.sheets.iter().any(|s| s.name == n);
     if case
@@ -188,6 +190,11 @@ fn check_stacking(case: &Case, ctx: &Ctx) -> Result<(), Error> {
                 (jt.lower == a.name && jt.upper == b.name)
                     || (jt.lower == b.name && jt.upper == a.name)
             });
+            // A welded stack whose contact is deliberately not modelled (a linear, tied
+            // model) is allowed; a stack held by nothing is not.
+            let welded = case.welds.iter().any(|w| {
+                w.sheets.iter().any(|s| *s == a.name) && w.sheets.iter().any(|s| *s == b.name)
+            });
             let names = format!("`{}` (sheets[{i}]) and `{}`", a.name, b.name);
             if gap < touch * (1.0 - 1e-9) {
                 return Err(ctx.err(
@@ -199,7 +206,7 @@ fn check_stacking(case: &Case, ctx: &Ctx) -> Result<(), Error> {
                     ),
                 ));
             }
-            if gap <= touch * (1.0 + 1e-9) && !joined {
+            if gap <= touch * (1.0 + 1e-9) && !joined && !welded {
                 return Err(ctx.err(
                     format!("sheets[{j}]"),
                     format!(

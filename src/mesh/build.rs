@@ -47,6 +47,8 @@ pub(super) fn build(case: &Case) -> Result<Mesh, Error> {
         nuggets: welds.nuggets,
     };
     let pairs = sheets.joints(&case.joints, &supports, &nodes)?;
+    // After the joints' and welds' own checks, which name the field more precisely.
+    crate::case::validate::check_stacking(case, &ctx)?;
 
     check_contact_and_load(case, &ctx)?;
 

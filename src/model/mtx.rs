@@ -46,7 +46,7 @@ fn err(file: &Path, at: impl Into<String>, reason: impl Into<String>) -> Error {
     Error::Case {
         file: file.display().to_string(),
         path: at.into(),
-        reason: reason.into(),
+        reason: format!("MatrixMarket: {}", reason.into()),
         source: None,
     }
 }

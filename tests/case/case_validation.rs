@@ -240,12 +240,12 @@ fn element_counts_must_be_positive_and_bounded() {
     edited(
         |c| c["sheets"][0]["elements"] = json!([100000, 100000]),
         "sheets[0].elements",
-        "allowed",
+        "JOINTROM_MAX_DOF",
     );
     edited(
         |c| c["sheets"][0]["elements"] = json!([u64::MAX, 3]),
         "sheets[0].elements",
-        "allowed",
+        "JOINTROM_MAX_DOF",
     );
 }
 

@@ -499,7 +499,7 @@ fn damaged_inputs() -> Vec<(&'static str, Box<Damage>, &'static str, &'static st
             "zero-diagonal",
             Box::new(|v, _| tiny_map(v, "zero.mtx", "diag7.mtx")),
             "zero.mtx",
-            "entry (7, 7)",
+            "every row needs at least its diagonal",
         ),
     ]
 }

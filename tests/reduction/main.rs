@@ -9,4 +9,5 @@ mod competitors;
 mod export;
 mod reduction;
 mod roundoff;
+mod threads;
 mod tolerance;
