@@ -192,9 +192,10 @@ pub(crate) fn check_stacking(case: &Case, ctx: &Ctx) -> Result<(), Error> {
             });
             // A welded stack whose contact is deliberately not modelled (a linear, tied
             // model) is allowed; a stack held by nothing is not.
-            let welded = case.welds.iter().any(|w| {
-                w.sheets.iter().any(|s| *s == a.name) && w.sheets.iter().any(|s| *s == b.name)
-            });
+            let welded = case
+                .welds
+                .iter()
+                .any(|w| w.sheets.contains(&a.name) && w.sheets.contains(&b.name));
             let names = format!("`{}` (sheets[{i}]) and `{}`", a.name, b.name);
             if gap < touch * (1.0 - 1e-9) {
                 return Err(ctx.err(

@@ -369,7 +369,8 @@ pub const DEFAULT_MAX_WALL_S: f64 = 3600.0;
 /// error past [`MAX_OUTPUTS`].
 pub fn output_count(end: f64, output_step: f64) -> Result<usize, Error> {
     let n = (end / output_step - 1e-9).ceil().max(1.0);
-    if !(n <= MAX_OUTPUTS) {
+    // NaN (0/0) fails the comparison too.
+    if n.is_nan() || n > MAX_OUTPUTS {
         return Err(Error::Invalid(format!(
             "end time {end:e} s / output step {output_step:e} s = {n:e} output points, more than \
              the {MAX_OUTPUTS:e} a run keeps: raise --output-step or lower --end-time"

@@ -69,8 +69,7 @@ use crate::model::{Cell, CellNodes, Geometry, Model, Origin};
 pub const SCHEMA: &str = "jointrom-matrices";
 /// The map version this build reads and writes.
 pub const VERSION: u32 = 1;
-/// Tolerance of the symmetry check, relative to the largest entry.
-pub const SYMMETRY_TOLERANCE: f64 = 1e-12;
+pub use super::mtx::SYMMETRY_TOLERANCE;
 /// Tolerance of the orthonormality check of pair frames.
 pub const FRAME_TOLERANCE: f64 = 1e-6;
 

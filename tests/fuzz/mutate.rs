@@ -49,7 +49,7 @@ impl Mutator {
                 0 => self.flip(v),
                 1 => self.cut(v),
                 2 => self.duplicate(v),
-                3 | 4 | 5 => self.number(v),
+                3..=5 => self.number(v),
                 6 | 7 => self.json(v),
                 _ => self.lines(v),
             };

@@ -167,8 +167,10 @@ pub fn corpus() -> Vec<Hostile> {
     let fx = fixture();
     let mut v = Vec::new();
     v.extend(case_files(fx));
+    v.extend(case_files_values(fx));
     v.extend(geometry(fx));
     v.extend(matrix_market(fx));
+    v.extend(matrix_market_values(fx));
     v.extend(maps(fx));
     v.extend(rom_files(fx));
     v.extend(flags(fx));
@@ -285,6 +287,13 @@ fn case_files(fx: &Fixture) -> Vec<Hostile> {
             set(c, "/sheets/0/elements", json!([0, 2])),
             Fails("sheets[0].elements"),
         ),
+    ]
+}
+
+fn case_files_values(fx: &Fixture) -> Vec<Hostile> {
+    let c = &fx.case;
+    use Expect::Fails;
+    vec![
         info_case(
             "case-negative-elements",
             "negative element count",
@@ -584,6 +593,18 @@ fn matrix_market(fx: &Fixture) -> Vec<Hostile> {
             mtx_edit(&k, false, |e| e[0] = "1 1 abc".into()),
             Fails("K.mtx"),
         ),
+    ]
+}
+
+fn matrix_market_values(fx: &Fixture) -> Vec<Hostile> {
+    let (map, k, m) = (fx.map.clone(), fx.k.clone(), fx.m.clone());
+    use Expect::Fails;
+    let mk =
+        |id, what, k2: String, expect| map_entry(id, what, fx, map.clone(), k2, m.clone(), expect);
+    let (head, size, entries) = mtx_parts(&k);
+    let n: usize = size.split_whitespace().next().unwrap().parse().unwrap();
+    let od = off_diagonal(&entries);
+    vec![
         mk(
             "mtx-complex",
             "complex field",
@@ -650,6 +671,24 @@ fn matrix_market(fx: &Fixture) -> Vec<Hostile> {
             }),
             Fails("M.mtx"),
         ),
+        entry(
+            "mtx-indefinite",
+            "matrix map + MatrixMarket",
+            "K indefinite with a positive diagonal (one off-diagonal 1e12)",
+            &["modes", MAP],
+            Fails("K.mtx, mass"),
+        )
+        .file("model.json", map.clone())
+        .file(
+            "K.mtx",
+            mtx_edit(&k, false, |e| {
+                let od = off_diagonal(e);
+                let mut it = e[od].split_whitespace();
+                let (i, j) = (it.next().unwrap(), it.next().unwrap());
+                e[od] = format!("{i} {j} 1e12");
+            }),
+        )
+        .file("M.mtx", m.clone()),
         entry(
             "mtx-dev-zero",
             "matrix map + MatrixMarket",

@@ -1,8 +1,9 @@
 //! Helpers the commands share: printing, flag checks, files.
 
 use std::path::Path;
+use std::sync::Mutex;
 
-use jointrom::Error;
+use jointrom::{Error, Model};
 use serde_json::Value;
 
 /// Prints one pretty JSON document on stdout.
@@ -40,4 +41,30 @@ pub fn create_dir(dir: &Path) -> Result<(), Error> {
 /// Writes `text` to `file`.
 pub fn write_file(file: &Path, text: impl AsRef<[u8]>) -> Result<(), Error> {
     jointrom::files::write_atomic(file, text)
+}
+
+/// The inputs the command has read, for errors that cannot name one themselves (a matrix that
+/// is not positive definite, a CVODE failure): the main function names them.
+static INPUTS: Mutex<Vec<String>> = Mutex::new(Vec::new());
+
+/// Records an input the command read (a model's files, a reduced-model file).
+pub fn record_input(what: String) {
+    if let Ok(mut v) = INPUTS.lock() {
+        if !v.contains(&what) {
+            v.push(what);
+        }
+    }
+}
+
+/// The inputs recorded so far.
+pub fn inputs() -> Vec<String> {
+    INPUTS.lock().map(|v| v.clone()).unwrap_or_default()
+}
+
+/// Loads a case file, built-in scene or matrix map ([`Model::from_case_name`]) and records
+/// where its matrices came from.
+pub fn load_model(arg: &str) -> Result<Model, Error> {
+    let model = Model::from_case_name(arg)?;
+    record_input(format!("model {}", model.describe_source()));
+    Ok(model)
 }

@@ -49,5 +49,16 @@ fn main() -> ExitCode {
 
 fn fail(e: &jointrom::Error) -> ExitCode {
     eprintln!("jointrom: error: {e}");
+    // Errors from inside the numerics name no file; say which inputs they came from.
+    if matches!(
+        e,
+        jointrom::Error::LinearAlgebra(_)
+            | jointrom::Error::Sundials { .. }
+            | jointrom::Error::Callback { .. }
+    ) {
+        for input in common::inputs() {
+            eprintln!("jointrom:   in {}", jointrom::files::printable(&input));
+        }
+    }
     ExitCode::FAILURE
 }

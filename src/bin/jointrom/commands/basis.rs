@@ -4,7 +4,7 @@ use clap::Args;
 
 use jointrom::reduction::BasisOptions;
 use jointrom::studies::convergence as study;
-use jointrom::{Error, Model};
+use jointrom::Error;
 
 use crate::cli::TvdKindArg;
 use crate::common::print_json;
@@ -31,7 +31,7 @@ pub struct BasisArgs {
 }
 
 pub fn run(a: BasisArgs) -> Result<(), Error> {
-    let model = Model::from_case_name(&a.case)?;
+    let model = crate::common::load_model(&a.case)?;
     let opts = BasisOptions {
         nu: a.nu,
         g: a.g,

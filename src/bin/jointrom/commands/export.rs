@@ -7,7 +7,7 @@ use clap::Args;
 use jointrom::reduction::rom_file as export;
 use jointrom::reduction::{build_basis, BasisKind, BasisOptions};
 use jointrom::system::ReducedSystem;
-use jointrom::{Error, Model};
+use jointrom::Error;
 
 use jointrom::studies::tolerance::{tolerance_model, ToleranceOptions};
 
@@ -37,7 +37,7 @@ pub struct ExportArgs {
 }
 
 pub fn run(a: ExportArgs) -> Result<(), Error> {
-    let model = Model::from_case_name(&a.case)?;
+    let model = crate::common::load_model(&a.case)?;
     if let Some(tol) = a.tolerance {
         if a.basis.is_some() || a.g.is_some() {
             return Err(Error::Invalid(

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use clap::Args;
 use serde_json::json;
 
-use jointrom::{Error, Model};
+use jointrom::Error;
 
 use crate::common::print_json;
 
@@ -22,7 +22,7 @@ pub struct ExportMatricesArgs {
 }
 
 pub fn run(a: ExportMatricesArgs) -> Result<(), Error> {
-    let model = Model::from_case_name(&a.case)?;
+    let model = crate::common::load_model(&a.case)?;
     let files = jointrom::model::matrices::write(&model, &a.out)?;
     if a.json {
         print_json(&json!({

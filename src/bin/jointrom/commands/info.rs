@@ -17,7 +17,7 @@ pub struct InfoArgs {
 }
 
 pub fn run(a: InfoArgs) -> Result<(), Error> {
-    let model = Model::from_case_name(&a.case)?;
+    let model = crate::common::load_model(&a.case)?;
     let v = info_json(&model);
     if a.json {
         print_json(&v);

@@ -5,7 +5,7 @@ use std::time::Instant;
 use clap::Args;
 use serde_json::json;
 
-use jointrom::{Error, Interface, Model};
+use jointrom::{Error, Interface};
 
 use crate::cli::InterfaceArg;
 use crate::common::print_json;
@@ -26,7 +26,7 @@ pub struct ModesArgs {
 }
 
 pub fn run(a: ModesArgs) -> Result<(), Error> {
-    let model = Model::from_case_name(&a.case)?;
+    let model = crate::common::load_model(&a.case)?;
     let iface = Interface::from(a.interface);
     let t0 = Instant::now();
     let modes = model.modes(a.count, iface)?;

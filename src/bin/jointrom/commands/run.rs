@@ -11,7 +11,7 @@ use serde_json::json;
 use jointrom::report::main_job as report;
 use jointrom::studies::main_job::{Progress, Report, ReportOptions};
 use jointrom::studies::tolerance::check_tolerance;
-use jointrom::{Error, Interface, Model};
+use jointrom::{Error, Interface};
 
 use super::info::info_json;
 use super::statics::static_json;
@@ -43,7 +43,7 @@ pub struct RunArgs {
 pub fn run(a: RunArgs) -> Result<(), Error> {
     check_tolerance(a.tolerance)?;
     let t0 = Instant::now();
-    let model = Model::from_case_name(&a.case)?;
+    let model = crate::common::load_model(&a.case)?;
     let t_assembly = t0.elapsed().as_secs_f64();
     let t1 = Instant::now();
     let fixed = model.modes(10, Interface::Fixed)?;

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use clap::Args;
 
 use jointrom::report::shapes;
-use jointrom::{Error, Model};
+use jointrom::Error;
 
 #[derive(Args)]
 pub struct ShapesArgs {
@@ -23,7 +23,7 @@ pub struct ShapesArgs {
 }
 
 pub fn run(a: ShapesArgs) -> Result<(), Error> {
-    let model = Model::from_case_name(&a.case)?;
+    let model = crate::common::load_model(&a.case)?;
     let s = shapes::shapes(&model, a.nu, a.count)?;
     let dir = a.out.join(jointrom::files::safe_name(&model.name));
     for f in shapes::write_shapes(&model, &s, &dir)? {

@@ -57,7 +57,7 @@ pub fn run(a: StaticArgs) -> Result<(), Error> {
                 "--tolerance chooses its own reduced model: drop --basis, --g and --linear".into(),
             ));
         }
-        let model = Model::from_case_name(&a.case)?;
+        let model = crate::common::load_model(&a.case)?;
         return tolerance_static(&model, tol, a.nu, scale, a.json);
     }
     if a.basis.is_none() && a.g.is_some() {
@@ -70,10 +70,10 @@ pub fn run(a: StaticArgs) -> Result<(), Error> {
                     .into(),
             ));
         }
-        let model = Model::from_case_name(&a.case)?;
+        let model = crate::common::load_model(&a.case)?;
         return reduced_static(&model, kind.into(), a.g, a.nu, scale, a.json);
     }
-    let model = Model::from_case_name(&a.case)?;
+    let model = crate::common::load_model(&a.case)?;
     let v = if a.linear {
         static_json(&model, scale)?
     } else {

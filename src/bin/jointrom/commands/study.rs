@@ -7,7 +7,7 @@ use clap::Args;
 use serde_json::json;
 
 use jointrom::studies::convergence as study;
-use jointrom::{Error, Model};
+use jointrom::Error;
 
 use crate::common::{create_dir, print_json, write_file};
 
@@ -36,7 +36,7 @@ pub struct StudyArgs {
 }
 
 pub fn run(a: StudyArgs) -> Result<(), Error> {
-    let model = Model::from_case_name(&a.case)?;
+    let model = crate::common::load_model(&a.case)?;
     let opts = study::StudyOptions {
         nu: a.nu,
         max_g: a.max_g,

@@ -11,7 +11,7 @@ use jointrom::reduction::{build_basis, BasisKind, BasisOptions};
 use jointrom::studies::sweep::{self, SweepResult};
 use jointrom::studies::tolerance::{tolerance_model, ToleranceOptions};
 use jointrom::system::ReducedSystem;
-use jointrom::{Error, Model};
+use jointrom::Error;
 
 use crate::cli::BasisArg;
 use crate::common::{positive, print_json};
@@ -49,7 +49,7 @@ pub struct SweepArgs {
 }
 
 pub fn run(a: SweepArgs) -> Result<(), Error> {
-    let model = Model::from_case_name(&a.case)?;
+    let model = crate::common::load_model(&a.case)?;
     let list = sweep::read_variants(&a.variants)?;
     let mut opts = TransientOptions::default();
     if let Some(t) = a.end_time {

@@ -165,7 +165,7 @@ struct Outcome {
 
 pub fn run(a: TransientArgs) -> Result<(), Error> {
     let opts = transient_options(&a)?;
-    let model = Model::from_case_name(&a.case)?;
+    let model = crate::common::load_model(&a.case)?;
     let vtu_every = vtu_every(&a, &opts, &model)?;
     let t0 = Instant::now();
     let mut o = run_model(&a, &model, &opts, vtu_every)?;
@@ -498,6 +498,7 @@ fn run_file(a: &TransientArgs, path: &Path, opts: &TransientOptions) -> Result<O
         ));
     }
     let f = export::RomFile::read(path)?;
+    crate::common::record_input(format!("reduced model {}", path.display()));
     Ok(Outcome {
         res: driver::run(f.system()?, &f.scene(), opts)?,
         basis_size: f.dimension,
