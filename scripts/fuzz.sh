@@ -33,7 +33,8 @@ for s in c["sheets"]:
     s["elements"] = [6, 2]
 c["rigid_tie"]["x"] = 160.0
 c["rigid_tie"]["master"] = [160.0, 0.5, 12.5]
-c["welds"] = []
+# One weld: without it the upper sheet hangs on the master alone and K is singular.
+c["welds"] = [{"x": 100.0, "z": 12.5, "sheets": ["A", "B"], "diameter": 5.0}]
 json.dump(c, open(sys.argv[1], "w"))
 PY
 "$bin" export-matrices "$small" --out "$seeds/matrices" >/dev/null

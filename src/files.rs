@@ -291,7 +291,12 @@ pub fn write_atomic(path: &Path, bytes: impl AsRef<[u8]>) -> Result<(), Error> {
     write_atomic_with(path, |tmp| {
         let mut f = std::fs::File::create(tmp)?;
         f.write_all(bytes.as_ref())?;
-        f.sync_data()
+        // Flushed to disk before the rename; a device or pipe written in place has nothing to
+        // flush (and refuses the call).
+        if f.metadata()?.is_file() {
+            f.sync_data()?;
+        }
+        Ok::<(), std::io::Error>(())
     })
 }
 
@@ -303,6 +308,18 @@ pub fn write_atomic_with<E: Into<WriteFailure>>(
     path: &Path,
     fill: impl FnOnce(&Path) -> Result<(), E>,
 ) -> Result<(), Error> {
+    let path = match output_target(path)? {
+        Target::Replace(p) => p,
+        Target::Stream => {
+            // A device or a pipe (`--out /dev/null`, a FIFO) is written in place: there is
+            // nothing to replace, and renaming over it would put a file where the device was.
+            return fill(path).map_err(|e| match e.into() {
+                WriteFailure::Io(source) => write_err(path, "write", source),
+                WriteFailure::Error(err) => err,
+            });
+        }
+    };
+    let path = path.as_path();
     let dir = match path.parent() {
         Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
         _ => PathBuf::from("."),
@@ -315,7 +332,11 @@ pub fn write_atomic_with<E: Into<WriteFailure>>(
         .extension()
         .map(|e| format!(".{}", e.to_string_lossy()))
         .unwrap_or_default();
-    let tmp = tempfile::Builder::new()
+    let mut builder = tempfile::Builder::new();
+    // A normal new file's permissions (0666 less the umask), not the temporary file's 0600.
+    #[cfg(unix)]
+    builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o666));
+    let tmp = builder
         .prefix(&format!(".{name}."))
         .suffix(&suffix)
         .tempfile_in(&dir)
@@ -335,6 +356,45 @@ pub fn write_atomic_with<E: Into<WriteFailure>>(
         record(Created::File(path.to_path_buf()));
     }
     Ok(())
+}
+
+/// Where an output goes.
+enum Target {
+    /// A regular file, new or replaced by rename (a symbolic link's target, not the link).
+    Replace(PathBuf),
+    /// A device, pipe or socket, written in place.
+    Stream,
+}
+
+/// Resolves what writing `path` means: a new or regular file is replaced atomically, a symbolic
+/// link is followed (the file it points to is replaced and the link kept), a device or pipe is
+/// written in place, and a folder is an error.
+fn output_target(path: &Path) -> Result<Target, Error> {
+    let meta = match std::fs::symlink_metadata(path) {
+        Ok(m) => m,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+            return Ok(Target::Replace(path.to_path_buf()))
+        }
+        Err(e) => return Err(write_err(path, "write", e)),
+    };
+    let kind = meta.file_type();
+    if kind.is_symlink() {
+        let real = std::fs::canonicalize(path)
+            .map_err(|e| write_err(path, "write through the symbolic link", e))?;
+        return output_target(&real);
+    }
+    if kind.is_dir() {
+        return Err(write_err(
+            path,
+            "write",
+            std::io::Error::from(std::io::ErrorKind::IsADirectory),
+        ));
+    }
+    if kind.is_file() {
+        Ok(Target::Replace(path.to_path_buf()))
+    } else {
+        Ok(Target::Stream)
+    }
 }
 
 /// How a writer given to [`write_atomic_with`] failed: an OS error, or a jointrom error that

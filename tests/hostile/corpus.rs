@@ -1274,6 +1274,68 @@ fn outputs(fx: &Fixture) -> Vec<Hostile> {
         )
         .file("taken", "a file"),
         entry(
+            "out-link-to-device",
+            "output",
+            "--out is a symbolic link to /dev/null",
+            &["export", "friction_bar", "--g", "2", "--out", "{d}/nul"],
+            Contained("written through the link; the device stays a device"),
+        )
+        .setup(|d| std::os::unix::fs::symlink("/dev/null", d.join("nul")).unwrap())
+        .check(|d, _, _| {
+            use std::os::unix::fs::FileTypeExt;
+            let dev = std::fs::symlink_metadata("/dev/null").map_err(|e| e.to_string())?;
+            let link = std::fs::symlink_metadata(d.join("nul")).map_err(|e| e.to_string())?;
+            if !dev.file_type().is_char_device() {
+                Err("/dev/null was replaced by a file".into())
+            } else if !link.file_type().is_symlink() {
+                Err("the link was replaced".into())
+            } else {
+                Ok(())
+            }
+        }),
+        entry(
+            "out-link-to-file",
+            "output",
+            "--out is a symbolic link to a file",
+            &[
+                "export",
+                "friction_bar",
+                "--g",
+                "2",
+                "--out",
+                "{d}/link.json",
+            ],
+            Contained("the file it points to is replaced, the link kept"),
+        )
+        .file("real.json", "old")
+        .setup(|d| std::os::unix::fs::symlink("real.json", d.join("link.json")).unwrap())
+        .check(|d, _, _| {
+            let link = std::fs::symlink_metadata(d.join("link.json")).map_err(|e| e.to_string())?;
+            let real = std::fs::read_to_string(d.join("real.json")).map_err(|e| e.to_string())?;
+            if !link.file_type().is_symlink() {
+                Err("the link was replaced by a file".into())
+            } else if !real.contains("jointrom-rom") {
+                Err("the file behind the link was not written".into())
+            } else {
+                Ok(())
+            }
+        }),
+        entry(
+            "out-file-is-folder",
+            "output",
+            "--out names an existing folder where a file is written",
+            &[
+                "export",
+                "friction_bar",
+                "--g",
+                "2",
+                "--out",
+                "{d}/rom.json",
+            ],
+            Fails("is a folder"),
+        )
+        .setup(|d| std::fs::create_dir_all(d.join("rom.json")).unwrap()),
+        entry(
             "out-export-fails-clean",
             "output",
             "an export that fails half-way (M.mtx cannot be written)",

@@ -19,7 +19,7 @@ use corpus::{corpus, Expect};
 fn every_hostile_input_gets_its_answer() {
     let cases = corpus();
     assert!(cases.len() >= 80, "the corpus has {} entries", cases.len());
-    let failures = runner::run_all(&cases);
+    let (failures, _) = runner::run_all(&cases);
     assert!(
         failures.is_empty(),
         "{} of {} hostile inputs did not get their answer:\n{}",
@@ -39,24 +39,112 @@ fn corpus_ids_are_unique() {
     assert_eq!(ids.len(), n, "duplicate corpus ids");
 }
 
-/// Prints the README's table: class, input, what jointrom answers (a substring of its message).
+/// Prints the README's table: input kind, bad input, and the answer jointrom gives (the line of
+/// its message that the corpus checks).
 #[test]
 #[ignore = "prints the README table"]
 fn print_table() {
-    println!("| # | input kind | bad input | answer (exit, message contains) |");
+    let cases = corpus();
+    let (failures, answers) = runner::run_all(&cases);
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+    println!("| # | input kind | bad input | answer |");
     println!("|---|---|---|---|");
-    for (i, c) in corpus().iter().enumerate() {
+    for (i, (c, answer)) in cases.iter().zip(&answers).enumerate() {
+        let mut answer = answer.trim_start_matches("jointrom: ").replace('|', "\\|");
+        if answer.chars().count() > 160 {
+            answer = answer.chars().take(157).collect::<String>() + "…";
+        }
         let answer = match &c.expect {
-            Expect::Fails(m) => format!("error: `{}`", m.replace('|', "\\|")),
-            Expect::Warns(m) => format!("exit 0, warning: `{}`", m.replace('|', "\\|")),
-            Expect::Contained(m) => format!("exit 0, contained: {m}"),
+            Expect::Warns(_) => format!("exit 0, {answer}"),
+            _ => answer,
         };
         println!(
             "| {} | {} | {} | {} |",
             i + 1,
             c.kind,
             c.what.replace('|', "\\|"),
-            answer
+            answer.replace('`', "'")
+        );
+    }
+}
+
+/// Two runs writing into one folder at the same time (issue 16: 14 of 30 rounds left files that
+/// did not load): with atomic writes every round leaves whole files — the reduced model and the
+/// exported matrices load, whichever run renamed last.
+#[test]
+fn concurrent_runs_into_one_folder_leave_whole_files() {
+    use std::process::{Command, Stdio};
+    let dir = common::tmp_dir("hostile_concurrent");
+    let rom = dir.join("rom.json");
+    let mats = dir.join("fb");
+    let bin = env!("CARGO_BIN_EXE_jointrom");
+    for round in 0..20 {
+        let spawn = |args: &[&str]| {
+            Command::new(bin)
+                .args(args)
+                .stdout(Stdio::null())
+                .stderr(Stdio::piped())
+                .spawn()
+                .expect("spawn jointrom")
+        };
+        let g = if round % 2 == 0 { "4" } else { "6" };
+        let children = [
+            spawn(&[
+                "export",
+                "friction_bar",
+                "--g",
+                "4",
+                "--out",
+                rom.to_str().unwrap(),
+            ]),
+            spawn(&[
+                "export",
+                "friction_bar",
+                "--g",
+                g,
+                "--out",
+                rom.to_str().unwrap(),
+            ]),
+            spawn(&[
+                "export-matrices",
+                "friction_bar",
+                "--out",
+                mats.to_str().unwrap(),
+            ]),
+            spawn(&[
+                "export-matrices",
+                "friction_bar",
+                "--out",
+                mats.to_str().unwrap(),
+            ]),
+        ];
+        for c in children {
+            let out = c.wait_with_output().unwrap();
+            assert!(
+                out.status.success(),
+                "round {round}: {}",
+                String::from_utf8_lossy(&out.stderr)
+            );
+        }
+        // Both files load: the ROM through a short run, the matrices through `info`.
+        common::jointrom_ok([
+            "transient",
+            "friction_bar",
+            "--model",
+            &format!("file:{}", rom.display()),
+            "--end-time",
+            "0.001",
+        ]);
+        common::jointrom_ok(["info", mats.join("model.json").to_str().unwrap()]);
+        let leftovers: Vec<_> = std::fs::read_dir(&dir)
+            .unwrap()
+            .chain(std::fs::read_dir(&mats).unwrap())
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .filter(|n| n.starts_with('.'))
+            .collect();
+        assert!(
+            leftovers.is_empty(),
+            "round {round}: temporary files left: {leftovers:?}"
         );
     }
 }

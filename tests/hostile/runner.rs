@@ -60,30 +60,35 @@ pub fn fixture() -> &'static Fixture {
     })
 }
 
-/// Runs every entry (two threads); the failures, one line each.
-pub fn run_all(cases: &[Hostile]) -> Vec<String> {
+/// Runs every entry (two threads); the failures, one line each, and every entry's answer (in
+/// corpus order; empty for a failure).
+pub fn run_all(cases: &[Hostile]) -> (Vec<String>, Vec<String>) {
     let fx = fixture();
     let root = fx.dir.join("corpus");
     let _ = std::fs::remove_dir_all(&root);
     let next = std::sync::atomic::AtomicUsize::new(0);
     let failures = std::sync::Mutex::new(Vec::new());
+    let answers = std::sync::Mutex::new(vec![String::new(); cases.len()]);
     std::thread::scope(|s| {
         for _ in 0..2 {
             s.spawn(|| loop {
                 let i = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
                 let Some(c) = cases.get(i) else { break };
-                if let Err(msg) = run_one(c, &root.join(c.id)) {
-                    failures.lock().unwrap().push(format!("  {}: {msg}", c.id));
+                match run_one(c, &root.join(c.id)) {
+                    Ok(answer) => answers.lock().unwrap()[i] = answer,
+                    Err(msg) => failures.lock().unwrap().push(format!("  {}: {msg}", c.id)),
                 }
             });
         }
     });
     let mut f = failures.into_inner().unwrap();
     f.sort();
-    f
+    (f, answers.into_inner().unwrap())
 }
 
-fn run_one(c: &Hostile, dir: &Path) -> Result<(), String> {
+/// Runs one entry; its answer (the stderr line that carries the expected text, the folder
+/// replaced by `…`) or what went wrong.
+fn run_one(c: &Hostile, dir: &Path) -> Result<String, String> {
     std::fs::create_dir_all(dir).unwrap();
     for (name, bytes) in &c.files {
         let p = dir.join(name);
@@ -155,7 +160,15 @@ fn run_one(c: &Hostile, dir: &Path) -> Result<(), String> {
     if let Some(check) = &c.check {
         check(dir, &stdout, &stderr)?;
     }
-    Ok(())
+    let answer = match &c.expect {
+        Expect::Fails(m) | Expect::Warns(m) => stderr
+            .lines()
+            .find(|l| l.contains(m))
+            .unwrap_or(line)
+            .to_string(),
+        Expect::Contained(m) => format!("exit 0: {m}"),
+    };
+    Ok(answer.replace(dir.to_str().unwrap(), "…"))
 }
 
 type Drained = std::thread::JoinHandle<Vec<u8>>;

@@ -108,7 +108,7 @@ pub fn run(a: SweepArgs) -> Result<(), Error> {
         print_runs(&res);
     }
     for r in &res.runs {
-        let check = r.curves.energy_check();
+        let check = r.curves.energy_check(opts.energy_resolution());
         if r.status == "ok" && !check.ok {
             eprintln!(
                 "jointrom: warning: variant `{}`: energy balance off by {:.3e} of its energy \

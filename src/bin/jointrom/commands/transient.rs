@@ -188,11 +188,11 @@ pub fn run(a: TransientArgs) -> Result<(), Error> {
         "error_estimate": estimate_json(&o.estimate),
         "curves": c,
         "energy_balance": c.balance(),
-        "energy_check": c.energy_check(),
+        "energy_check": c.energy_check(opts.energy_resolution()),
         "training": o.training,
         "profile": o.res.profile,
     });
-    let check = c.energy_check();
+    let check = c.energy_check(opts.energy_resolution());
     if !check.ok {
         eprintln!(
             "jointrom: warning: energy balance off by {:.3e} of the run's energy ({:.3e} N·mm \
