@@ -40,7 +40,7 @@ pub enum Error {
     /// A JSON document jointrom reads besides case files and maps (an exported reduced model, a
     /// sweep's variants) is malformed: the file, the JSON path, the reason, and serde's error as
     /// the source when the JSON did not parse into the schema.
-    #[error("invalid request: {}: at `{path}`: {reason}", file.display())]
+    #[error("{}: at `{path}`: {reason}", file.display())]
     Document {
         file: PathBuf,
         path: String,

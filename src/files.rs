@@ -7,7 +7,9 @@
 //! - **writes are atomic**: every output file is written to a temporary file in the same folder
 //!   and renamed over its name when complete ([`write_atomic`], [`write_atomic_with`]), so a
 //!   reader never sees a half-written file, two runs into one folder leave whole files, and a
-//!   failed write leaves nothing;
+//!   failed write leaves nothing; a symbolic link is followed (the file it points to is
+//!   replaced, the link kept), a device or pipe (`--out /dev/null`) is written in place, never
+//!   replaced, and new files get the usual permissions (0666 less the umask);
 //! - **names are contained**: a model or variant name becomes a file or folder name only through
 //!   [`safe_name`] (no `/`, no `..`, no absolute path, no control characters) and is printed only
 //!   through [`printable`] (control characters escaped);

@@ -661,6 +661,9 @@ impl MapReader<'_> {
     /// farther apart than `max_pair_distance` (default: 10 × the median pair distance, at least
     /// 10⁻³ × the model's bounding-box diagonal) is a mistake in the map, not a joint.
     fn check_pair_distances(&self, pairs: &[PairFrame]) -> Result<(), Error> {
+        if pairs.is_empty() {
+            return Ok(());
+        }
         let xyz = |i: usize| self.map.nodes[i].xyz;
         let dist = |p: &PairFrame| {
             let (a, b) = (xyz(p.lower), xyz(p.upper));

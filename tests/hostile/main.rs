@@ -51,8 +51,8 @@ fn print_table() {
     println!("|---|---|---|---|");
     for (i, (c, answer)) in cases.iter().zip(&answers).enumerate() {
         let mut answer = answer.trim_start_matches("jointrom: ").replace('|', "\\|");
-        if answer.chars().count() > 160 {
-            answer = answer.chars().take(157).collect::<String>() + "…";
+        if answer.chars().count() > 240 {
+            answer = answer.chars().take(237).collect::<String>() + "…";
         }
         let answer = match &c.expect {
             Expect::Warns(_) => format!("exit 0, {answer}"),

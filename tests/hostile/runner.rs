@@ -161,11 +161,23 @@ fn run_one(c: &Hostile, dir: &Path) -> Result<String, String> {
         check(dir, &stdout, &stderr)?;
     }
     let answer = match &c.expect {
-        Expect::Fails(m) | Expect::Warns(m) => stderr
-            .lines()
-            .find(|l| l.contains(m))
-            .unwrap_or(line)
-            .to_string(),
+        Expect::Fails(m) | Expect::Warns(m) => {
+            // The error (or warning) line, and the line with the expected text if another.
+            let first = stderr
+                .lines()
+                .find(|l| l.contains("error:") || l.contains("warning:"))
+                .unwrap_or(line);
+            match stderr.lines().find(|l| l.contains(m)) {
+                Some(l) if l != first => {
+                    let head: String = first.chars().take(120).collect();
+                    format!(
+                        "{head}… / {}",
+                        l.trim().trim_start_matches("jointrom:").trim()
+                    )
+                }
+                _ => first.to_string(),
+            }
+        }
         Expect::Contained(m) => format!("exit 0: {m}"),
     };
     Ok(answer.replace(dir.to_str().unwrap(), "…"))
