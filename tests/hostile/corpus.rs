@@ -176,6 +176,7 @@ pub fn corpus() -> Vec<Hostile> {
     v.extend(flags(fx));
     v.extend(variants(fx));
     v.extend(outputs(fx));
+    v.extend(output_links());
     v
 }
 
@@ -1283,6 +1284,27 @@ fn outputs(fx: &Fixture) -> Vec<Hostile> {
         )
         .file("taken", "a file"),
         entry(
+            "out-export-fails-clean",
+            "output",
+            "an export that fails half-way (M.mtx cannot be written)",
+            &["export-matrices", "friction_bar", "--out", "{d}/out"],
+            Fails("M.mtx"),
+        )
+        .setup(|d| std::fs::create_dir_all(d.join("out/M.mtx/inside")).unwrap())
+        .check(|d, _, _| {
+            if d.join("out/K.mtx").exists() {
+                Err("partial output K.mtx left behind".into())
+            } else {
+                Ok(())
+            }
+        }),
+    ]
+}
+
+fn output_links() -> Vec<Hostile> {
+    use Expect::{Contained, Fails};
+    vec![
+        entry(
             "out-link-to-device",
             "output",
             "--out is a symbolic link to /dev/null",
@@ -1344,20 +1366,5 @@ fn outputs(fx: &Fixture) -> Vec<Hostile> {
             Fails("is a folder"),
         )
         .setup(|d| std::fs::create_dir_all(d.join("rom.json")).unwrap()),
-        entry(
-            "out-export-fails-clean",
-            "output",
-            "an export that fails half-way (M.mtx cannot be written)",
-            &["export-matrices", "friction_bar", "--out", "{d}/out"],
-            Fails("M.mtx"),
-        )
-        .setup(|d| std::fs::create_dir_all(d.join("out/M.mtx/inside")).unwrap())
-        .check(|d, _, _| {
-            if d.join("out/K.mtx").exists() {
-                Err("partial output K.mtx left behind".into())
-            } else {
-                Ok(())
-            }
-        }),
     ]
 }
