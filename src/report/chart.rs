@@ -45,6 +45,9 @@ pub struct Series {
     pub markers: bool,
     /// Join the points by a line (`false`: a scatter of markers).
     pub line: bool,
+    /// Palette slot of the colour; `None`: the series' position in the chart (so that one
+    /// model keeps its colour across charts that show different subsets).
+    pub color: Option<usize>,
 }
 
 impl Series {
@@ -55,6 +58,7 @@ impl Series {
             points,
             markers: true,
             line: true,
+            color: None,
         }
     }
 
@@ -179,8 +183,14 @@ impl LineChart {
         })
     }
 
+    /// A point that can be drawn: finite, positive on a log axis, and inside a fixed y range
+    /// (a series leaving the range is cut there rather than drawn across the frame).
     fn drawable(&self, x: f64, y: f64) -> bool {
-        x.is_finite() && y.is_finite() && (!self.x_log || x > 0.0) && (!self.y_log || y > 0.0)
+        x.is_finite()
+            && y.is_finite()
+            && (!self.x_log || x > 0.0)
+            && (!self.y_log || y > 0.0)
+            && self.y_range.is_none_or(|(lo, hi)| (lo..=hi).contains(&y))
     }
 
     /// Data ranges over the drawable points and references, with a margin.
@@ -271,8 +281,8 @@ impl LineChart {
             .y_label_area_size(80)
             .build_cartesian_2d(xs, ys)
             .map_err(|e| err(&e))?;
-        let x_fmt = |v: &f64| tick(*v, self.x_log);
-        let y_fmt = |v: &f64| tick(*v, self.y_log);
+        let x_fmt = |v: &f64| tick(*v, self.x_log, xmin.abs().max(xmax.abs()));
+        let y_fmt = |v: &f64| tick(*v, self.y_log, ylo.abs().max(yhi.abs()));
         chart
             .configure_mesh()
             .x_desc(self.x_label.as_str())
@@ -284,7 +294,7 @@ impl LineChart {
             .draw()
             .map_err(|e| err(&e))?;
         for (k, s) in self.series.iter().enumerate() {
-            let color = palette(k);
+            let color = palette(s.color.unwrap_or(k));
             // Runs of drawable points: a point that cannot be drawn breaks the line.
             let mut runs: Vec<Vec<(f64, f64)>> = vec![Vec::new()];
             for &(x, y) in &s.points {
@@ -466,7 +476,14 @@ fn pad_x((lo, hi): (f64, f64), log: bool) -> (f64, f64) {
     }
 }
 
-fn tick(v: f64, log: bool) -> String {
+/// A tick label; on a linear axis whose values reach `scale`, a value within round-off of zero
+/// (`-2.2e-16`) is written `0`.
+fn tick(v: f64, log: bool, scale: f64) -> String {
+    let v = if !log && v.abs() <= 1e-9 * scale {
+        0.0
+    } else {
+        v
+    };
     if log {
         format!("{v:.0e}")
     } else if v != 0.0 && (v.abs() >= 1e5 || v.abs() < 1e-3) {

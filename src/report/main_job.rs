@@ -102,9 +102,14 @@ pub fn write_report(
         &serde_json::to_string_pretty(report).expect("the report serialises"),
     )?;
     let md = dir.join("report.md");
-    write(&md, &markdown(report, &stab, !stability_files.is_empty()))?;
+    let text = markdown(report, &stab, !stability_files.is_empty());
+    write(&md, &text)?;
+    // The same report as one self-contained page (images inlined).
+    let page = crate::report::html::render(&text, dir, &format!("jointrom report: {case}"))?;
+    write(&dir.join("report.html"), &page)?;
     report.files.push("results.json".into());
     report.files.push("report.md".into());
+    report.files.push("report.html".into());
     Ok(())
 }
 
@@ -141,37 +146,160 @@ fn time_charts(rep: &Report, dir: &Path) -> Result<Vec<PathBuf>, Error> {
         shown.push(h);
     }
     let mut files = Vec::new();
-    let quantities: [(&str, &str, &str, Curve); 3] = [
-        ("fc_t", "contact force norm ‖f_c‖", "‖f_c‖ (N)", |r| &r.fc),
-        ("fr_t", "friction force norm ‖f_R‖", "‖f_R‖ (N)", |r| &r.fr),
-        ("uy_t", "master displacement u_y", "u_y (mm)", |r| &r.uy),
+    let quantities: [(&str, &str, &str, &str, Curve); 3] = [
+        (
+            "fc",
+            "contact force norm ‖f_c‖",
+            "‖f_c‖ (N)",
+            "N",
+            |r| &r.fc,
+        ),
+        (
+            "fr",
+            "friction force norm ‖f_R‖",
+            "‖f_R‖ (N)",
+            "N",
+            |r| &r.fr,
+        ),
+        ("uy", "master displacement u_y", "u_y (mm)", "mm", |r| &r.uy),
     ];
-    for (stem, what, unit, get) in quantities {
-        let mut c = LineChart::new(
-            format!("{}: {what}, full FE vs reduced models", rep.case),
-            "t (s)",
-            unit,
+    for (stem, what, axis, unit, get) in quantities {
+        let label = |r: &RunRecord| run_label(rep, r);
+        files.extend(
+            history_chart(rep, &shown, what, axis, unit, get, &label)?
+                .write(&dir.join(format!("{stem}_t")))?,
         );
-        c.legend = LegendPosition::UpperRight;
-        for r in &shown {
-            let mut s = Series::new(
-                if r.model == "full" {
-                    format!("full FE ({} DOF)", r.size)
-                } else if let Some((tol, _)) = r.tolerance {
-                    format!("adaptive, TOL {tol:.0e} (r = {})", r.size)
-                } else if r.g == Some(rep.g_chosen) {
-                    format!("TVD g = {} (a priori, w ≥ {})", rep.g_chosen, rep.threshold)
-                } else {
-                    format!("TVD g = {}", r.g.unwrap_or(0))
-                },
-                r.t.iter().copied().zip(get(r).iter().copied()).collect(),
-            );
-            s.markers = false;
-            c.series.push(s);
+        if let Some(c) = error_chart(rep, &shown, what, get, &label) {
+            files.extend(c.write(&dir.join(format!("{stem}_err_t")))?);
         }
-        files.extend(c.write(&dir.join(stem))?);
     }
     Ok(files)
+}
+
+/// The legend text of a run in the time charts.
+fn run_label(rep: &Report, r: &RunRecord) -> String {
+    if r.model == "full" {
+        format!("full FE ({} DOF)", r.size)
+    } else if let Some((tol, _)) = r.tolerance {
+        format!("adaptive, TOL {tol:.0e} (r = {})", r.size)
+    } else if r.g == Some(rep.g_chosen) {
+        format!("TVD g = {} (a priori, w ≥ {})", rep.g_chosen, rep.threshold)
+    } else {
+        format!("TVD g = {}", r.g.unwrap_or(0))
+    }
+}
+
+/// How far beyond the full run's range a series may reach before it is drawn off scale: a
+/// series that dwarfs the others (g = 0's 55 N against 2.5 N) would flatten the curves that
+/// matter into the axis.
+const OFF_SCALE: f64 = 3.0;
+
+/// One quantity's history, full FE against the reduced models. The y range is the full run's
+/// (and every series within [`OFF_SCALE`] of it); a series beyond is cut at the frame and its
+/// legend gives its peak.
+fn history_chart(
+    rep: &Report,
+    shown: &[&RunRecord],
+    what: &str,
+    axis: &str,
+    unit: &str,
+    get: Curve,
+    label: &dyn Fn(&RunRecord) -> String,
+) -> Result<LineChart, Error> {
+    let mut c = LineChart::new(
+        format!("{}: {what}, full FE vs reduced models", rep.case),
+        "t (s)",
+        axis,
+    );
+    c.legend = LegendPosition::UpperRight;
+    let extent = |r: &RunRecord| {
+        get(r)
+            .iter()
+            .filter(|v| v.is_finite())
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| {
+                (lo.min(v), hi.max(v))
+            })
+    };
+    let (flo, fhi) = extent(shown[0]);
+    let span = (fhi - flo)
+        .max(fhi.abs().max(flo.abs()) * 1e-6)
+        .max(f64::MIN_POSITIVE);
+    let in_scale =
+        |(lo, hi): (f64, f64)| lo >= flo - OFF_SCALE * span && hi <= fhi + OFF_SCALE * span;
+    let mut range = (flo, fhi);
+    let mut off = false;
+    for r in shown {
+        let e = extent(r);
+        if e.0 > e.1 {
+            continue;
+        }
+        if in_scale(e) {
+            range = (range.0.min(e.0), range.1.max(e.1));
+        } else {
+            off = true;
+        }
+    }
+    for r in shown {
+        let e = extent(r);
+        let mut text = label(r);
+        if off && e.0 <= e.1 && !in_scale(e) {
+            let peak = if e.1.abs() >= e.0.abs() { e.1 } else { e.0 };
+            text = format!("{text} — off scale, peak {peak:.3} {unit}");
+        }
+        let mut s = Series::new(
+            text,
+            r.t.iter().copied().zip(get(r).iter().copied()).collect(),
+        );
+        s.markers = false;
+        c.series.push(s);
+    }
+    if off {
+        let pad = 0.08 * (range.1 - range.0).max(span);
+        c.y_range = Some((range.0 - pad, range.1 + pad));
+    }
+    Ok(c)
+}
+
+/// The reduced models' error over time, `|q_ROM(t) − q_full(t)| / max_t |q_full|`, on a log
+/// axis: where the histories lie on top of each other this is what tells them apart. `None`
+/// without a full run to compare with.
+fn error_chart(
+    rep: &Report,
+    shown: &[&RunRecord],
+    what: &str,
+    get: Curve,
+    label: &dyn Fn(&RunRecord) -> String,
+) -> Option<LineChart> {
+    let full = shown.first().filter(|r| r.model == "full")?;
+    let reference = get(full);
+    let scale = reference.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    if !(scale > 0.0 && scale.is_finite()) {
+        return None;
+    }
+    let mut c = LineChart::new(
+        format!("{}: error of {what} against full FE", rep.case),
+        "t (s)",
+        "|ROM − full| / max |full| (log)",
+    );
+    c.y_log = true;
+    c.legend = LegendPosition::LowerRight;
+    for (k, r) in shown.iter().enumerate().skip(1) {
+        // The runs share the output times; a run that stopped early is compared where it ran.
+        let pts: Vec<(f64, f64)> =
+            r.t.iter()
+                .zip(get(r))
+                .zip(reference)
+                .map(|((&t, &q), &q0)| (t, (q - q0).abs() / scale))
+                .collect();
+        let mut s = Series::new(label(r), pts);
+        s.markers = false;
+        // The colour the run has in the history chart.
+        s.color = Some(k);
+        c.series.push(s);
+    }
+    // Errors at round-off level (or exactly zero) are not drawn on the log axis.
+    let drawable = c.series.iter().any(|s| s.points.iter().any(|p| p.1 > 0.0));
+    drawable.then_some(c)
 }
 
 /// CPU time against the ‖f_c‖ error, one scatter series per (basis kind, iteration), the Pareto
@@ -307,12 +435,21 @@ fn markdown(rep: &Report, stab: &Path, stability: bool) -> String {
         s,
         "## Transient: full FE against TVD reduced models (Figs. 9, 11, 12, 17, 18)\n"
     );
+    let _ = writeln!(
+        s,
+        "Each quantity twice: its history (a model far off the full run's range is cut at the \
+         frame, its legend gives its peak), and each reduced model's error against the full run \
+         on a log scale, relative to the full run's peak.\n"
+    );
     for (stem, what) in [
-        ("fc_t", "contact force norm"),
-        ("fr_t", "friction force norm"),
-        ("uy_t", "master displacement"),
+        ("fc", "contact force norm"),
+        ("fr", "friction force norm"),
+        ("uy", "master displacement"),
     ] {
-        let _ = writeln!(s, "![{what}]({stem}.png)\n");
+        let _ = writeln!(s, "![{what}]({stem}_t.png)\n");
+        if rep.files.iter().any(|f| *f == format!("{stem}_err_t.png")) {
+            let _ = writeln!(s, "![error of the {what}]({stem}_err_t.png)\n");
+        }
     }
     let _ = writeln!(s, "## Speed against accuracy\n");
     let _ = writeln!(

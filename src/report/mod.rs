@@ -6,6 +6,7 @@ pub mod chart;
 pub mod convergence;
 pub mod curves;
 pub mod heatmap;
+pub mod html;
 pub mod main_job;
 pub mod shapes;
 pub mod stability;
