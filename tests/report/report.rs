@@ -20,62 +20,7 @@ fn quick_report_on_the_friction_bar() {
     extra.insert("marker".into(), serde_json::json!(42));
     let rep = run_report(&model, &dir, &opts, extra).unwrap();
 
-    // Files: every chart as PNG and SVG, the study charts, the stored stability map, the texts.
-    for f in [
-        "report.md",
-        "results.json",
-        "report.html",
-        "fc_t.png",
-        "fc_t.svg",
-        "fc_err_t.png",
-        "fr_t.png",
-        "fr_err_t.png",
-        "uy_t.png",
-        "speed_accuracy.png",
-        "speed_accuracy.svg",
-        "study/fc_error.png",
-        "study/w.png",
-        "stability_status.png",
-    ] {
-        let p = dir.join(f);
-        let len = std::fs::metadata(&p)
-            .unwrap_or_else(|e| panic!("{} missing: {e}", p.display()))
-            .len();
-        assert!(
-            len > 1000,
-            "{} is suspiciously small ({len} bytes)",
-            p.display()
-        );
-    }
-    let md = std::fs::read_to_string(dir.join("report.md")).unwrap();
-    for needle in [
-        "speed_accuracy.png",
-        "fc_t.png",
-        "study/w.png",
-        "stability_status.png",
-    ] {
-        assert!(md.contains(needle), "report.md does not show {needle}");
-    }
-    // The error charts are shown, and the HTML page carries every image of the markdown inline
-    // (no link back to the folder).
-    assert!(
-        md.contains("fc_err_t.png"),
-        "report.md does not show the error chart"
-    );
-    let html = std::fs::read_to_string(dir.join("report.html")).unwrap();
-    let images = md.matches("![").count();
-    assert_eq!(
-        html.matches("src=\"data:image/png;base64,").count(),
-        images,
-        "report.html does not inline all {images} images"
-    );
-    assert!(!html.contains("src=\"fc_t.png\""));
-    // g = 0's contact force dwarfs the others: it is drawn off scale, its peak in the legend.
-    let svg = std::fs::read_to_string(dir.join("fc_t.svg")).unwrap();
-    assert!(
-        svg.contains("TVD g = 0 — off scale, peak"),
-        "g = 0 not drawn off scale"
-    );
+    check_outputs(&dir);
     let json: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("results.json")).unwrap()).unwrap();
     assert_eq!(json["marker"], 42, "extra fields reach results.json");
@@ -173,4 +118,64 @@ fn quick_report_on_the_friction_bar() {
         h.error_fc
     );
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The quick report's files: every chart as PNG and SVG, the study charts, the stored stability
+/// map, the texts, the inlined HTML page and the off-scale legend.
+fn check_outputs(dir: &std::path::Path) {
+    for f in [
+        "report.md",
+        "results.json",
+        "report.html",
+        "fc_t.png",
+        "fc_t.svg",
+        "fc_err_t.png",
+        "fr_t.png",
+        "fr_err_t.png",
+        "uy_t.png",
+        "speed_accuracy.png",
+        "speed_accuracy.svg",
+        "study/fc_error.png",
+        "study/w.png",
+        "stability_status.png",
+    ] {
+        let p = dir.join(f);
+        let len = std::fs::metadata(&p)
+            .unwrap_or_else(|e| panic!("{} missing: {e}", p.display()))
+            .len();
+        assert!(
+            len > 1000,
+            "{} is suspiciously small ({len} bytes)",
+            p.display()
+        );
+    }
+    let md = std::fs::read_to_string(dir.join("report.md")).unwrap();
+    for needle in [
+        "speed_accuracy.png",
+        "fc_t.png",
+        "study/w.png",
+        "stability_status.png",
+    ] {
+        assert!(md.contains(needle), "report.md does not show {needle}");
+    }
+    // The error charts are shown, and the HTML page carries every image of the markdown inline
+    // (no link back to the folder).
+    assert!(
+        md.contains("fc_err_t.png"),
+        "report.md does not show the error chart"
+    );
+    let html = std::fs::read_to_string(dir.join("report.html")).unwrap();
+    let images = md.matches("![").count();
+    assert_eq!(
+        html.matches("src=\"data:image/png;base64,").count(),
+        images,
+        "report.html does not inline all {images} images"
+    );
+    assert!(!html.contains("src=\"fc_t.png\""));
+    // g = 0's contact force dwarfs the others: it is drawn off scale, its peak in the legend.
+    let svg = std::fs::read_to_string(dir.join("fc_t.svg")).unwrap();
+    assert!(
+        svg.contains("TVD g = 0 — off scale, peak"),
+        "g = 0 not drawn off scale"
+    );
 }
