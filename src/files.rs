@@ -37,11 +37,16 @@ pub const INPUT_BUDGET_VAR: &str = "JOINTROM_MAX_INPUT_BYTES";
 /// The largest input file jointrom reads, bytes: `JOINTROM_MAX_INPUT_BYTES` if set to a positive
 /// integer, else [`DEFAULT_INPUT_BUDGET`].
 pub fn input_budget() -> u64 {
-    std::env::var(INPUT_BUDGET_VAR)
+    env_budget(INPUT_BUDGET_VAR, DEFAULT_INPUT_BUDGET)
+}
+
+/// The positive integer in the environment variable `var`, else `default`.
+fn env_budget<T: std::str::FromStr + PartialOrd + Default>(var: &str, default: T) -> T {
+    std::env::var(var)
         .ok()
-        .and_then(|v| v.trim().parse::<u64>().ok())
-        .filter(|&v| v > 0)
-        .unwrap_or(DEFAULT_INPUT_BUDGET)
+        .and_then(|v| v.trim().parse::<T>().ok())
+        .filter(|v| *v > T::default())
+        .unwrap_or(default)
 }
 
 /// Default bound on the size of a model, DOF (6 per node of a case's mesh, or rows of a
@@ -56,11 +61,7 @@ pub const DOF_BUDGET_VAR: &str = "JOINTROM_MAX_DOF";
 /// The largest model jointrom builds, DOF: `JOINTROM_MAX_DOF` if set to a positive integer,
 /// else [`DEFAULT_DOF_BUDGET`].
 pub fn dof_budget() -> usize {
-    std::env::var(DOF_BUDGET_VAR)
-        .ok()
-        .and_then(|v| v.trim().parse::<usize>().ok())
-        .filter(|&v| v > 0)
-        .unwrap_or(DEFAULT_DOF_BUDGET)
+    env_budget(DOF_BUDGET_VAR, DEFAULT_DOF_BUDGET)
 }
 
 /// What a file-system error means, in words (used by [`Error::Io`] and [`Error::Write`]).

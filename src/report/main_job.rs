@@ -164,12 +164,11 @@ fn time_charts(rep: &Report, dir: &Path) -> Result<Vec<PathBuf>, Error> {
         ("uy", "master displacement u_y", "u_y (mm)", "mm", |r| &r.uy),
     ];
     for (stem, what, axis, unit, get) in quantities {
-        let label = |r: &RunRecord| run_label(rep, r);
         files.extend(
-            history_chart(rep, &shown, what, axis, unit, get, &label)?
+            history_chart(rep, &shown, what, axis, unit, get)
                 .write(&dir.join(format!("{stem}_t")))?,
         );
-        if let Some(c) = error_chart(rep, &shown, what, get, &label) {
+        if let Some(c) = error_chart(rep, &shown, what, get) {
             files.extend(c.write(&dir.join(format!("{stem}_err_t")))?);
         }
     }
@@ -204,8 +203,7 @@ fn history_chart(
     axis: &str,
     unit: &str,
     get: Curve,
-    label: &dyn Fn(&RunRecord) -> String,
-) -> Result<LineChart, Error> {
+) -> LineChart {
     let mut c = LineChart::new(
         format!("{}: {what}, full FE vs reduced models", rep.case),
         "t (s)",
@@ -241,7 +239,7 @@ fn history_chart(
     }
     for r in shown {
         let e = extent(r);
-        let mut text = label(r);
+        let mut text = run_label(rep, r);
         if off && e.0 <= e.1 && !in_scale(e) {
             let peak = if e.1.abs() >= e.0.abs() { e.1 } else { e.0 };
             text = format!("{text} — off scale, peak {peak:.3} {unit}");
@@ -257,19 +255,13 @@ fn history_chart(
         let pad = 0.08 * (range.1 - range.0).max(span);
         c.y_range = Some((range.0 - pad, range.1 + pad));
     }
-    Ok(c)
+    c
 }
 
 /// The reduced models' error over time, `|q_ROM(t) − q_full(t)| / max_t |q_full|`, on a log
 /// axis: where the histories lie on top of each other this is what tells them apart. `None`
 /// without a full run to compare with.
-fn error_chart(
-    rep: &Report,
-    shown: &[&RunRecord],
-    what: &str,
-    get: Curve,
-    label: &dyn Fn(&RunRecord) -> String,
-) -> Option<LineChart> {
+fn error_chart(rep: &Report, shown: &[&RunRecord], what: &str, get: Curve) -> Option<LineChart> {
     let full = shown.first().filter(|r| r.model == "full")?;
     let reference = get(full);
     let scale = reference.iter().fold(0.0f64, |m, v| m.max(v.abs()));
@@ -291,7 +283,7 @@ fn error_chart(
                 .zip(reference)
                 .map(|((&t, &q), &q0)| (t, (q - q0).abs() / scale))
                 .collect();
-        let mut s = Series::new(label(r), pts);
+        let mut s = Series::new(run_label(rep, r), pts);
         s.markers = false;
         // The colour the run has in the history chart.
         s.color = Some(k);
