@@ -48,6 +48,15 @@ pub enum Error {
         #[source]
         source: Option<Box<serde_json::Error>>,
     },
+    /// A NASTRAN deck is malformed or asks for what jointrom does not model: the file and line
+    /// of the card, the card (name and id) and the reason.
+    #[error("{}:{line}: {card}: {reason}", file.display())]
+    Deck {
+        file: PathBuf,
+        line: usize,
+        card: String,
+        reason: String,
+    },
     /// An element could not be built (degenerate geometry, bad material).
     #[error("element: {0}")]
     Element(String),

@@ -32,7 +32,7 @@ pub struct Structure {
     pub mass: SymCsc,
 }
 
-/// Builds every `Shell4`, `Beam2` and area `Weld` of the mesh and assembles K and M on the
+/// Builds every `Shell4`, `Beam2`, area `Weld` and point mass of the mesh and assembles K and M on the
 /// independent DOF.
 pub fn assemble_structure(mesh: &Mesh) -> Result<Structure, Error> {
     let material = mesh.material;
@@ -65,18 +65,24 @@ pub fn assemble_structure(mesh: &Mesh) -> Result<Structure, Error> {
         .map(|s| &s.nodes[..])
         .chain(mesh.beams.iter().map(|b| &b.nodes[..]))
         .chain(welds.iter().map(Weld::nodes))
+        .chain(mesh.masses.iter().map(|m| std::slice::from_ref(&m.node)))
         .collect();
     let assembler = Assembler::new(&dof_map, element_nodes);
-    let (ns, nb) = (shells.len(), beams.len());
+    let (ns, nb, nw) = (shells.len(), beams.len(), welds.len());
     let stiffness = assembler.assemble(|e| match e {
         e if e < ns => shells[e].stiffness(),
         e if e < ns + nb => beams[e - ns].stiffness(),
-        e => welds[e - ns - nb].stiffness(),
+        e if e < ns + nb + nw => welds[e - ns - nb].stiffness(),
+        _ => Mat::zeros(6, 6),
     });
     let mass = assembler.assemble(|e| match e {
         e if e < ns => shells[e].mass(),
         e if e < ns + nb => beams[e - ns].mass(),
-        e => welds[e - ns - nb].mass(),
+        e if e < ns + nb + nw => welds[e - ns - nb].mass(),
+        e => {
+            let m = mesh.masses[e - ns - nb - nw].matrix();
+            Mat::from_fn(6, 6, |a, b| m[a][b])
+        }
     });
     Ok(Structure {
         dof_map,

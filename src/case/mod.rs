@@ -65,6 +65,7 @@
 //! the mesh, which re-runs the field checks too — so a `Case` edited in code cannot produce a
 //! broken mesh either, and the validator and the generator cannot disagree.
 
+pub mod nastran;
 mod parse;
 
 pub(crate) mod validate;
@@ -231,7 +232,7 @@ pub struct ContactSpec {
 }
 
 /// The load on the master node: constant components times a ramp in time.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct LoadSpec {
     /// Final values of the master-node load.
@@ -280,40 +281,163 @@ impl MasterLoadSpec {
     }
 }
 
-/// The load's rise in time.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+/// The load's time function: a half-cosine rise (`{"shape": "half_cosine", "duration": T}`)
+/// or a table (`{"shape": "table", "points": [[t0, f0], [t1, f1], ...]}`, NASTRAN's `TABLED1`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RampSpec {
-    /// Shape of the rise.
+    /// Shape of the time function.
     pub shape: RampShape,
-    /// Rise time T, s (> 0): the load is at its final value from `t = T` on.
-    pub duration: f64,
+    /// Rise time T of `half_cosine`, s (> 0; required there, not allowed for `table`): the
+    /// load is at its final value from `t = T` on.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub duration: Option<f64>,
+    /// The `table` shape's points `[t (s), factor]`, at least two, t non-decreasing (a repeated
+    /// t is a jump); empty for `half_cosine`.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub points: Vec<[f64; 2]>,
 }
 
 impl RampSpec {
-    /// The load factor at time `t` (s): 0 for `t ≤ 0`, 1 for `t ≥ T`, and for
-    /// [`RampShape::HalfCosine`] `½(1 − cos(π t / T))` in between.
+    /// The half-cosine rise over `duration` s.
+    pub fn half_cosine(duration: f64) -> RampSpec {
+        RampSpec {
+            shape: RampShape::HalfCosine,
+            duration: Some(duration),
+            points: Vec::new(),
+        }
+    }
+
+    /// The load factor at time `t` (s). [`RampShape::HalfCosine`]: 0 for `t ≤ 0`, 1 for
+    /// `t ≥ T`, `½(1 − cos(π t / T))` in between. [`RampShape::Table`]: linear interpolation
+    /// between the points, the mean of the two sides at a jump, and beyond the first or last
+    /// point the straight line through the two end points (NASTRAN's `TABLED1` rule).
     pub fn factor(&self, t: f64) -> f64 {
-        if t <= 0.0 {
-            0.0
-        } else if t >= self.duration {
-            1.0
-        } else {
-            match self.shape {
-                RampShape::HalfCosine => {
-                    0.5 * (1.0 - (std::f64::consts::PI * t / self.duration).cos())
+        match self.shape {
+            RampShape::HalfCosine => {
+                let duration = self.duration.unwrap_or(f64::NAN);
+                if t <= 0.0 {
+                    0.0
+                } else if t >= duration {
+                    1.0
+                } else {
+                    0.5 * (1.0 - (std::f64::consts::PI * t / duration).cos())
                 }
+            }
+            RampShape::Table => table_value(&self.points, t),
+        }
+    }
+
+    /// Checks the fields of the shape (`path` is the JSON path of the ramp, for messages):
+    /// `Err((field path, reason))`.
+    pub fn check(&self, path: &str) -> Result<(), (String, String)> {
+        match self.shape {
+            RampShape::HalfCosine => {
+                if !self.points.is_empty() {
+                    return Err((
+                        format!("{path}.points"),
+                        "only the `table` shape has points".into(),
+                    ));
+                }
+                match self.duration {
+                    Some(d) if d.is_finite() && d > 0.0 => Ok(()),
+                    Some(d) => Err((
+                        format!("{path}.duration"),
+                        format!("must be positive (finite and > 0), got {d} s"),
+                    )),
+                    None => Err((
+                        format!("{path}.duration"),
+                        "missing field `duration` (the half-cosine rise time, s)".into(),
+                    )),
+                }
+            }
+            RampShape::Table => {
+                if self.duration.is_some() {
+                    return Err((
+                        format!("{path}.duration"),
+                        "a `table` has no duration: its points give the time function".into(),
+                    ));
+                }
+                if self.points.len() < 2 {
+                    return Err((
+                        format!("{path}.points"),
+                        format!(
+                            "a table needs at least two points, got {}",
+                            self.points.len()
+                        ),
+                    ));
+                }
+                for (i, p) in self.points.iter().enumerate() {
+                    if !(p[0].is_finite() && p[1].is_finite()) {
+                        return Err((
+                            format!("{path}.points[{i}]"),
+                            format!("must be finite, got [{}, {}]", p[0], p[1]),
+                        ));
+                    }
+                    if i > 0 && p[0] < self.points[i - 1][0] {
+                        return Err((
+                            format!("{path}.points[{i}]"),
+                            format!(
+                                "times must not decrease: {} s after {} s",
+                                p[0],
+                                self.points[i - 1][0]
+                            ),
+                        ));
+                    }
+                    if i > 1 && p[0] == self.points[i - 1][0] && p[0] == self.points[i - 2][0] {
+                        return Err((
+                            format!("{path}.points[{i}]"),
+                            format!("three points at t = {} s (a jump has two)", p[0]),
+                        ));
+                    }
+                }
+                let (first, last) = (self.points[0], self.points[self.points.len() - 1]);
+                if first[0] == self.points[1][0] || last[0] == self.points[self.points.len() - 2][0]
+                {
+                    return Err((
+                        format!("{path}.points"),
+                        "the first two and the last two points need distinct times (the \
+                         straight line beyond the ends runs through them)"
+                            .into(),
+                    ));
+                }
+                Ok(())
             }
         }
     }
 }
 
-/// Ramp shapes, spelled in snake case in the file (`"half_cosine"`).
+/// Linear interpolation in a checked table (see [`RampSpec::factor`]); no allocation.
+fn table_value(points: &[[f64; 2]], t: f64) -> f64 {
+    let n = points.len();
+    if n < 2 {
+        return f64::NAN;
+    }
+    let line = |a: [f64; 2], b: [f64; 2]| a[1] + (b[1] - a[1]) * (t - a[0]) / (b[0] - a[0]);
+    if t <= points[0][0] {
+        return line(points[0], points[1]);
+    }
+    if t >= points[n - 1][0] {
+        return line(points[n - 2], points[n - 1]);
+    }
+    // The first point with time > t; 1 ≤ k ≤ n - 1.
+    let k = points.partition_point(|p| p[0] <= t);
+    let (a, b) = (points[k - 1], points[k]);
+    if a[0] == t && k >= 2 && points[k - 2][0] == t {
+        // At a jump: the mean of the two sides.
+        return 0.5 * (points[k - 2][1] + a[1]);
+    }
+    line(a, b)
+}
+
+/// Ramp shapes, spelled in snake case in the file (`"half_cosine"`, `"table"`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum RampShape {
     /// `F(t) = F·½(1 − cos(π t / T))` for `t < T`, then `F`: smooth start, zero rate at `T`.
     HalfCosine,
+    /// `F(t) = F·f(t)` with `f` interpolated in [`RampSpec::points`].
+    Table,
 }
 
 impl Case {

@@ -89,7 +89,9 @@ pub(crate) fn check_contact_load(
     ] {
         ctx.finite(&format!("load.master.{key}"), v, unit)?;
     }
-    ctx.positive("load.ramp.duration", load.ramp.duration, " s")?;
+    load.ramp
+        .check("load.ramp")
+        .map_err(|(path, reason)| ctx.err(path, reason))?;
     ctx.positive("end_time", end_time, " s")
 }
 

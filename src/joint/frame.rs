@@ -20,6 +20,44 @@ impl PairFrame {
     pub const SHEET_AXES: ([f64; 3], [f64; 3], [f64; 3]) =
         ([0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]);
 
+    /// The frame of a pair whose normal points along `direction` (from the lower to the upper
+    /// node; need not be unit): t1 is global x projected onto the tangent plane (global z when
+    /// the normal is within 45° of x), t2 = t1 × n. A normal within 1e-6 of +y gives
+    /// [`PairFrame::SHEET_AXES`] exactly. `None` for a zero or non-finite direction.
+    pub fn along(lower: usize, upper: usize, direction: [f64; 3]) -> Option<PairFrame> {
+        let len = (direction.iter().map(|d| d * d).sum::<f64>()).sqrt();
+        if !(len.is_finite() && len > 0.0) {
+            return None;
+        }
+        let n = direction.map(|d| d / len);
+        let (normal, t1, t2) = if (n[1] - 1.0).abs() < 1e-6 {
+            Self::SHEET_AXES
+        } else {
+            let axis = if n[0].abs() < std::f64::consts::FRAC_1_SQRT_2 {
+                [1.0, 0.0, 0.0]
+            } else {
+                [0.0, 0.0, 1.0]
+            };
+            let dot: f64 = (0..3).map(|k| axis[k] * n[k]).sum();
+            let t: [f64; 3] = std::array::from_fn(|k| axis[k] - dot * n[k]);
+            let tl = t.iter().map(|d| d * d).sum::<f64>().sqrt();
+            let t1 = t.map(|d| d / tl);
+            let t2 = [
+                t1[1] * n[2] - t1[2] * n[1],
+                t1[2] * n[0] - t1[0] * n[2],
+                t1[0] * n[1] - t1[1] * n[0],
+            ];
+            (n, t1, t2)
+        };
+        Some(PairFrame {
+            lower,
+            upper,
+            normal,
+            t1,
+            t2,
+        })
+    }
+
     /// The three directions in row order (normal, t1, t2).
     pub fn directions(&self) -> [[f64; 3]; 3] {
         [self.normal, self.t1, self.t2]

@@ -65,6 +65,7 @@ pub(super) fn build(case: &Case) -> Result<Mesh, Error> {
         shells,
         beams: welds.beams,
         welds: welds.welds,
+        masses: Vec::new(),
         clamped,
         tie,
         pairs,

@@ -9,7 +9,10 @@ use crate::case::Case;
 use crate::error::Error;
 
 mod build;
+pub mod deck;
 mod nugget;
+
+pub use deck::DeckModel;
 
 /// A 4-node shell on a sheet's mid-surface. Nodes run counter-clockwise in the (x, z) plane:
 /// `(i, k), (i+1, k), (i+1, k+1), (i, k+1)` of the sheet's grid.
@@ -70,6 +73,36 @@ pub struct NuggetPoint {
     pub shape: [f64; 4],
 }
 
+/// A point mass with rotary inertia at a node (NASTRAN CONM2, no offset).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PointMass {
+    /// Node index into [`Mesh::nodes`].
+    pub node: usize,
+    /// Mass, t.
+    pub mass: f64,
+    /// Inertia `[I11, I21, I22, I31, I32, I33]` about the node, t·mm²: the rotational block of
+    /// the mass matrix is `[[I11, −I21, −I31], [−I21, I22, −I32], [−I31, −I32, I33]]`.
+    pub inertia: [f64; 6],
+}
+
+impl PointMass {
+    /// The 6 × 6 mass matrix on the node's `[ux, uy, uz, rx, ry, rz]`.
+    pub fn matrix(&self) -> [[f64; 6]; 6] {
+        let [i11, i21, i22, i31, i32, i33] = self.inertia;
+        let mut m = [[0.0; 6]; 6];
+        for (k, row) in m.iter_mut().enumerate().take(3) {
+            row[k] = self.mass;
+        }
+        let rot = [[i11, -i21, -i31], [-i21, i22, -i32], [-i31, -i32, i33]];
+        for a in 0..3 {
+            for b in 0..3 {
+                m[3 + a][3 + b] = rot[a][b];
+            }
+        }
+        m
+    }
+}
+
 /// Rigid-body tie (NASTRAN RBE2, all 6 DOF): every slave node moves as
 /// `u_s = u_m + θ_m × (x_s − x_m)`, `θ_s = θ_m`.
 #[derive(Clone, Debug, PartialEq)]
@@ -106,7 +139,8 @@ pub struct SheetGrid {
 pub struct Mesh {
     /// Node coordinates (x, y, z), mm. Sheet nodes first (sheet by sheet), the master node last.
     pub nodes: Vec<[f64; 3]>,
-    /// The sheets' node grids, in case-file order.
+    /// The sheets' node grids, in case-file order (empty for a deck: its sheets are
+    /// unstructured).
     pub sheets: Vec<SheetGrid>,
     /// Shell elements.
     pub shells: Vec<ShellElem>,
@@ -114,6 +148,8 @@ pub struct Mesh {
     pub beams: Vec<BeamElem>,
     /// Area welds (`"model": "area"`, the default).
     pub welds: Vec<WeldElem>,
+    /// Point masses (a deck's CONM2; none in a case).
+    pub masses: Vec<PointMass>,
     /// Nodes with all 6 DOF clamped, in increasing order.
     pub clamped: Vec<usize>,
     /// The rigid tie to the master node.
@@ -174,5 +210,11 @@ impl Mesh {
     /// the node grids), labelled with [`Case::source`].
     pub fn from_case(case: &Case) -> Result<Mesh, Error> {
         build::build(case)
+    }
+
+    /// Builds the mesh of a NASTRAN deck with its load, contact law and end time (see
+    /// [`deck`]).
+    pub fn from_deck(deck: &crate::case::nastran::Deck) -> Result<DeckModel, Error> {
+        deck::build(deck)
     }
 }

@@ -357,6 +357,7 @@ pub fn load(map_path: &Path) -> Result<Model, Error> {
         mass,
         joint,
         load: map.load,
+        warnings: Vec::new(),
         contact: map.contact,
         end_time: map.end_time,
     })
@@ -962,7 +963,7 @@ pub fn write(model: &Model, dir: &Path) -> Result<Vec<PathBuf>, Error> {
             })
             .collect(),
         cells,
-        load: model.load,
+        load: model.load.clone(),
         contact: model.contact,
         end_time: model.end_time,
         duplicates: None,

@@ -31,6 +31,16 @@ use crate::linalg::eigen::{self as modes, Modes};
 use crate::linalg::SymCsc;
 use crate::mesh::Mesh;
 
+/// The model data besides the mesh, for [`Model::assemble`].
+struct Parts {
+    name: String,
+    source: String,
+    load: LoadSpec,
+    contact: ContactSpec,
+    end_time: f64,
+    warnings: Vec<String>,
+}
+
 /// Which boundary the master node has in an eigenproblem.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Interface {
@@ -93,6 +103,13 @@ pub enum Origin {
         /// Its discretisation.
         mesh: Box<Mesh>,
     },
+    /// Read from a NASTRAN deck ([`crate::case::nastran`]).
+    Deck {
+        /// The deck file.
+        deck: PathBuf,
+        /// Its discretisation.
+        mesh: Box<Mesh>,
+    },
     /// Read from a user's MatrixMarket K and M plus a JSON map ([`crate::model::matrices`]).
     Matrices {
         /// The map file.
@@ -140,6 +157,9 @@ pub struct Model {
     pub contact: ContactSpec,
     /// End of the simulated time span, s.
     pub end_time: f64,
+    /// What the reader noticed but did not refuse (a deck's ignored and unknown cards, unused
+    /// grids, pairs fused by welds); empty for cases and matrices.
+    pub warnings: Vec<String>,
 }
 
 impl Model {
@@ -147,7 +167,7 @@ impl Model {
     /// `builtin:<name>`), or the map with its stiffness and mass files.
     pub fn describe_source(&self) -> String {
         match &self.origin {
-            Origin::Case { .. } => self.source.clone(),
+            Origin::Case { .. } | Origin::Deck { .. } => self.source.clone(),
             Origin::Matrices {
                 map,
                 stiffness,
@@ -164,11 +184,6 @@ impl Model {
     /// Builds the mesh and assembles K and M.
     pub fn from_case(case: Case) -> Result<Model, Error> {
         let mesh = Mesh::from_case(&case)?;
-        let Structure {
-            dof_map,
-            stiffness,
-            mass,
-        } = assemble_structure(&mesh)?;
         let (normal, t1, t2) = PairFrame::SHEET_AXES;
         let pairs: Vec<PairFrame> = mesh
             .pairs
@@ -181,6 +196,68 @@ impl Model {
                 t2,
             })
             .collect();
+        let node_ids = (1..=mesh.nodes.len() as u64).collect();
+        let parts = Parts {
+            name: case.name.clone(),
+            source: case.source.clone(),
+            load: case.load.clone(),
+            contact: case.contact,
+            end_time: case.end_time,
+            warnings: Vec::new(),
+        };
+        Model::assemble(mesh, pairs, node_ids, parts, |mesh| Origin::Case {
+            case: Box::new(case),
+            mesh: Box::new(mesh),
+        })
+    }
+
+    /// Reads a NASTRAN deck ([`crate::case::nastran`]), builds its mesh and assembles K and M.
+    /// Pair frames follow each CGAP's GA → GB direction ([`PairFrame::along`]).
+    pub fn from_deck(path: &std::path::Path) -> Result<Model, Error> {
+        let deck = crate::case::nastran::deck::read(path)?;
+        let built = Mesh::from_deck(&deck)?;
+        let mesh = built.mesh;
+        let pairs = mesh
+            .pairs
+            .iter()
+            .map(|p| {
+                let (a, b) = (mesh.nodes[p.lower], mesh.nodes[p.upper]);
+                PairFrame::along(p.lower, p.upper, [b[0] - a[0], b[1] - a[1], b[2] - a[2]])
+                    .ok_or_else(|| Error::Invalid(format!("{}: a degenerate CGAP", path.display())))
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        let name = path
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_else(|| "deck".into());
+        let parts = Parts {
+            name,
+            source: path.display().to_string(),
+            load: built.load,
+            contact: built.contact,
+            end_time: built.end_time,
+            warnings: built.warnings,
+        };
+        let deck_path = path.to_path_buf();
+        Model::assemble(mesh, pairs, built.grid_ids, parts, |mesh| Origin::Deck {
+            deck: deck_path,
+            mesh: Box::new(mesh),
+        })
+    }
+
+    /// Assembles a mesh into a model.
+    fn assemble(
+        mesh: Mesh,
+        pairs: Vec<PairFrame>,
+        node_ids: Vec<u64>,
+        parts: Parts,
+        origin: impl FnOnce(Mesh) -> Origin,
+    ) -> Result<Model, Error> {
+        let Structure {
+            dof_map,
+            stiffness,
+            mass,
+        } = assemble_structure(&mesh)?;
         let joint = JointOperator::new(&pairs, &dof_map)?;
         let mut cells: Vec<Cell> = mesh
             .shells
@@ -198,20 +275,18 @@ impl Model {
         }));
         let geometry = Geometry {
             nodes: mesh.nodes.clone(),
-            node_ids: (1..=mesh.nodes.len() as u64).collect(),
+            node_ids,
             cells,
             followers: mesh.tie.slaves.clone(),
         };
         Ok(Model {
-            name: case.name.clone(),
-            source: case.source.clone(),
-            load: case.load,
-            contact: case.contact,
-            end_time: case.end_time,
-            origin: Origin::Case {
-                case: Box::new(case),
-                mesh: Box::new(mesh),
-            },
+            name: parts.name,
+            source: parts.source,
+            load: parts.load,
+            contact: parts.contact,
+            end_time: parts.end_time,
+            warnings: parts.warnings,
+            origin: origin(mesh),
             geometry,
             pairs,
             dof_map,
@@ -225,14 +300,14 @@ impl Model {
     pub fn case(&self) -> Option<&Case> {
         match &self.origin {
             Origin::Case { case, .. } => Some(case),
-            Origin::Matrices { .. } => None,
+            Origin::Deck { .. } | Origin::Matrices { .. } => None,
         }
     }
 
-    /// The mesh, for a model generated from a case.
+    /// The mesh, for a model generated from a case or read from a deck.
     pub fn mesh(&self) -> Option<&Mesh> {
         match &self.origin {
-            Origin::Case { mesh, .. } => Some(mesh),
+            Origin::Case { mesh, .. } | Origin::Deck { mesh, .. } => Some(mesh),
             Origin::Matrices { .. } => None,
         }
     }

@@ -34,7 +34,7 @@
 //!
 //! [`RomFile::read`] checks the schema, the version, every dimension and that every number is
 //! finite, and the mechanics: r ≥ 1, w ≥ 1, M̃ symmetric positive definite, K̃ symmetric positive
-//! semidefinite, a positive ramp duration, positive k_n, k_t, τ and coordinate sizes, μ ≥ 0,
+//! semidefinite, a valid load ramp (a positive half-cosine duration or a table), positive k_n, k_t, τ and coordinate sizes, μ ≥ 0,
 //! and `reduced_loads` equal to `master_rows` (read and checked: the two are the same
 //! numbers, written twice for readers that want the load vectors by name), naming the file and
 //! the field at fault; [`RomFile::system`] turns it into a
@@ -156,7 +156,7 @@ impl RomFile {
             master_rows: rows(phi_master),
             reduced_loads: rows(phi_master),
             master_load: model.load.master,
-            load_ramp: model.load.ramp,
+            load_ramp: model.load.ramp.clone(),
             contact: model.contact,
             friction_relaxation_time: DEFAULT_TAU,
             coordinate_size: column_size,
@@ -253,7 +253,9 @@ impl RomFile {
         for (i, s) in f.coordinate_size.iter().enumerate() {
             positive(&format!("coordinate_size[{i}]"), *s)?;
         }
-        positive("load_ramp.duration", f.load_ramp.duration)?;
+        f.load_ramp
+            .check("load_ramp")
+            .map_err(|(field, reason)| bad(&field, reason))?;
         let m = &f.master_load;
         for (k, v) in [m.fx, m.fy, m.fz, m.mx, m.my, m.mz].into_iter().enumerate() {
             if !v.is_finite() {
@@ -345,7 +347,7 @@ impl RomFile {
             (mat(&self.master_rows), self.coordinate_size.clone()),
             crate::case::LoadSpec {
                 master: self.master_load,
-                ramp: self.load_ramp,
+                ramp: self.load_ramp.clone(),
             },
             None,
         )

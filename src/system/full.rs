@@ -109,7 +109,7 @@ impl FullSystem {
             mass: m.clone(),
             joint: joint.clone(),
             master: model.master_dofs(),
-            load: model.load,
+            load: model.load.clone(),
             mass_llt,
             newton,
             newton_values: vec![0.0; nnz],
@@ -127,7 +127,7 @@ impl FullSystem {
             &self.mass,
             &self.joint,
             self.master,
-            self.load,
+            self.load.clone(),
             phi,
         )
     }

@@ -84,7 +84,7 @@ impl ReducedSystem {
             &model.mass,
             &model.joint,
             model.master_dofs(),
-            model.load,
+            model.load.clone(),
             phi,
         )
     }
@@ -286,7 +286,7 @@ impl Clone for ReducedSystem {
             b_rows: self.b_rows.clone(),
             phi_master: self.phi_master.clone(),
             column_size: self.column_size.clone(),
-            load: self.load,
+            load: self.load.clone(),
             m_identity: self.m_identity,
             m_llt: self.m_llt.clone(),
             newton: Mat::zeros(self.r, self.r),

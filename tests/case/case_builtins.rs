@@ -123,8 +123,8 @@ fn friction_bar_load_and_ramp() {
     let (case, _) = builtin("friction_bar");
     assert_eq!(case.master_load(), [0.0, -0.7, 0.0, -20.0, 0.0, 0.0]);
     assert_eq!(case.end_time, 0.2);
-    let ramp = case.load.ramp;
-    assert_eq!(ramp.duration, 0.05);
+    let ramp = case.load.ramp.clone();
+    assert_eq!(ramp.duration, Some(0.05));
     assert_eq!(ramp.factor(0.0), 0.0);
     assert!((ramp.factor(0.025) - 0.5).abs() < 1e-15);
     assert_eq!(ramp.factor(0.05), 1.0);
@@ -187,7 +187,7 @@ fn multilayer_sheet_numbering_and_coordinates() {
         }
     }
     assert_eq!(case.master_load(), [0.0, -50.0, 0.0, -2500.0, 0.0, 0.0]);
-    assert_eq!(case.load.ramp.duration, 0.005);
+    assert_eq!(case.load.ramp.duration, Some(0.005));
     assert_eq!(case.end_time, 0.05);
     // Interface by interface: bottom–middle first, then middle–top, 43 pairs each.
     let sheet_of = |n: usize| n / 50;

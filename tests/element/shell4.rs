@@ -301,6 +301,7 @@ fn strip(length: f64, width: f64, t: f64, nx: usize, nz: usize, material: Materi
         shells,
         beams: vec![],
         welds: vec![],
+        masses: Vec::new(),
         clamped: (0..=nz).map(|k| id(0, k)).collect(),
         tie: RigidTie {
             master: id(nx, nz / 2),

@@ -5,5 +5,6 @@
 mod common;
 
 mod contact_statics;
+mod deck;
 mod matrices;
 mod model;

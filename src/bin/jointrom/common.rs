@@ -66,5 +66,8 @@ pub fn inputs() -> Vec<String> {
 pub fn load_model(arg: &str) -> Result<Model, Error> {
     let model = Model::from_case_name(arg)?;
     record_input(format!("model {}", model.describe_source()));
+    for w in &model.warnings {
+        eprintln!("warning: {}", jointrom::files::printable(w));
+    }
     Ok(model)
 }

@@ -9,7 +9,7 @@ use crate::common::print_json;
 
 #[derive(Args)]
 pub struct InfoArgs {
-    /// Case file, matrix map (`jointrom-matrices` JSON) or built-in name (friction_bar, multilayer_sheet).
+    /// Case file, NASTRAN deck (.bdf), matrix map (`jointrom-matrices` JSON) or built-in name (friction_bar, multilayer_sheet).
     case: String,
     /// One JSON document on stdout.
     #[arg(long)]
@@ -51,7 +51,11 @@ pub fn info_json(model: &Model) -> Value {
         "origin": match model.origin {
             jointrom::model::Origin::Case { .. } => "case",
             jointrom::model::Origin::Matrices { .. } => "matrices",
+            jointrom::model::Origin::Deck { .. } => "deck",
         },
+        "structural_mass": structural_mass(model),
+        "point_masses": model.mesh().map_or(0, |m| m.masses.len()),
+        "warnings": model.warnings,
         "nodes": model.geometry.nodes.len(),
         "elements": model.geometry.cells.len() + area_welds(model),
         "shells": cell_count(model, true),
@@ -66,6 +70,39 @@ pub fn info_json(model: &Model) -> Value {
         "tied_nodes": model.geometry.followers.len(),
         "stiffness_nonzeros": model.stiffness.values.len(),
     })
+}
+
+/// The mass of the mesh's shells, beams and point masses (t): Σ ρ t A + Σ ρ π d²/4 L + Σ m,
+/// for a cross-check against a pre-processor's mass; `null` for a user's matrices.
+fn structural_mass(model: &Model) -> Option<f64> {
+    let mesh = model.mesh()?;
+    let rho = mesh.material.density;
+    let x = &mesh.nodes;
+    let sub = |a: usize, b: usize| [0, 1, 2].map(|k| x[b][k] - x[a][k]);
+    let shells: f64 = mesh
+        .shells
+        .iter()
+        .map(|s| {
+            let (d1, d2) = (sub(s.nodes[0], s.nodes[2]), sub(s.nodes[1], s.nodes[3]));
+            let c = [
+                d1[1] * d2[2] - d1[2] * d2[1],
+                d1[2] * d2[0] - d1[0] * d2[2],
+                d1[0] * d2[1] - d1[1] * d2[0],
+            ];
+            rho * s.thickness * 0.5 * (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]).sqrt()
+        })
+        .sum();
+    let beams: f64 = mesh
+        .beams
+        .iter()
+        .map(|b| {
+            let d = sub(b.nodes[0], b.nodes[1]);
+            let length = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+            rho * std::f64::consts::FRAC_PI_4 * b.diameter * b.diameter * length
+        })
+        .sum();
+    let points: f64 = mesh.masses.iter().map(|m| m.mass).sum();
+    Some(shells + beams + points)
 }
 
 /// Number of area welds (a generated case's `Weld` elements; none for a user's matrices).
