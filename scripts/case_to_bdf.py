@@ -7,7 +7,8 @@ The deck is the same structure as the case, meshed by the same rule (sheet s, no
 x0 + i (x1 - x0)/nx, z0 + k (z1 - z0)/nz), in the forms pre-processors write: executive and case
 control (SOL 129, SPC, DLOAD, TSTEP), the grids and shells in an INCLUDEd file, GRID* in large
 field, CQUAD4 in small field, MAT1/PSHELL in free field, continuations on RBE2, CWELD and TABLED1,
-SPC1 with THRU, one PSHELL per sheet (a pre-processor's "part"), CWELD PARTPAT with a location
+SPC1 with THRU, one PSHELL per sheet (a pre-processor's "part"; property and element ids unique across kinds,
+as NASTRAN requires), CWELD PARTPAT with a location
 grid GS per weld (one CWELD per pair of consecutive sheets of a stack) and PWELD, CGAP + PGAP at
 every coincident node pair of each joint that is neither clamped nor tied (those inside a weld
 nugget included: jointrom leaves them out, as it does for a case), FORCE/MOMENT at the RBE2's
@@ -187,7 +188,7 @@ def write(case, out):
     for lo, hi in runs:
         main.append(small("SPC1", [1, 123456, lo, "THRU", hi] if hi > lo + 1 else [1, 123456] + list(range(lo, hi + 1))))
 
-    main.append(small("PWELD", [1, 1, f8(case["welds"][0]["diameter"]) if case["welds"] else "5.", "", "", "OFF", "", "SPOT"]))
+    main.append(small("PWELD", [101, 1, f8(case["welds"][0]["diameter"]) if case["welds"] else "5.", "", "", "OFF", "", "SPOT"]))
     weld_ids = 0
     nuggets = []
     for w, weld in enumerate(case["welds"]):
@@ -197,10 +198,10 @@ def write(case, out):
         main.append(large("GRID", [gs, "", f16(weld["x"]), f16(y), f16(weld["z"])]))
         for lo, hi in zip(stack, stack[1:]):
             weld_ids += 1
-            main.append(small("CWELD", [60000 + weld_ids, 1, gs, "PARTPAT", "", "", "", "", lo.s + 1, hi.s + 1]))
+            main.append(small("CWELD", [60000 + weld_ids, 101, gs, "PARTPAT", "", "", "", "", lo.s + 1, hi.s + 1]))
         nuggets.append(weld)
 
-    main.append(small("PGAP", [1, "", "", f8(case["contact"]["normal_stiffness"]), "",
+    main.append(small("PGAP", [201, "", "", f8(case["contact"]["normal_stiffness"]), "",
                                f8(case["contact"]["stick_stiffness"]), f8(case["contact"]["friction_coefficient"]),
                                f8(case["contact"]["friction_coefficient"])]))
     gap = 70000
@@ -217,7 +218,7 @@ def write(case, out):
             if u is None or a in clamped | tied or u in clamped | tied:
                 continue
             gap += 1
-            main.append(small("CGAP", [gap, 1, a, u, 0.0, 1.0, 0.0]))
+            main.append(small("CGAP", [gap, 201, a, u, 0.0, 1.0, 0.0]))
 
     load = case["load"]["master"]
     f = [load.get(k, 0.0) for k in ("fx", "fy", "fz")]

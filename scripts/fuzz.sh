@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Coverage-guided fuzzing of every parser with libFuzzer (cargo-fuzz on the stable toolchain,
 # with RUSTC_BOOTSTRAP=1 for the sanitizer flags cargo-fuzz passes): case files, MatrixMarket
-# files, matrix maps, reduced-model files, sweep variants.
+# files, MatrixMarket files, matrix maps, reduced-model files, sweep variants, NASTRAN decks.
 #   scripts/fuzz.sh [SECONDS per target, default 60] [TARGET ...]
 # Prints one line per target: seconds, executions, crashes. Crashes are left in
 # fuzz/artifacts/TARGET/ (replay: RUSTC_BOOTSTRAP=1 cargo fuzz run TARGET FILE).
@@ -10,7 +10,7 @@ cd "$(dirname "${BASH_SOURCE[0]}")/.."
 secs=${1:-60}
 shift || true
 targets=("$@")
-[ ${#targets[@]} -gt 0 ] || targets=(case mtx map rom variants)
+[ ${#targets[@]} -gt 0 ] || targets=(case mtx map rom variants deck)
 
 command -v cargo-fuzz >/dev/null || cargo install cargo-fuzz --locked
 export RUSTC_BOOTSTRAP=1
@@ -20,7 +20,7 @@ export JOINTROM_MAX_DOF=30000
 cargo build --release --bin jointrom -q
 bin=target/release/jointrom
 seeds=fuzz/seeds
-rm -rf "$seeds"; mkdir -p "$seeds"/{case,mtx,map,rom,variants}
+rm -rf "$seeds"; mkdir -p "$seeds"/{case,mtx,map,rom,variants,deck}
 cp cases/*.json "$seeds/case/"
 cp cases/sweeps/*.json "$seeds/variants/"
 small="$seeds/small.json"
@@ -42,6 +42,18 @@ cp "$seeds/matrices/K.mtx" "$seeds/mtx/K.mtx"; cp "$seeds/matrices/M.mtx" "$seed
 cp "$seeds/matrices/model.json" "$seeds/map/model.json"
 "$bin" export "$small" --g 2 --out "$seeds/rom/rom.json" >/dev/null
 export JOINTROM_FUZZ_MATRICES="$PWD/$seeds/matrices"
+# Decks: the small case as one file (the mesh include inlined), and the built-in scenes'.
+python3 scripts/case_to_bdf.py "$small" "$seeds/deck_small/small.bdf" >/dev/null
+for d in "$seeds/deck_small/small" cases/nastran/friction_bar cases/nastran/multilayer_sheet; do
+  python3 - "$d" "$seeds/deck/$(basename "$d").bdf" <<'PY'
+import os, sys
+base, out = sys.argv[1], sys.argv[2]
+text = open(base + ".bdf").read()
+mesh = open(base + "_mesh.bdf").read()
+name = os.path.basename(base) + "_mesh.bdf"
+open(out, "w").write(text.replace(f"INCLUDE '{name}'", mesh))
+PY
+done
 
 for t in "${targets[@]}"; do
   mkdir -p "fuzz/corpus/$t"

@@ -103,16 +103,17 @@ fn deck_err(deck: &Deck, reason: impl Into<String>) -> Error {
     err(deck, "deck".into(), Position { file: 0, line: 1 }, reason)
 }
 
+/// At most this many of the smallest elements across a nugget (bounds the sampling points,
+/// which grow with (d/h)²).
+const MAX_NUGGET_ELEMENTS: f64 = 200.0;
+
 type NodeIndex = HashMap<i64, usize>;
 
 /// The used grids: node positions (mm), grid ids and the id → node index map.
 type UsedGrids = (Vec<[f64; 3]>, Vec<u64>, NodeIndex);
 
 /// The used grids: positions, ids and the id → node index map; the RBE2 master last.
-fn nodes(
-    deck: &Deck,
-    warnings: &mut Vec<String>,
-) -> Result<UsedGrids, Error> {
+fn nodes(deck: &Deck, warnings: &mut Vec<String>) -> Result<UsedGrids, Error> {
     let mut used: BTreeSet<i64> = BTreeSet::new();
     let mut refs: Vec<(i64, &str, Position)> = Vec::new();
     for q in &deck.quads {
@@ -402,17 +403,19 @@ fn clamps(deck: &Deck, index: &NodeIndex, tie: &RigidTie) -> Result<Vec<usize>, 
     }
     let mut clamped: BTreeSet<usize> = BTreeSet::new();
     for spc in deck.spcs.iter().filter(|s| wanted.contains(&s.sid)) {
-        for g in &spc.grids {
-            if !deck.grids.contains_key(g) {
+        for &(lo, hi) in &spc.grids {
+            if lo == hi && !deck.grids.contains_key(&lo) {
                 return Err(err(
                     deck,
-                    format!("{} {}", "SPC", spc.sid),
+                    format!("SPC {}", spc.sid),
                     spc.at,
-                    format!("grid {g} is not defined"),
+                    format!("grid {lo} is not defined"),
                 ));
             }
-            if let Some(&n) = index.get(g) {
-                clamped.insert(n);
+            for (g, _) in deck.grids.range(lo..=hi) {
+                if let Some(&n) = index.get(g) {
+                    clamped.insert(n);
+                }
             }
         }
     }
@@ -720,6 +723,15 @@ fn welds(
             return Err(e("both sides are the same sheet".into()));
         }
         let (lower, upper) = if la.y <= lb.y { (la, lb) } else { (lb, la) };
+        let h = lower.h.min(upper.h);
+        if (d / h).is_nan() || d / h > MAX_NUGGET_ELEMENTS {
+            return Err(e(format!(
+                "PWELD {}: the nugget diameter D = {d} mm spans {:.0} of the smallest elements \
+                 around it ({h} mm; at most {MAX_NUGGET_ELEMENTS})",
+                card.pid,
+                d / h
+            )));
+        }
         if upper.y - lower.y <= NODE_TOLERANCE {
             return Err(e("the two sheets are at the same height".into()));
         }

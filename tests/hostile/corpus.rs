@@ -177,6 +177,7 @@ pub fn corpus() -> Vec<Hostile> {
     v.extend(variants(fx));
     v.extend(outputs(fx));
     v.extend(output_links());
+    v.extend(decks());
     v
 }
 
@@ -1366,5 +1367,134 @@ fn output_links() -> Vec<Hostile> {
             Fails("is a folder"),
         )
         .setup(|d| std::fs::create_dir_all(d.join("rom.json")).unwrap()),
+    ]
+}
+
+const DECK: &str = "{d}/deck.bdf";
+
+/// The friction bar's deck (`cases/nastran/friction_bar.bdf`) with its mesh include inlined.
+fn deck_text() -> String {
+    let dir = crate::common::repo_path("cases/nastran");
+    let main = std::fs::read_to_string(dir.join("friction_bar.bdf")).unwrap();
+    let mesh = std::fs::read_to_string(dir.join("friction_bar_mesh.bdf")).unwrap();
+    main.replace("INCLUDE 'friction_bar_mesh.bdf'", &mesh)
+}
+
+fn deck(id: &'static str, what: &'static str, text: String, expect: Expect) -> Hostile {
+    entry(id, "NASTRAN deck", what, &["info", DECK], expect).file("deck.bdf", text)
+}
+
+fn decks() -> Vec<Hostile> {
+    use Expect::{Fails, Warns};
+    let d = deck_text();
+    let add = |card: &str| d.replace("ENDDATA", &format!("{card}\nENDDATA"));
+    vec![
+        deck(
+            "deck-ok",
+            "the friction bar as a deck",
+            d.clone(),
+            Warns("EIGRL"),
+        ),
+        deck(
+            "deck-ctria3",
+            "a CTRIA3",
+            add("CTRIA3,9,1,10001,10002,10004"),
+            Fails("CTRIA3"),
+        ),
+        deck(
+            "deck-mats1",
+            "material nonlinearity (MATS1)",
+            add("MATS1,1,,PLASTIC,1000."),
+            Fails("MATS1"),
+        ),
+        deck(
+            "deck-u0",
+            "a gap with an initial opening",
+            d.replace("PGAP         201        ", "PGAP         201    0.01"),
+            Fails("U0"),
+        ),
+        deck(
+            "deck-unknown",
+            "an unknown card",
+            add("FOOBAR,1,2"),
+            Warns("unknown cards"),
+        ),
+        deck(
+            "deck-shared-id",
+            "a PGAP with a PSHELL's id",
+            add("PGAP,1,,,1.E4,,1.E4,0.25"),
+            Fails("unique across kinds"),
+        ),
+        deck(
+            "deck-nan",
+            "E = NaN",
+            d.replace("MAT1,1,210000.0", "MAT1,1,NaN"),
+            Fails("E:"),
+        ),
+        deck(
+            "deck-long-free-line",
+            "12 fields on a free-field line",
+            add("PARAM,A,1,2,3,4,5,6,7,8,9,10,11"),
+            Fails("at most 8 data fields"),
+        ),
+        deck(
+            "deck-no-rbe2",
+            "no rigid tie",
+            d.replace("RBE2           1", "$BE2           1"),
+            Fails("no RBE2"),
+        ),
+        deck(
+            "deck-huge-weld",
+            "a 5 m weld nugget",
+            d.replace(
+                "PWELD        101       1     5.0",
+                "PWELD        101       1   5000.",
+            ),
+            Fails("nugget diameter"),
+        ),
+        deck(
+            "deck-huge-thru",
+            "SPC1 over a billion grid ids",
+            add("SPC1,1,123456,1,THRU,999999999"),
+            Fails("clamped and rigidly tied"),
+        ),
+        deck(
+            "deck-continuation-first",
+            "a continuation line first",
+            d.replace("BEGIN BULK\n", "BEGIN BULK\n+,1,2\n"),
+            Fails("no card above"),
+        ),
+        deck(
+            "deck-binary",
+            "binary garbage",
+            "\u{0}\u{1}GR\u{7f}ID\n\u{fffd}\u{fffd}".into(),
+            Fails("not a card name"),
+        ),
+        deck(
+            "deck-over-budget",
+            "over the DOF budget",
+            d.clone(),
+            Fails("JOINTROM_MAX_DOF"),
+        )
+        .env("JOINTROM_MAX_DOF", "100"),
+        entry(
+            "deck-include-itself",
+            "NASTRAN deck",
+            "a deck that includes itself",
+            &["info", DECK],
+            Fails("includes itself"),
+        )
+        .file("deck.bdf", format!("INCLUDE 'deck.bdf'\n{d}")),
+        entry(
+            "deck-include-missing",
+            "NASTRAN deck",
+            "an INCLUDE of a missing file",
+            &["info", DECK],
+            Fails("cannot read"),
+        )
+        .file(
+            "deck.bdf",
+            d.replace("ENDDATA", "INCLUDE 'nowhere.bdf'\nENDDATA"),
+        ),
     ]
 }

@@ -196,8 +196,8 @@ fn unsupported_mechanics_are_errors_naming_the_line() {
     );
     fails(
         "u0",
-        |t| t.replace("PGAP           1        ", "PGAP           1    0.01"),
-        &["PGAP 1", "U0"],
+        |t| t.replace("PGAP         201        ", "PGAP         201    0.01"),
+        &["PGAP 201", "U0"],
     );
     fails(
         "second rbe2",
@@ -252,10 +252,10 @@ fn unsupported_mechanics_are_errors_naming_the_line() {
     fails(
         "gap law",
         |t| {
-            let t = t.replace("CGAP       70001       1", "CGAP       70001       2");
-            before_enddata("PGAP,2,,,2.E4,,1.E4,0.25")(t)
+            let t = t.replace("CGAP       70001     201", "CGAP       70001     202");
+            before_enddata("PGAP,202,,,2.E4,,1.E4,0.25")(t)
         },
-        &["CGAP 70002", "PGAP 1 differs from PGAP 2"],
+        &["CGAP 70002", "PGAP 201 differs from PGAP 202"],
     );
     fails(
         "no tstep",

@@ -430,8 +430,9 @@ pub struct TableCard {
 pub struct SpcCard {
     /// Set id.
     pub sid: i64,
-    /// Constrained grids.
-    pub grids: Vec<i64>,
+    /// Constrained grids as inclusive id ranges (`G1 THRU G2`; a single grid is `(g, g)`);
+    /// ids in a range that no GRID defines are skipped, as NASTRAN does.
+    pub grids: Vec<(i64, i64)>,
     /// Where the card is.
     pub at: Position,
 }
@@ -539,6 +540,7 @@ pub fn interpret(cards: Cards) -> Result<Deck, Error> {
             }
         }
     }
+    deck.shared_ids(&cards)?;
     let list = |m: &BTreeMap<String, usize>| {
         m.iter()
             .map(|(n, c)| format!("{n} ×{c}"))
@@ -679,6 +681,54 @@ pub fn parse_real(s: &str) -> Option<f64> {
 }
 
 impl Deck {
+    /// NASTRAN's id spaces: element ids are unique across all elements (CQUAD4, CWELD,
+    /// CBAR/CBEAM, CGAP, CONM2, RBE2), property ids across all properties (PSHELL, PWELD,
+    /// PBARL/PBEAML, PGAP).
+    fn shared_ids(&self, cards: &Cards) -> Result<(), Error> {
+        let elements = self
+            .quads
+            .iter()
+            .map(|e| (e.id, "CQUAD4", e.at))
+            .chain(self.welds.iter().map(|e| (e.id, "CWELD", e.at)))
+            .chain(self.beams.iter().map(|e| (e.id, "CBAR/CBEAM", e.at)))
+            .chain(self.gaps.iter().map(|e| (e.id, "CGAP", e.at)))
+            .chain(self.masses.iter().map(|e| (e.id, "CONM2", e.at)))
+            .chain(self.rbe2.iter().map(|e| (e.id, "RBE2", e.at)));
+        let properties = self
+            .pshells
+            .iter()
+            .map(|(&id, p)| (id, "PSHELL", p.at))
+            .chain(self.pwelds.iter().map(|(&id, p)| (id, "PWELD", p.at)))
+            .chain(self.rods.iter().map(|(&id, p)| (id, "PBARL/PBEAML", p.at)))
+            .chain(self.pgaps.iter().map(|(&id, p)| (id, "PGAP", p.at)));
+        for (space, ids) in [
+            ("element", elements.collect::<Vec<_>>()),
+            ("property", properties.collect::<Vec<_>>()),
+        ] {
+            let mut seen: BTreeMap<i64, (&str, Position)> = BTreeMap::new();
+            for (id, card, at) in ids {
+                if let Some((first, first_at)) = seen.insert(id, (card, at)) {
+                    let (later, earlier) = if (at.file, at.line) > (first_at.file, first_at.line) {
+                        ((card, at), (first, first_at))
+                    } else {
+                        ((first, first_at), (card, at))
+                    };
+                    return Err(cards.error_at(
+                        format!("{} {id}", later.0),
+                        later.1,
+                        format!(
+                            "{space} id {id} is also {} {id} at {}: NASTRAN's {space} ids are \
+                             unique across kinds",
+                            earlier.0,
+                            cards.locate(earlier.1)
+                        ),
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+
     fn unique<T>(
         f: &Fields,
         map: &mut BTreeMap<i64, T>,
@@ -1079,7 +1129,8 @@ impl Deck {
                 if f.raw(g).is_empty() {
                     continue;
                 }
-                grids.push(f.id(g, "G")?);
+                let id = f.id(g, "G")?;
+                grids.push((id, id));
                 if !is_all_six(f.raw(c)) {
                     return Err(
                         f.error("C: jointrom constrains all six components of a grid (123456)")
@@ -1101,15 +1152,17 @@ impl Deck {
             while k <= n {
                 if f.word(k) == "THRU" {
                     let (from, to) = (f.id(k - 1, "G")?, f.id(k + 1, "G")?);
-                    if to < from || to - from > 10_000_000 {
+                    if to < from {
                         return Err(f.error(format!("THRU: bad range {from} THRU {to}")));
                     }
-                    grids.extend(from + 1..=to);
+                    grids.pop();
+                    grids.push((from, to));
                     k += 2;
                     continue;
                 }
                 if !f.raw(k).is_empty() {
-                    grids.push(f.id(k, "G")?);
+                    let id = f.id(k, "G")?;
+                    grids.push((id, id));
                 }
                 k += 1;
             }

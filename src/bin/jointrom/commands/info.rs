@@ -54,6 +54,8 @@ pub fn info_json(model: &Model) -> Value {
             jointrom::model::Origin::Deck { .. } => "deck",
         },
         "structural_mass": structural_mass(model),
+        "master_load": model.master_load(),
+        "end_time": model.end_time,
         "point_masses": model.mesh().map_or(0, |m| m.masses.len()),
         "warnings": model.warnings,
         "nodes": model.geometry.nodes.len(),
