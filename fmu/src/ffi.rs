@@ -28,8 +28,10 @@
 //!   dangling pointer safe.
 //! - Arrays (`vr[nvr]`, `value[nvr]`) are read as slices of the given length, as the standard
 //!   defines them.
-//! - The logger is a C variadic function: it is called with the format `"%s"` and the message
-//!   as its one argument, so a `%` in a message (or a case name) is never interpreted.
+//! - The logger is a C variadic function whose message is a `printf` format: it is called
+//!   without variadic arguments and with every `%` of the message doubled, so a `%` in a message
+//!   (or a case name) is printed, never interpreted — and importers whose logger prints the
+//!   message without formatting it still show the text (with `%%` for `%`).
 //! - `fmi2FreeInstance` drops the `Box<Instance>`: the slave, its integrator (CVODE memory,
 //!   vectors, solvers, SUNDIALS context — freed by their RAII owners) and the copied strings.
 //!
@@ -110,18 +112,18 @@ fn log_to(
     message: &str,
 ) {
     let Some(logger) = logger else { return };
-    let message = c_message(message);
+    let format = c_message(&message.replace('%', "%%"));
     // SAFETY: `logger` is the importer's logger function (FMI: callable from any fmi2 function
     // with the environment it gave); every string passed is NUL-terminated and lives across
-    // the call; the format "%s" consumes exactly the one variadic argument, a C string.
+    // the call; the format has no conversion left (every `%` doubled), so no variadic argument
+    // is read.
     unsafe {
         logger(
             env,
             name.as_ptr(),
             status,
             category.as_ptr(),
-            c"%s".as_ptr(),
-            message.as_ptr(),
+            format.as_ptr(),
         )
     };
 }

@@ -94,6 +94,10 @@ impl Slave {
     /// Reads the reduced model from the resources folder `resources` and checks that it is the
     /// one the model description's GUID `fmu_guid` was made for.
     pub fn new(resources: &Path, fmu_guid: &str) -> Outcome<Slave> {
+        // faer's dense kernels (the reduced model's checks at reading) run on the calling
+        // thread: no rayon pool is started inside the importer's process (its threads would
+        // outlive the instance). The setting is this binary's own copy of faer's.
+        faer::set_global_parallelism(faer::Par::Seq);
         let path = resources.join(Path::new(ROM_RESOURCE).file_name().unwrap_or_default());
         let bytes = jointrom::files::read_bytes(&path)
             .map_err(|e| format!("cannot read the reduced model {}: {e}", path.display()))?;

@@ -5,7 +5,7 @@
 //! A zip archive ([`package`]) holding
 //!
 //! ```text
-//! modelDescription.xml                  the variables below, units, GUID (description)
+//! modelDescription.xml                  the variables below, units, GUID (description.rs)
 //! binaries/linux64/<modelIdentifier>.so the FMU binary: the `jointrom-fmu` crate (fmu/)
 //! resources/rom.json                    the exported reduced model (jointrom-rom v1)
 //! ```
@@ -49,8 +49,8 @@
 //! the model description and the reduced model it finds belong together — an edited or
 //! corrupted `rom.json` is refused with a message rather than simulated.
 
-mod description;
-mod package;
+pub mod description;
+pub mod package;
 
 use sha2::{Digest, Sha256};
 
