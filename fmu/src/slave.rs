@@ -392,3 +392,130 @@ impl Slave {
         })
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A one-coordinate reduced model (`rom.json` text): a 1 t mass on a 10⁴ N/mm spring whose
+    /// coordinate is the master's u_y and the one pair's gap; the master load −1 N along y
+    /// (half-cosine ramp over 10 ms) closes the pair.
+    fn tiny_rom() -> String {
+        let zero = [0.0];
+        serde_json::json!({
+            "schema": "jointrom-rom", "version": 1, "case": "tiny",
+            "basis": {"kind": "modes", "g": 0, "nu": 1, "threshold": 0.999, "w": []},
+            "dimension": 1, "pairs": 1,
+            "mass": [[1.0]], "stiffness": [[1e4]],
+            "joint_operator": [[1.0], zero, zero],
+            "master_rows": [zero, [1.0], zero, zero, zero, zero],
+            "reduced_loads": [zero, [1.0], zero, zero, zero, zero],
+            "master_load": {"fy": -1.0},
+            "load_ramp": {"shape": "half_cosine", "duration": 0.01},
+            "contact": {"normal_stiffness": 1e4, "friction_coefficient": 0.25,
+                        "stick_stiffness": 1e4},
+            "friction_relaxation_time": 1e-6, "coordinate_size": [1.0], "end_time": 0.05
+        })
+        .to_string()
+    }
+
+    /// A resources folder `name` holding `text` as rom.json; the folder and the GUID.
+    fn resources(name: &str, text: &str) -> (std::path::PathBuf, String) {
+        let dir =
+            std::env::temp_dir().join(format!("jointrom_fmu_slave_{}_{name}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        std::fs::write(dir.join("rom.json"), text).unwrap();
+        (dir, guid(text.as_bytes()))
+    }
+
+    fn slave(name: &str) -> Slave {
+        let (dir, g) = resources(name, &tiny_rom());
+        Slave::new(&dir, &g).unwrap()
+    }
+
+    #[test]
+    fn a_run_follows_the_state_machine() {
+        let mut s = slave("run");
+        assert!(s
+            .get_real(&[vr::MASTER_UY], &mut [0.0])
+            .unwrap_err()
+            .contains("Instantiated"));
+        s.setup_experiment(None, 0.0, Some(0.02)).unwrap();
+        s.set_real(&[vr::MU, vr::MASTER_FY], &[0.3, 0.0]).unwrap();
+        s.enter_initialization().unwrap();
+        s.exit_initialization().unwrap();
+        assert_eq!(s.phase(), Phase::StepComplete);
+        let mut out = [f64::NAN; 3];
+        let outs = [vr::MU, vr::MASTER_UY, vr::CONTACT_FORCE_NORM];
+        s.get_real(&outs, &mut out).unwrap();
+        assert_eq!(out, [0.3, 0.0, 0.0], "at rest");
+        for k in 0..20 {
+            s.do_step(k as f64 * 1e-3, 1e-3).unwrap();
+        }
+        s.get_real(&outs, &mut out).unwrap();
+        assert!(out[1] < 0.0 && out[2] > 0.0, "pushed into contact: {out:?}");
+        assert!((s.last_successful_time() - 0.02).abs() < 1e-15);
+        assert!(s.statistics().unwrap().contains("CVODE steps"));
+        let e = s.do_step(0.02, 1e-3).unwrap_err();
+        assert!(e.contains("past the stopTime"), "{e}");
+        s.terminate().unwrap();
+        assert!(s.do_step(0.02, 1e-3).unwrap_err().contains("Terminated"));
+        s.reset();
+        assert_eq!(s.phase(), Phase::Instantiated);
+        assert_eq!(s.values[vr::MU as usize], 0.25, "start values back");
+    }
+
+    #[test]
+    fn bad_arguments_are_refused_with_their_names() {
+        let mut s = slave("args");
+        for (tol, start, stop, what) in [
+            (Some(0.0), 0.0, None, "tolerance"),
+            (Some(f64::NAN), 0.0, None, "tolerance"),
+            (None, f64::INFINITY, None, "startTime"),
+            (None, 1.0, Some(0.5), "stopTime"),
+        ] {
+            let e = s.setup_experiment(tol, start, stop).unwrap_err();
+            assert!(e.contains(what), "{e}");
+        }
+        // All or nothing.
+        let e = s
+            .set_real(&[vr::LOAD_SCALE, vr::K_T], &[2.0, 0.0])
+            .unwrap_err();
+        assert!(e.contains("k_t must be > 0"), "{e}");
+        assert_eq!(s.values[vr::LOAD_SCALE as usize], 1.0);
+        let e = s.set_real(&[vr::COUNT], &[1.0]).unwrap_err();
+        assert!(e.contains("value reference 18"), "{e}");
+        s.enter_initialization().unwrap();
+        s.exit_initialization().unwrap();
+        assert!(s
+            .set_real(&[vr::K_N], &[1.0])
+            .unwrap_err()
+            .contains("fixed parameter"));
+        s.set_real(&[vr::LOAD_SCALE], &[0.5]).unwrap();
+        let e = s.do_step(1.0, 1e-3).unwrap_err();
+        assert!(e.contains("is not the FMU's time 0 s"), "{e}");
+        assert!(s
+            .do_step(0.0, -1e-3)
+            .unwrap_err()
+            .contains("communicationStepSize"));
+    }
+
+    #[test]
+    fn a_foreign_or_damaged_reduced_model_is_refused() {
+        let (dir, g) = resources("foreign", &tiny_rom());
+        let e = Slave::new(&dir, "{not-the-guid}").err().unwrap();
+        assert!(
+            e.contains("does not belong to this FMU") && e.contains(&g),
+            "{e}"
+        );
+        let bad = tiny_rom().replace("\"dimension\":1", "\"dimension\":2");
+        assert_ne!(bad, tiny_rom());
+        let (dir, g) = resources("damaged", &bad);
+        let e = Slave::new(&dir, &g).err().unwrap();
+        assert!(e.contains("rom.json") && e.contains("mass"), "{e}");
+        let e = Slave::new(Path::new("/nonexistent/resources"), &g)
+            .err()
+            .unwrap();
+        assert!(e.contains("cannot read the reduced model"), "{e}");
+    }
+}
