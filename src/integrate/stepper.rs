@@ -35,6 +35,10 @@
 //! Events (if on) are handled as in the driver loop: a re-initialisation at every root, and a
 //! chattering switch ends the step with [`Error::Chatter`].
 //!
+//! Step budget: [`OdeOptions::max_steps`] applies to each [`Stepper::advance`] (a co-simulation
+//! runs for as long as its importer wants; a run's budget of 10⁶ steps would end it after ~20 s
+//! of the friction bar's simulated time).
+//!
 //! Allocation: none in the callbacks; one copy of the state per [`Stepper::advance`] into a
 //! buffer allocated once, and one vector per load change.
 
@@ -54,6 +58,8 @@ pub struct Stepper<S: SecondOrderSystem> {
     restart: bool,
     /// Re-initialisations done for load changes.
     restarts: u64,
+    /// Internal steps allowed per [`Stepper::advance`] ([`OdeOptions::max_steps`]).
+    steps_per_advance: u64,
     /// The outputs at the current time.
     last: EnergySample,
     /// The state at the current time (a buffer for sampling).
@@ -88,6 +94,7 @@ impl<S: SecondOrderSystem> Stepper<S> {
             roots: RootGuard::new(),
             restart: false,
             restarts: 0,
+            steps_per_advance: ode.max_steps as u64,
             last,
             y,
         })
@@ -136,7 +143,8 @@ impl<S: SecondOrderSystem> Stepper<S> {
     /// # Errors
     /// [`Error::Invalid`] for a `t_next` that is not finite or not after the current time, or
     /// an output that is not finite at `t_next` (an overflow); integrator failures
-    /// ([`Error::Sundials`] with the flag and the time reached, [`Error::Callback`],
+    /// ([`Error::Sundials`] with the flag and the time reached — `CV_TOO_MUCH_WORK` after
+    /// [`OdeOptions::max_steps`] internal steps in this advance —, [`Error::Callback`],
     /// [`Error::Chatter`]). After an error the time and state are the last ones CVODE reached
     /// and the outputs those of the last successful step.
     pub fn advance(&mut self, t_next: f64) -> Result<&EnergySample, Error> {
@@ -152,6 +160,8 @@ impl<S: SecondOrderSystem> Stepper<S> {
             self.restart = false;
             self.restarts += 1;
         }
+        let budget = self.cv.stats().steps.saturating_add(self.steps_per_advance);
+        self.cv.set_max_steps(budget);
         self.roots.advance_to(&mut self.cv, t_next)?;
         let t = self.cv.t();
         self.y.copy_from_slice(self.cv.y());

@@ -75,3 +75,27 @@ fn a_load_change_restarts_once_and_bad_values_are_refused() {
     }
     assert!(Stepper::new(rom().0, f64::NAN, &scene.contact, &d.ode, &d.problem).is_err());
 }
+
+#[test]
+fn the_step_budget_applies_to_each_advance() {
+    // A co-simulation runs for as long as its importer wants: OdeOptions::max_steps bounds one
+    // advance, not the whole run as in the driver loop.
+    let (sys, scene) = rom();
+    let end = 5e-3;
+    let steps = run(sys.clone(), &scene, &common::until(end))
+        .unwrap()
+        .stats
+        .steps;
+    let mut opts = common::until(end);
+    opts.ode.max_steps = (steps / 3) as usize;
+    let e = run(sys.clone(), &scene, &opts).unwrap_err().to_string();
+    assert!(e.contains("CV_TOO_MUCH_WORK"), "{e}");
+    let mut st = Stepper::new(sys.clone(), 0.0, &scene.contact, &opts.ode, &opts.problem).unwrap();
+    for k in 1..=50 {
+        st.advance(k as f64 * end / 50.0).unwrap();
+    }
+    assert!(st.stats().steps > steps / 3, "{} steps", st.stats().steps);
+    let mut one = Stepper::new(sys, 0.0, &scene.contact, &opts.ode, &opts.problem).unwrap();
+    let e = one.advance(end).unwrap_err().to_string();
+    assert!(e.contains("CV_TOO_MUCH_WORK"), "{e}");
+}
