@@ -398,7 +398,7 @@ pub fn output_count(end: f64, output_step: f64) -> Result<usize, Error> {
 /// The first output quantity of `s` that is NaN or infinite, by name: an integrator can step
 /// on with finite coordinates while a pair force overflows (k_n = 1e300 N/mm), and such a run
 /// must not count as finished.
-fn non_finite(s: &super::mechanical::EnergySample) -> Option<&'static str> {
+pub(super) fn non_finite(s: &super::mechanical::EnergySample) -> Option<&'static str> {
     let named = [
         ("contact force norm", s.contact_force_norm),
         ("friction force norm", s.friction_force_norm),
@@ -577,9 +577,7 @@ struct Driver<S: SecondOrderSystem> {
     curves: Curves,
     trajectory: Option<Trajectory>,
     y0: Vec<f64>,
-    events: u64,
-    last_root_t: f64,
-    stalled: usize,
+    roots: RootGuard,
 }
 
 impl<S: SecondOrderSystem> Driver<S> {
@@ -632,9 +630,7 @@ impl<S: SecondOrderSystem> Driver<S> {
             curves,
             trajectory,
             y0,
-            events: 0,
-            last_root_t: f64::NEG_INFINITY,
-            stalled: 0,
+            roots: RootGuard::new(),
         })
     }
 
@@ -646,7 +642,7 @@ impl<S: SecondOrderSystem> Driver<S> {
         let mut failure = None;
         for k in 1..=outputs {
             let tout = (k as f64 * self.output_step).min(self.end);
-            if let Err(e) = self.advance_to(tout) {
+            if let Err(e) = self.roots.advance_to(&mut self.cv, tout) {
                 failure = Some(e);
                 break;
             }
@@ -686,7 +682,7 @@ impl<S: SecondOrderSystem> Driver<S> {
             stats,
             wall_s,
             cpu_s,
-            events: self.events,
+            events: self.roots.events,
             curves: self.curves,
             final_state: self.cv.y().to_vec(),
             trajectory: self.trajectory,
@@ -694,11 +690,36 @@ impl<S: SecondOrderSystem> Driver<S> {
             failure,
         }
     }
+}
 
-    /// Integrates to `tout`, re-initialising at every root.
-    fn advance_to(&mut self, tout: f64) -> Result<(), Error> {
+/// Event handling shared by the driver loop and [`super::Stepper`]: integrates to an output time,
+/// re-initialising at every root, and ends a chattering switch ([`MAX_STALLED_ROOTS`] roots in
+/// a row without progress in time) with [`Error::Chatter`].
+#[derive(Clone, Debug)]
+pub(super) struct RootGuard {
+    /// Events located (and re-initialisations done).
+    pub(super) events: u64,
+    last_root_t: f64,
+    stalled: usize,
+}
+
+impl RootGuard {
+    pub(super) fn new() -> RootGuard {
+        RootGuard {
+            events: 0,
+            last_root_t: f64::NEG_INFINITY,
+            stalled: 0,
+        }
+    }
+
+    /// Integrates `cv` to `tout`, re-initialising at every root.
+    pub(super) fn advance_to<P: OdeProblem>(
+        &mut self,
+        cv: &mut Cvode<P>,
+        tout: f64,
+    ) -> Result<(), Error> {
         loop {
-            match self.cv.solve_to(tout)? {
+            match cv.solve_to(tout)? {
                 Stop::Reached(_) => return Ok(()),
                 Stop::Root { t, .. } => {
                     self.events += 1;
@@ -715,8 +736,8 @@ impl<S: SecondOrderSystem> Driver<S> {
                         self.stalled = 0;
                     }
                     self.last_root_t = t;
-                    let y = self.cv.y().to_vec();
-                    self.cv.reinit(t, &y)?;
+                    let y = cv.y().to_vec();
+                    cv.reinit(t, &y)?;
                 }
             }
         }

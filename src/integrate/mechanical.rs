@@ -263,6 +263,22 @@ pub struct MechanicalOde<S: SecondOrderSystem> {
     s_scale: f64,
     e_scale: f64,
     v_scale: f64,
+    /// The co-simulation's load ([`MechanicalOde::set_load`]); `None`: the system's own load.
+    load_hook: Option<LoadHook>,
+}
+
+/// A load other than the system's own ([`MechanicalOde::set_load`]):
+/// `f(t) = scale · f_system(t) + F_master`, with `F_master` the (generalized) forces of a
+/// master-node load held constant until the next change.
+#[derive(Clone, Debug, PartialEq)]
+struct LoadHook {
+    /// Factor on the system's own load history (dimensionless).
+    scale: f64,
+    /// The added master-node load `[Fx, Fy, Fz (N), Mx, My, Mz (N·mm)]`.
+    master: [f64; 6],
+    /// Its (generalized) forces ([`SecondOrderSystem::master_load_into`]), computed once per
+    /// change so that the right-hand side does not allocate.
+    forces: Vec<f64>,
 }
 
 impl<S: SecondOrderSystem> MechanicalOde<S> {
@@ -325,8 +341,64 @@ impl<S: SecondOrderSystem> MechanicalOde<S> {
             s_scale: opts.slip_scale,
             e_scale: opts.energy_scale,
             v_scale: opts.velocity_scale,
+            load_hook: None,
             sys,
         })
+    }
+
+    /// Replaces the load by `scale · f_system(t) + F(master)`: the system's own load history
+    /// times `scale` (dimensionless) plus the master-node load `master = [Fx, Fy, Fz (N), Mx,
+    /// My, Mz (N·mm)]` held constant (a co-simulation's input between two communication
+    /// points). `(1, 0)` restores the system's own load exactly (the same arithmetic as without
+    /// a call). The right-hand side is not smooth across a change: restart the integrator
+    /// after one ([`crate::integrate::Stepper`] does).
+    ///
+    /// # Errors
+    /// [`Error::Invalid`] naming the component if `scale` or a load component is not finite.
+    pub fn set_load(&mut self, scale: f64, master: [f64; 6]) -> Result<(), Error> {
+        if !scale.is_finite() {
+            return Err(Error::Invalid(format!(
+                "the load scale must be finite, got {scale}"
+            )));
+        }
+        const NAMES: [&str; 6] = ["Fx", "Fy", "Fz", "Mx", "My", "Mz"];
+        if let Some(d) = master.iter().position(|v| !v.is_finite()) {
+            return Err(Error::Invalid(format!(
+                "the master load component {} must be finite, got {}",
+                NAMES[d], master[d]
+            )));
+        }
+        if scale == 1.0 && master.iter().all(|&v| v == 0.0) {
+            self.load_hook = None;
+            return Ok(());
+        }
+        let mut forces = vec![0.0; self.n];
+        self.sys.master_load_into(&master, &mut forces);
+        self.load_hook = Some(LoadHook {
+            scale,
+            master,
+            forces,
+        });
+        Ok(())
+    }
+
+    /// The load set by [`MechanicalOde::set_load`]: `(scale, master load)`, `(1, 0)` for the
+    /// system's own.
+    pub fn load(&self) -> (f64, [f64; 6]) {
+        match &self.load_hook {
+            Some(h) => (h.scale, h.master),
+            None => (1.0, [0.0; 6]),
+        }
+    }
+
+    /// `self.f = f(t)`: the system's load, changed by the load hook if set.
+    fn total_load_into_f(&mut self, t: f64) {
+        self.sys.load_into(t, &mut self.f);
+        if let Some(h) = &self.load_hook {
+            for (fi, e) in self.f.iter_mut().zip(&h.forces) {
+                *fi = h.scale * *fi + e;
+            }
+        }
     }
 
     /// The system.
@@ -644,7 +716,7 @@ impl<S: SecondOrderSystem> OdeProblem for MechanicalOde<S> {
             &mut self.p,
             &mut self.srate,
         );
-        self.sys.load_into(t, &mut self.f);
+        self.total_load_into_f(t);
         self.sys.mul_k_into(q, &mut self.tmp);
         self.sys.joint_transpose_add(&self.p, &mut self.tmp);
         let (dq, drest) = ydot.split_at_mut(n);
@@ -790,7 +862,7 @@ impl<S: SecondOrderSystem> OdeProblem for MechanicalOde<S> {
                         + l.diss_g * ba[0]);
             }
         }
-        self.sys.load_into(t, &mut self.f);
+        self.total_load_into_f(t);
         ze[0] = rest[0] + g * dot(&self.f, zb) / self.e_scale;
         ze[1] = zd / self.e_scale;
         non_finite("the Newton correction", z)

@@ -1,11 +1,13 @@
 //! Time integration: the first-order ODE problem, its options and statistics ([`problem`]), the
 //! mechanical problem of any [`crate::system::SecondOrderSystem`] with contact and friction
 //! ([`mechanical`]), the one driver loop with deadline, observer and a typed [`RunStatus`]
-//! ([`driver`]), and SUNDIALS CVODE beneath ([`sundials`], the crate's only `unsafe`).
+//! ([`driver`]), the same run advanced from outside for co-simulation ([`stepper`]), and SUNDIALS
+//! CVODE beneath ([`sundials`], the crate's only `unsafe`).
 
 pub mod driver;
 pub mod mechanical;
 pub mod problem;
+pub mod stepper;
 #[allow(unsafe_code)]
 pub mod sundials;
 
@@ -14,3 +16,4 @@ pub use driver::{
     integrate, run, thread_cpu_s, Curves, Profile, Run, RunStatus, Trajectory, TransientOptions,
 };
 pub use mechanical::{EnergySample, MechanicalOde, ProblemOptions};
+pub use stepper::Stepper;

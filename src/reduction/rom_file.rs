@@ -173,13 +173,19 @@ impl RomFile {
     /// Reads and checks a file (errors name the file and the field).
     pub fn read(path: &Path) -> Result<RomFile, Error> {
         let text = crate::files::read_text(path)?;
+        RomFile::parse(&text, path)
+    }
+
+    /// Parses and checks the text of a file read from `path` (errors name `path` and the
+    /// field), for readers that need the bytes too (an FMU checks them against its GUID).
+    pub fn parse(text: &str, path: &Path) -> Result<RomFile, Error> {
         let bad = |field: &str, msg: String| Error::Document {
             file: path.to_path_buf(),
             path: field.to_string(),
             reason: msg,
             source: None,
         };
-        let de = &mut serde_json::Deserializer::from_str(&text);
+        let de = &mut serde_json::Deserializer::from_str(text);
         let f: RomFile = serde_path_to_error::deserialize(de).map_err(|e| Error::Document {
             file: path.to_path_buf(),
             path: e.path().to_string(),

@@ -1,10 +1,12 @@
 //! Output for people and tools: charts ([`chart`], [`heatmap`]), VTU fields for ParaView
 //! ([`vtu`], [`shapes`]), CSV curves ([`curves`]), the convergence study's and the stability
-//! map's outputs ([`convergence`], [`stability`]) and the main job's report ([`main_job`]).
+//! map's outputs ([`convergence`], [`stability`]), the main job's report ([`main_job`]) and the
+//! reduced model as an FMI 2.0 co-simulation FMU ([`fmu`]).
 
 pub mod chart;
 pub mod convergence;
 pub mod curves;
+pub mod fmu;
 pub mod heatmap;
 pub mod html;
 pub mod main_job;

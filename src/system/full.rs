@@ -155,8 +155,10 @@ impl SecondOrderSystem for FullSystem {
         self.mass_llt.solve_vec_in_place(x);
     }
     fn load_into(&self, t: f64, out: &mut [f64]) {
+        self.master_load_into(&self.load.master_at(t), out);
+    }
+    fn master_load_into(&self, f: &[f64; 6], out: &mut [f64]) {
         out.fill(0.0);
-        let f = self.load.master_at(t);
         for d in 0..6 {
             out[self.master[d]] += f[d];
         }

@@ -74,6 +74,11 @@ pub trait SecondOrderSystem {
     fn solve_m_in_place(&mut self, x: &mut [f64]);
     /// `out = f(t)` (N, N·mm; reduced: generalized forces).
     fn load_into(&self, t: f64, out: &mut [f64]);
+    /// `out` = the (generalized) forces of the master-node load `f = [Fx, Fy, Fz (N), Mx, My,
+    /// Mz (N·mm)]`: the load vector with `f` on the six master DOF (full), `Φ_mᵀ f` (reduced).
+    /// [`SecondOrderSystem::load_into`] is this of the case's load at `t`; a co-simulation adds
+    /// its own master load through it ([`crate::integrate::Stepper`]).
+    fn master_load_into(&self, f: &[f64; 6], out: &mut [f64]);
     /// `out = B q` (3 per pair: gap, slip x, slip z; mm).
     fn joint_apply_into(&self, q: &[f64], out: &mut [f64]);
     /// `out += Bᵀ p`.

@@ -333,7 +333,9 @@ impl SecondOrderSystem for ReducedSystem {
         );
     }
     fn load_into(&self, t: f64, out: &mut [f64]) {
-        let f = self.load.master_at(t);
+        self.master_load_into(&self.load.master_at(t), out);
+    }
+    fn master_load_into(&self, f: &[f64; 6], out: &mut [f64]) {
         for (c, o) in out.iter_mut().enumerate() {
             *o = (0..6).map(|d| self.phi_master[(d, c)] * f[d]).sum();
         }

@@ -7,5 +7,6 @@ mod common;
 mod cvode;
 mod friction;
 mod refresh;
+mod stepper;
 mod system;
 mod transient_reference;

@@ -598,6 +598,14 @@ impl<P: OdeProblem> Cvode<P> {
         self.current_stats()
     }
 
+    /// Raises (or lowers) the run's step budget: `solve_to` fails with `CV_TOO_MUCH_WORK` once
+    /// the internal steps since creation (across `reinit`) reach `total` (at least one more
+    /// step is always allowed). A caller that advances a run for an open-ended time (a
+    /// co-simulation, [`crate::integrate::Stepper`]) gives each advance its own budget this way.
+    pub fn set_max_steps(&mut self, total: u64) {
+        self.max_steps = total;
+    }
+
     /// Number of warnings CVODE reported (e.g. `t + h = t`), which are not printed.
     pub fn warnings(&self) -> u64 {
         self.shared.get().warnings

@@ -1,6 +1,7 @@
-//! `jointrom export`: a reduced model as a versioned JSON file (`jointrom-rom` v1).
+//! `jointrom export`: a reduced model as a versioned JSON file (`jointrom-rom` v1) and/or as an
+//! FMI 2.0 co-simulation FMU (`jointrom::report::fmu`).
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use clap::Args;
 
@@ -31,9 +32,70 @@ pub struct ExportArgs {
     /// |f_c|(t) over the case's transient with friction is at most TOL, in (0, 1)).
     #[arg(long, allow_negative_numbers = true)]
     tolerance: Option<f64>,
-    /// Output file.
+    /// Output file: the reduced model as JSON (`jointrom-rom` v1).
+    #[arg(long, required_unless_present = "fmu")]
+    out: Option<PathBuf>,
+    /// Also (or instead) write the reduced model as an FMI 2.0 co-simulation FMU: the archive
+    /// holds modelDescription.xml, the FMU binary (libjointrom_fmu.so, taken from
+    /// $JOINTROM_FMU_BINARY or beside this executable; build it with `cargo build --release
+    /// -p jointrom-fmu`) and the reduced model as resources/rom.json.
     #[arg(long)]
-    out: PathBuf,
+    fmu: Option<PathBuf>,
+}
+
+/// The FMU binary to package: `$JOINTROM_FMU_BINARY`, else `libjointrom_fmu.so` beside the
+/// running executable (cargo builds both into `target/release/`).
+fn fmu_binary() -> Result<PathBuf, Error> {
+    use jointrom::report::fmu::{BINARY_ENV, BINARY_FILE};
+    if let Some(p) = std::env::var_os(BINARY_ENV) {
+        let p = PathBuf::from(p);
+        if !p.is_file() {
+            return Err(Error::Invalid(format!(
+                "{BINARY_ENV}={} is not a file (point it at the {BINARY_FILE} built by `cargo \
+                 build --release -p jointrom-fmu`, or unset it)",
+                p.display()
+            )));
+        }
+        return Ok(p);
+    }
+    let exe = std::env::current_exe().map_err(|e| {
+        Error::Invalid(format!(
+            "--fmu: cannot locate this executable to find {BINARY_FILE} beside it ({e}); set \
+             {BINARY_ENV}"
+        ))
+    })?;
+    let dir = exe.parent().unwrap_or(Path::new("."));
+    let p = dir.join(BINARY_FILE);
+    if p.is_file() {
+        Ok(p)
+    } else {
+        Err(Error::Invalid(format!(
+            "--fmu: the FMU binary {} does not exist: build it with `cargo build --release -p \
+             jointrom-fmu` (it lands beside the jointrom executable), or set {BINARY_ENV} to it",
+            p.display()
+        )))
+    }
+}
+
+/// Writes `file` to `--out` and/or `--fmu`; the paths written, for the summary line.
+fn write_outputs(a: &ExportArgs, file: &export::RomFile) -> Result<String, Error> {
+    // Find the binary first: a missing binary must not leave a half-done export behind.
+    let binary = a.fmu.as_ref().map(|_| fmu_binary()).transpose()?;
+    let mut written = Vec::new();
+    if let Some(out) = &a.out {
+        file.write(out)?;
+        written.push(out.display().to_string());
+    }
+    if let (Some(out), Some(binary)) = (&a.fmu, binary) {
+        let p = jointrom::report::fmu::write_fmu(file, &binary, out)?;
+        written.push(format!(
+            "{} (FMI 2.0 co-simulation, {}, {} bytes)",
+            out.display(),
+            p.model_identifier,
+            p.bytes
+        ));
+    }
+    Ok(written.join(" and "))
 }
 
 pub fn run(a: ExportArgs) -> Result<(), Error> {
@@ -61,7 +123,7 @@ pub fn run(a: ExportArgs) -> Result<(), Error> {
             }),
         };
         let file = export::RomFile::new(&model, &t.rom, info)?;
-        file.write(&a.out)?;
+        let written = write_outputs(&a, &file)?;
         println!(
             "{}: adaptive basis for tolerance {tol:e} ({} pairs, nu = {}), r = {}, estimated |f_c| error {:.2e}{} → {}",
             jointrom::files::printable(&model.name),
@@ -70,7 +132,7 @@ pub fn run(a: ExportArgs) -> Result<(), Error> {
             file.dimension,
             t.estimate.total.contact_force.unwrap_or(0.0),
             if t.met { "" } else { " (tolerance NOT met)" },
-            a.out.display()
+            written
         );
         return Ok(());
     }
@@ -91,14 +153,14 @@ pub fn run(a: ExportArgs) -> Result<(), Error> {
     };
     let rom = ReducedSystem::new(&model, b.phi)?;
     let file = export::RomFile::new(&model, &rom, info)?;
-    file.write(&a.out)?;
+    let written = write_outputs(&a, &file)?;
     println!(
         "{}: {} basis, g = {}, r = {} → {}",
         jointrom::files::printable(&model.name),
         kind.name(),
         file.basis.g,
         file.dimension,
-        a.out.display()
+        written
     );
     Ok(())
 }
