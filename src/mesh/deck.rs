@@ -434,9 +434,10 @@ fn clamps(deck: &Deck, index: &NodeIndex, tie: &RigidTie) -> Result<Vec<usize>, 
         .iter()
         .find(|&&n| n == tie.master || tie.slaves.binary_search(&n).is_ok())
     {
+        let grid = index.iter().find(|(_, &i)| i == n).map_or(0, |(&g, _)| g);
         return Err(deck_err(
             deck,
-            format!("node {n} is both clamped and rigidly tied (RBE2)"),
+            format!("grid {grid} is both clamped and rigidly tied (RBE2)"),
         ));
     }
     Ok(clamped.into_iter().collect())
