@@ -163,7 +163,9 @@ fn load_variant(name: &str, edit: impl Fn(String) -> String) -> Result<Model, Er
     }
     let main = dir.join("friction_bar.bdf");
     let text = std::fs::read_to_string(&main).unwrap();
-    std::fs::write(&main, edit(text)).unwrap();
+    let edited = edit(text.clone());
+    assert_ne!(edited, text, "{name}: the edit matched nothing in the deck");
+    std::fs::write(&main, edited).unwrap();
     Model::from_case_name(main.to_str().unwrap())
 }
 
@@ -368,4 +370,53 @@ fn truncations_never_panic() {
     assert!(errors > 0);
     let cards = cards::read(Path::new(&path)).unwrap();
     assert!(!cards.files.is_empty());
+}
+
+/// CWELD ELPAT (patches by element) gives the PARTPAT model; CWELD ALIGN and a CBAR with a
+/// PBARL ROD between the weld-centre grids give the case's point weld (`"model": "point"`).
+#[test]
+fn weld_attachments_map_to_jointrom_welds() {
+    let freq = |m: &Model| m.modes(10, Interface::Fixed).unwrap().frequencies_hz;
+    let partpat = freq(&deck_model("friction_bar"));
+    let elpat = load_variant("elpat", |t| {
+        t.replace(
+            "CWELD      60001     101   80001 PARTPAT\n+              1       2",
+            "CWELD      60001     101   80001   ELPAT\n+         100026  200010",
+        )
+        .replace(
+            "CWELD      60002     101   80002 PARTPAT\n+              1       2",
+            "CWELD      60002     101   80002  ELEMID\n+         100044  200028",
+        )
+    })
+    .unwrap();
+    assert_eq!(freq(&elpat), partpat, "ELPAT/ELEMID = PARTPAT");
+    let point = freq(&common::point_weld_model("friction_bar"));
+    let align = |t: String| {
+        t.replace(
+            "CWELD      60001     101   80001 PARTPAT\n+              1       2",
+            "CWELD,60001,101,,ALIGN,10038,20014",
+        )
+        .replace(
+            "CWELD      60002     101   80002 PARTPAT\n+              1       2",
+            "CWELD,60002,101,,ALIGN,10065,20041",
+        )
+    };
+    let aligned = load_variant("align", align).unwrap();
+    let bars = load_variant("cbar", |t| {
+        align(t)
+            .replace("CWELD,60001,101,,ALIGN,", "CBAR,60001,301,")
+            .replace("CWELD,60002,101,,ALIGN,", "CBAR,60002,301,")
+            .replace("ENDDATA", "PBARL,301,1,,ROD\n,2.5\nENDDATA")
+    })
+    .unwrap();
+    for (k, p) in point.iter().enumerate() {
+        let (a, b) = (freq(&aligned)[k], freq(&bars)[k]);
+        println!(
+            "mode {}: point weld {p:.6}, ALIGN {a:.6}, CBAR ROD {b:.6} Hz",
+            k + 1
+        );
+        assert!(rel(a, *p) < 1e-9 && rel(b, *p) < 1e-9, "mode {}", k + 1);
+    }
+    // Welds without a nugget fuse no pairs: all 54 CGAPs are joint pairs.
+    assert_eq!(aligned.pair_count(), 54);
 }
