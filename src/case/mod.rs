@@ -30,6 +30,11 @@
 //! }
 //! ```
 //!
+//! The load's time function may instead be a table, NASTRAN's `TABLED1` rule (linear between
+//! the points, the mean at a jump, the straight line through the end points beyond them):
+//! `"ramp": {"shape": "table", "points": [[0.0, 0.0], [0.05, 1.0], [0.2, 1.0]]}` (s, factor).
+//! A NASTRAN deck is read into the same model by [`nastran`].
+//!
 //! # Geometry and numbering
 //!
 //! Sheet `s` spans `x ∈ [x0, x1]`, `z ∈ [z0, z1]` at height `y` (its mid-surface) and is meshed

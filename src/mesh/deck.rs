@@ -44,6 +44,9 @@ pub struct DeckModel {
     pub end_time: f64,
     /// Warnings: ignored and unknown cards, unused grids, pairs fused by welds.
     pub warnings: Vec<String>,
+    /// Where each shell of [`Mesh::shells`] comes from: file, line and CQUAD4 id, for errors
+    /// found when its element is built.
+    pub shell_sources: Vec<(std::path::PathBuf, usize, i64)>,
 }
 
 /// Builds the mesh of a typed deck (see the module docs).
@@ -51,6 +54,7 @@ pub fn build(deck: &Deck) -> Result<DeckModel, Error> {
     let mut warnings = deck.warnings.clone();
     let (nodes, grid_ids, index) = nodes(deck, &mut warnings)?;
     let material = material(deck)?;
+    units_warning(deck, &material, &mut warnings);
     let mut shells = shells(deck, &index)?;
     let sheets = Sheets::new(&shells, &nodes);
     for (shell, &sheet) in shells.iter_mut().zip(&sheets.of_shell) {
@@ -67,8 +71,8 @@ pub fn build(deck: &Deck) -> Result<DeckModel, Error> {
         .iter()
         .map(|m| PointMass {
             node: index[&m.grid],
-            mass: m.mass,
-            inertia: m.inertia,
+            mass: m.mass * deck.wtmass,
+            inertia: m.inertia.map(|i| i * deck.wtmass),
         })
         .collect();
     let load = load(deck, tie.master, &grid_ids)?;
@@ -91,6 +95,11 @@ pub fn build(deck: &Deck) -> Result<DeckModel, Error> {
         contact,
         end_time,
         warnings,
+        shell_sources: deck
+            .quads
+            .iter()
+            .map(|q| (deck.cards.files[q.at.file].clone(), q.at.line, q.id))
+            .collect(),
     })
 }
 
@@ -217,7 +226,7 @@ fn material(deck: &Deck) -> Result<Material, Error> {
         let mat = Material {
             youngs_modulus: m.youngs_modulus,
             poisson_ratio: m.poisson_ratio,
-            density: m.density,
+            density: m.density * deck.wtmass,
         };
         match first {
             None => first = Some((mat, mid)),
@@ -238,6 +247,21 @@ fn material(deck: &Deck) -> Result<Material, Error> {
     first
         .map(|(m, _)| m)
         .ok_or_else(|| deck_err(deck, "no PSHELL: the deck has no sheets"))
+}
+
+/// A warning when the material does not look like mm, N, t, s (jointrom's units, and those of
+/// most car-body decks): steel is E = 2.1e5 N/mm², ρ = 7.85e-9 t/mm³; in SI it is 2.1e11 Pa and
+/// 7850 kg/m³.
+fn units_warning(deck: &Deck, m: &Material, warnings: &mut Vec<String>) {
+    if m.youngs_modulus > 1e8 || m.density > 1e-5 {
+        warnings.push(format!(
+            "{}: E = {} and ρ·WTMASS = {} do not look like N/mm² and t/mm³: jointrom reads decks \
+             in mm, N, t, s (results in other units are not converted)",
+            deck.cards.files[0].display(),
+            m.youngs_modulus,
+            m.density
+        ));
+    }
 }
 
 fn shells(deck: &Deck, index: &NodeIndex) -> Result<Vec<ShellElem>, Error> {

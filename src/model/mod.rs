@@ -217,6 +217,18 @@ impl Model {
         let deck = crate::case::nastran::deck::read(path)?;
         let built = Mesh::from_deck(&deck)?;
         let mesh = built.mesh;
+        // Each CQUAD4's element first, so that a degenerate or warped one is named by its line.
+        for (shell, (file, line, id)) in mesh.shells.iter().zip(&built.shell_sources) {
+            let corners = shell.nodes.map(|n| mesh.nodes[n]);
+            crate::element::Shell4::new(corners, shell.thickness, mesh.material).map_err(|e| {
+                Error::Deck {
+                    file: file.clone(),
+                    line: *line,
+                    card: format!("CQUAD4 {id}"),
+                    reason: e.to_string(),
+                }
+            })?;
+        }
         let pairs = mesh
             .pairs
             .iter()

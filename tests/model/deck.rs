@@ -264,6 +264,60 @@ fn unsupported_mechanics_are_errors_naming_the_line() {
         |t| t.replace("TSTEP   ", "$STEP   "),
         &["TSTEP"],
     );
+    fails(
+        "lgdisp",
+        before_enddata("PARAM,LGDISP,1"),
+        &["PARAM", "LGDISP", "large displacements"],
+    );
+    fails(
+        "damping",
+        before_enddata("PARAM,G,0.02"),
+        &["PARAM", "damping"],
+    );
+}
+
+/// PARAM,WTMASS scales every mass (ω ∝ 1/√m); a material in SI units draws a warning; a
+/// degenerate CQUAD4 is named by its line.
+#[test]
+fn params_units_and_warped_shells() {
+    let f = |m: &Model| m.modes(3, Interface::Fixed).unwrap().frequencies_hz;
+    let base = f(&deck_model("friction_bar"));
+    let light = load_variant("wtmass", before_enddata("PARAM,WTMASS,0.5")).unwrap();
+    for (a, b) in f(&light).iter().zip(&base) {
+        assert!(rel(*a, b * 2f64.sqrt()) < 1e-9, "{a} vs {b}·√2");
+    }
+    let si = load_variant("si", |t| {
+        t.replace("MAT1,1,210000.0,,0.3,7.85-9", "MAT1,1,2.1+11,,0.3,7850.")
+    })
+    .unwrap();
+    assert!(
+        si.warnings.iter().any(|w| w.contains("mm, N, t, s")),
+        "{:?}",
+        si.warnings
+    );
+    let dir = common::tmp_dir("deck_warped");
+    for f in ["friction_bar.bdf", "friction_bar_mesh.bdf"] {
+        std::fs::copy(repo_path("cases/nastran").join(f), dir.join(f)).unwrap();
+    }
+    let mesh = dir.join("friction_bar_mesh.bdf");
+    let text = std::fs::read_to_string(&mesh).unwrap();
+    // Grid 10005 (5, 0, 12.5) moved onto grid 10001 (0, 0, 0): its shells degenerate.
+    let warped = text.replacen(
+        "GRID*              10005                             5.0             0.0\n*                   12.5",
+        "GRID*              10005                             0.0             0.0\n*                    0.0",
+        1,
+    );
+    assert_ne!(warped, text);
+    std::fs::write(&mesh, warped).unwrap();
+    let e = Model::from_case_name(dir.join("friction_bar.bdf").to_str().unwrap())
+        .map(|_| ())
+        .unwrap_err()
+        .to_string();
+    println!("warped: {e}");
+    assert!(
+        e.contains("friction_bar_mesh.bdf:") && e.contains("CQUAD4 1000"),
+        "{e}"
+    );
 }
 
 #[test]

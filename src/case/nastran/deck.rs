@@ -11,8 +11,8 @@ use crate::error::Error;
 /// Cards that carry no mechanics jointrom models (solver controls, coordinate systems used by
 /// nothing, plot elements): read past, listed in a warning.
 pub const IGNORED: &[&str] = &[
-    "PARAM", "EIGRL", "EIGR", "NLPARM", "NLPCI", "CORD2R", "CORD2C", "CORD2S", "CORD1R", "CORD1C",
-    "CORD1S", "PLOTEL", "SWLDPRM", "DTI", "MDLPRM", "ECHOON", "ECHOOFF",
+    "EIGRL", "EIGR", "NLPARM", "NLPCI", "CORD2R", "CORD2C", "CORD2S", "CORD1R", "CORD1C", "CORD1S",
+    "PLOTEL", "SWLDPRM", "DTI", "MDLPRM", "ECHOON", "ECHOOFF",
 ];
 
 /// Cards that change the mechanics in ways jointrom does not model: an error naming the line.
@@ -480,6 +480,8 @@ pub struct Deck {
     pub gaps: Vec<GapCard>,
     /// PGAPs by id.
     pub pgaps: BTreeMap<i64, PgapCard>,
+    /// `PARAM,WTMASS`: the factor on every mass (density, CONM2), 1 by default.
+    pub wtmass: f64,
     /// Warnings (ignored and unknown cards).
     pub warnings: Vec<String>,
 }
@@ -492,7 +494,10 @@ pub fn read(path: &std::path::Path) -> Result<Deck, Error> {
 
 /// Types the cards of a read deck.
 pub fn interpret(cards: Cards) -> Result<Deck, Error> {
-    let mut deck = Deck::default();
+    let mut deck = Deck {
+        wtmass: 1.0,
+        ..Deck::default()
+    };
     let mut ignored: BTreeMap<String, usize> = BTreeMap::new();
     let mut unknown: BTreeMap<String, usize> = BTreeMap::new();
     for card in &cards.cards {
@@ -527,6 +532,11 @@ pub fn interpret(cards: Cards) -> Result<Deck, Error> {
             "TSTEP" | "TSTEPNL" => deck.tstep(&f)?,
             "CGAP" => deck.cgap(&f)?,
             "PGAP" => deck.pgap(&f)?,
+            "PARAM" => {
+                if !deck.param(&f)? {
+                    *ignored.entry("PARAM".into()).or_default() += 1;
+                }
+            }
             name => {
                 if let Some((_, why)) = REFUSED.iter().find(|(n, _)| *n == name) {
                     return Err(f.error(format!("not supported: {why}")));
@@ -727,6 +737,31 @@ impl Deck {
             }
         }
         Ok(())
+    }
+
+    /// A `PARAM`: `WTMASS` is applied, parameters that change the mechanics jointrom models are
+    /// refused (`LGDISP` ≥ 0: large displacements; `G`, `W3`, `W4`: damping); `true` when it
+    /// was read, `false` when it is ignored.
+    fn param(&mut self, f: &Fields) -> Result<bool, Error> {
+        let name = f.word(1);
+        match name.as_str() {
+            "WTMASS" => {
+                let w = f.real(2, "WTMASS")?;
+                if w <= 0.0 {
+                    return Err(f.error(format!("WTMASS must be > 0, found {w}")));
+                }
+                self.wtmass = w;
+                Ok(true)
+            }
+            "LGDISP" if f.int_opt(2, "LGDISP")?.unwrap_or(-1) >= 0 => Err(f.error(
+                "LGDISP ≥ 0 asks for large displacements: jointrom's structure is linear \
+                 (the joints carry the nonlinearity)",
+            )),
+            "G" | "W3" | "W4" if f.real_opt(2, &name)?.unwrap_or(0.0) != 0.0 => Err(f.error(
+                format!("{name}: structural damping is not modelled (the model is undamped)"),
+            )),
+            _ => Ok(false),
+        }
     }
 
     fn unique<T>(

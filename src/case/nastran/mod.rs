@@ -24,6 +24,7 @@
 //! | `TLOAD1` + `TABLED1` (`DLOAD`) | the load's time function (linear, NASTRAN's extrapolation) | DELAY cards, TYPE ≠ LOAD, US0/VS0, LOG axes, several tables |
 //! | `TSTEP`/`TSTEPNL` | the end time Σ Nᵢ·DTᵢ | |
 //! | `CGAP` + `PGAP` | a joint pair: normal GA → GB, KA → k_n, KT → k_t (default MU1·KA), MU1 → μ | U0 ≠ 0, F0 ≠ 0, KB > 1e-6·KA, MU2 ≠ MU1, CID, different PGAP laws |
+//! | `PARAM` | `WTMASS` (the factor on every mass) | `LGDISP` ≥ 0, `G`, `W3`, `W4` |
 //!
 //! Cards that carry no mechanics jointrom models ([`deck::IGNORED`]: `PARAM`, `EIGRL`, unused
 //! coordinate systems, ...) and unknown cards are listed in a warning; cards that change the
