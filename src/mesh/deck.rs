@@ -19,7 +19,9 @@
 //!   that weld's two sheets is fused by the weld, not in contact: it is left out, with a
 //!   warning, as a case's joint leaves out the nodes inside a nugget.
 
+use std::cell::RefCell;
 use std::collections::{BTreeMap, BTreeSet, HashMap};
+use std::rc::Rc;
 
 use super::nugget;
 use super::{BeamElem, JointPair, Material, Mesh, PointMass, RigidTie, ShellElem, WeldElem};
@@ -62,8 +64,8 @@ pub fn build(deck: &Deck) -> Result<DeckModel, Error> {
     }
     let tie = rigid_tie(deck, &index)?;
     let clamped = clamps(deck, &index, &tie)?;
-    let mut beams = beams(deck, &index, &material)?;
-    let (welds, align) = welds(deck, &index, &nodes, &shells, &sheets, &material)?;
+    let mut beams = beams(deck, &index)?;
+    let (welds, align) = welds(deck, &index, &nodes, &shells, &sheets)?;
     beams.extend(align);
     let (pairs, contact) = pairs(deck, &index, &nodes, &welds, &clamped, &tie, &mut warnings)?;
     let masses = deck
@@ -467,8 +469,7 @@ fn clamps(deck: &Deck, index: &NodeIndex, tie: &RigidTie) -> Result<Vec<usize>, 
     Ok(clamped.into_iter().collect())
 }
 
-fn beams(deck: &Deck, index: &NodeIndex, material: &Material) -> Result<Vec<BeamElem>, Error> {
-    let _ = material;
+fn beams(deck: &Deck, index: &NodeIndex) -> Result<Vec<BeamElem>, Error> {
     deck.beams
         .iter()
         .map(|b| {
@@ -648,6 +649,116 @@ fn shape([r, s]: [f64; 2]) -> [f64; 4] {
     ]
 }
 
+/// Layers by (sheet, PSHELL filter), each built once.
+type LayerCache<'a> = HashMap<(usize, Option<i64>), Rc<Layer<'a>>>;
+
+/// The two sides of the area welds: candidate sheets per PSHELL and per shell id, and the layers
+/// built so far by (sheet, PSHELL filter) — each built once however many welds it carries.
+struct WeldSides<'a> {
+    deck: &'a Deck,
+    shells: &'a [ShellElem],
+    nodes: &'a [[f64; 3]],
+    sheets: &'a Sheets,
+    shell_of_id: HashMap<i64, usize>,
+    sheets_of_part: HashMap<i64, BTreeSet<usize>>,
+    cache: RefCell<LayerCache<'a>>,
+}
+
+impl<'a> WeldSides<'a> {
+    fn new(
+        deck: &'a Deck,
+        shells: &'a [ShellElem],
+        nodes: &'a [[f64; 3]],
+        sheets: &'a Sheets,
+    ) -> WeldSides<'a> {
+        let mut sheets_of_part: HashMap<i64, BTreeSet<usize>> = HashMap::new();
+        for (e, q) in deck.quads.iter().enumerate() {
+            sheets_of_part
+                .entry(q.pid)
+                .or_default()
+                .insert(sheets.of_shell[e]);
+        }
+        WeldSides {
+            deck,
+            shells,
+            nodes,
+            sheets,
+            shell_of_id: deck
+                .quads
+                .iter()
+                .enumerate()
+                .map(|(e, q)| (q.id, e))
+                .collect(),
+            sheets_of_part,
+            cache: RefCell::new(HashMap::new()),
+        }
+    }
+
+    /// The layer of side `side` (`id`: PIDA/PIDB with `by_part`, else SHIDA/SHIDB): among the
+    /// candidate sheets, the nearest in y to `location` whose shells contain its (x, z).
+    fn pick(
+        &self,
+        side: &str,
+        id: i64,
+        by_part: bool,
+        location: [f64; 3],
+        e: &dyn Fn(String) -> Error,
+    ) -> Result<Rc<Layer<'a>>, Error> {
+        let (deck, shells, nodes, sheets) = (self.deck, self.shells, self.nodes, self.sheets);
+        let centre = [location[0], location[2]];
+        let candidates: Vec<usize> = if by_part {
+            match self.sheets_of_part.get(&id) {
+                Some(set) => set.iter().copied().collect(),
+                None => return Err(e(format!("PID{side} {id}: no CQUAD4 has this PSHELL"))),
+            }
+        } else {
+            match self.shell_of_id.get(&id) {
+                Some(&s) => vec![sheets.of_shell[s]],
+                None => return Err(e(format!("SHID{side} {id}: no such CQUAD4"))),
+            }
+        };
+        // The candidate sheets, nearest in y first, that contain the centre.
+        let mut found: Vec<(f64, usize)> = candidates
+            .into_iter()
+            .map(|k| {
+                let y = nodes[shells[sheets.members[k][0]].nodes[0]][1];
+                ((y - location[1]).abs(), k)
+            })
+            .collect();
+        found.sort_by(|a, b| a.0.total_cmp(&b.0));
+        for (_, k) in found {
+            let part = by_part.then_some(id);
+            let layer = match self.cache.borrow().get(&(k, part)) {
+                Some(l) => Some(Rc::clone(l)),
+                None => None,
+            };
+            let layer = match layer {
+                Some(l) => l,
+                None => {
+                    let members: Vec<usize> = sheets.members[k]
+                        .iter()
+                        .copied()
+                        .filter(|&s| part.is_none_or(|p| deck.quads[s].pid == p))
+                        .collect();
+                    let l = Rc::new(
+                        Layer::new(k, members, shells, nodes)
+                            .map_err(|why| e(format!("side {side}: {why}")))?,
+                    );
+                    self.cache.borrow_mut().insert((k, part), Rc::clone(&l));
+                    l
+                }
+            };
+            if layer.locate(centre).is_some() {
+                return Ok(layer);
+            }
+        }
+        Err(e(format!(
+            "the weld's location (x, z) = ({}, {}) mm lies outside the shells of side {side}",
+            centre[0], centre[1]
+        )))
+    }
+}
+
 /// Area welds (and the beams of ALIGN point welds).
 fn welds(
     deck: &Deck,
@@ -655,15 +766,8 @@ fn welds(
     nodes: &[[f64; 3]],
     shells: &[ShellElem],
     sheets: &Sheets,
-    material: &Material,
 ) -> Result<(Vec<WeldElem>, Vec<BeamElem>), Error> {
-    let _ = material;
-    let shell_of_id: HashMap<i64, usize> = deck
-        .quads
-        .iter()
-        .enumerate()
-        .map(|(e, q)| (q.id, e))
-        .collect();
+    let sides = WeldSides::new(deck, shells, nodes, sheets);
     let mut out = Vec::new();
     let mut beams = Vec::new();
     for (w, card) in deck.welds.iter().enumerate() {
@@ -694,56 +798,15 @@ fn welds(
             Some(Location::Point(p)) => *p,
         };
         let centre = [location[0], location[2]];
-        let pick = |side: &str, id: i64, by_part: bool| -> Result<Layer, Error> {
-            let candidates: Vec<usize> = if by_part {
-                let in_part: Vec<usize> = (0..shells.len())
-                    .filter(|&s| deck.quads[s].pid == id)
-                    .collect();
-                if in_part.is_empty() {
-                    return Err(e(format!("PID{side} {id}: no CQUAD4 has this PSHELL")));
-                }
-                in_part
-            } else {
-                match shell_of_id.get(&id) {
-                    Some(&s) => vec![s],
-                    None => return Err(e(format!("SHID{side} {id}: no such CQUAD4"))),
-                }
-            };
-            // The sheets of the candidates, nearest in y first, that contain the centre.
-            let mut found: Vec<(f64, usize)> = candidates
-                .iter()
-                .map(|&s| sheets.of_shell[s])
-                .collect::<BTreeSet<_>>()
-                .into_iter()
-                .map(|k| {
-                    let y = nodes[shells[sheets.members[k][0]].nodes[0]][1];
-                    ((y - location[1]).abs(), k)
-                })
-                .collect();
-            found.sort_by(|a, b| a.0.total_cmp(&b.0));
-            for (_, k) in found {
-                let members: Vec<usize> = sheets.members[k]
-                    .iter()
-                    .copied()
-                    .filter(|&s| !by_part || deck.quads[s].pid == id)
-                    .collect();
-                let layer = Layer::new(k, members, shells, nodes)
-                    .map_err(|why| e(format!("side {side}: {why}")))?;
-                if layer.locate(centre).is_some() {
-                    return Ok(layer);
-                }
-            }
-            Err(e(format!(
-                "the weld's location (x, z) = ({}, {}) mm lies outside the shells of side {side}",
-                centre[0], centre[1]
-            )))
-        };
         let (a, b, by_part) = match card.attach {
             WeldAttach::Parts { a, b } => (a, b, true),
             WeldAttach::Elements { a, b } => (a, b, false),
             WeldAttach::Align { .. } => unreachable!("handled above"),
         };
-        let (la, lb) = (pick("A", a, by_part)?, pick("B", b, by_part)?);
+        let (la, lb) = (
+            sides.pick("A", a, by_part, location, &e)?,
+            sides.pick("B", b, by_part, location, &e)?,
+        );
         if la.sheet == lb.sheet {
             return Err(e("both sides are the same sheet".into()));
         }
@@ -761,7 +824,7 @@ fn welds(
             return Err(e("the two sheets are at the same height".into()));
         }
         let inside = |p: [f64; 2]| lower.locate(p).is_some() && upper.locate(p).is_some();
-        let layers = [&lower, &upper]
+        let layers = [&*lower, &*upper]
             .map(|l| {
                 let interpolation = |p: [f64; 2]| {
                     l.locate(p)
