@@ -57,7 +57,7 @@ pub mod rom_file;
 pub mod tvd;
 
 pub use basis::{final_basis, modal_rotation, Basis, BasisOptions, JimSet, DEFAULT_DROP_TOL};
-pub use build::{build_basis, BasisKind};
+pub use build::{build_basis, build_tvd_basis_both_pods, BasisKind};
 pub use competitors::{
     alldof_vectors, jim_dofs, jim_vectors, joint_interface_modes, snapshot_basis, snapshot_pod,
     JointInterfaceModes,
