@@ -52,26 +52,57 @@ impl Dot2 {
     }
 }
 
+/// Columns of one block of [`sym_mul_compensated`].
+const COMPENSATED_BLOCK: usize = 32;
+
 /// `out[:, c] = start[:, c] + s · A x[:, c]` for every column, each entry accumulated in
 /// double-double and rounded once (A symmetric sparse, both triangles stored).
 ///
 /// Row-oriented: column i of the symmetric A is its row i, so `out[i, :]` is one pass over
-/// column i with all right-hand sides at once. `s·x` is stored row-major and pre-split
-/// (Veltkamp), the accumulators are kept as separate `hi`/`lo` arrays over the columns, so the
-/// inner loop is the same straight-line TwoProduct + TwoSum on contiguous data for every column
-/// (vectorizable). The summation order per entry is the column order of A, as in [`Dot2`].
+/// column i with all right-hand sides of a block at once. `s·x` is stored row-major and
+/// pre-split (Veltkamp), the accumulators are kept as separate `hi`/`lo` arrays over the
+/// columns, so the inner loop is the same straight-line TwoProduct + TwoSum on contiguous data
+/// for every column (vectorizable). The summation order per entry is the column order of A, as
+/// in [`Dot2`].
+///
+/// The columns go in blocks of 32, in parallel (rayon): the split copies of a block take
+/// `2 · 8 · 32 n` bytes (54 MB at 10⁵ DOF) instead of two more n × w matrices, and every entry
+/// is computed by the same operations in the same order whatever the blocks or the threads, so
+/// the result is bit-identical to a single pass.
 pub(crate) fn sym_mul_compensated(
     a: &SymCsc,
     x: MatRef<'_, f64>,
     s: f64,
     start: Option<MatRef<'_, f64>>,
 ) -> Mat<f64> {
-    let n = a.n;
-    let w = x.ncols();
-    let mut out = Mat::<f64>::zeros(n, w);
-    if w == 0 {
+    use rayon::prelude::*;
+    let mut out = Mat::<f64>::zeros(a.n, x.ncols());
+    if x.ncols() == 0 {
         return out;
     }
+    out.as_mut()
+        .par_col_chunks_mut(COMPENSATED_BLOCK)
+        .enumerate()
+        .for_each(|(b, out_b)| {
+            let c0 = b * COMPENSATED_BLOCK;
+            let w = out_b.ncols();
+            let x_b = x.subcols(c0, w);
+            let start_b = start.map(|st| st.subcols(c0, w));
+            sym_mul_compensated_block(a, x_b, s, start_b, out_b);
+        });
+    out
+}
+
+/// One block of [`sym_mul_compensated`], written to `out` (n × x.ncols()).
+fn sym_mul_compensated_block(
+    a: &SymCsc,
+    x: MatRef<'_, f64>,
+    s: f64,
+    start: Option<MatRef<'_, f64>>,
+    mut out: faer::MatMut<'_, f64>,
+) {
+    let n = a.n;
+    let w = x.ncols();
     // Row-major s·x, split into halves.
     let mut xh = vec![0.0; n * w];
     let mut xl = vec![0.0; n * w];
@@ -107,7 +138,6 @@ pub(crate) fn sym_mul_compensated(
             out[(i, c)] = hi[c] + lo[c];
         }
     }
-    out
 }
 
 /// `hi[c] + lo[c] += a · (bh[c] + bl[c])` for every c: Dekker's TwoProduct (`a = ah + al` and
@@ -182,4 +212,55 @@ pub(crate) fn compensated_gram(a: &SymCsc, phi: faer::MatRef<'_, f64>) -> Mat<f6
         }
     }
     g
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The blocked, parallel product equals the entry-by-entry [`Dot2`] sums bit for bit, for
+    /// column counts below, at and across the block width (ragged last block).
+    #[test]
+    fn blocked_product_is_the_dot2_sum() {
+        // A 1-D Laplacian-like symmetric pattern with spread values, both triangles stored.
+        let n: usize = 50;
+        let (mut col_ptr, mut row_idx, mut values) = (vec![0], Vec::new(), Vec::new());
+        for j in 0..n {
+            for i in j.saturating_sub(2)..(j + 3).min(n) {
+                row_idx.push(i);
+                let (lo, hi) = (i.min(j) as f64, i.max(j) as f64);
+                values.push(if i == j {
+                    4.0 + 1e6 * lo
+                } else {
+                    -1.0 / (1.0 + lo * hi)
+                });
+            }
+            col_ptr.push(row_idx.len());
+        }
+        let a = SymCsc {
+            n,
+            col_ptr,
+            row_idx,
+            values,
+        };
+        for w in [1, 31, 32, 33, 70] {
+            let x = Mat::from_fn(n, w, |i, c| ((i * 7 + c * 13) as f64).sin() * 1e3);
+            let b = Mat::from_fn(n, w, |i, c| ((i + 3 * c) as f64).cos());
+            let s = -0.7;
+            let out = sym_mul_compensated(&a, x.as_ref(), s, Some(b.as_ref()));
+            for c in 0..w {
+                for i in 0..n {
+                    let mut acc = Dot2::new(b[(i, c)]);
+                    for p in a.col_ptr[i]..a.col_ptr[i + 1] {
+                        acc.add_product(a.values[p], s * x[(a.row_idx[p], c)]);
+                    }
+                    assert_eq!(
+                        out[(i, c)].to_bits(),
+                        acc.value().to_bits(),
+                        "w {w}, ({i}, {c})"
+                    );
+                }
+            }
+        }
+    }
 }
