@@ -7,7 +7,7 @@ use faer::Mat;
 use super::basis::{final_basis, modal_rotation, Basis, BasisOptions};
 use super::competitors::{alldof_vectors, jim_vectors};
 use super::craig_bampton::craig_bampton;
-use super::pod::pod_tvd;
+use super::pod::{pod_tvd, pod_tvd_ratios};
 use super::tvd::trial_vector_derivatives;
 use crate::error::Error;
 use crate::model::Model;
@@ -124,7 +124,7 @@ fn build(
         let tvd = trial_vector_derivatives(model, cb.as_ref(), &opts.tvd)?;
         let p = pod_tvd(model, &tvd, kind != BasisKind::TvdPlain)?;
         if other_pod {
-            other_w = Some(pod_tvd(model, &tvd, kind == BasisKind::TvdPlain)?.w);
+            other_w = Some(pod_tvd_ratios(model, &tvd, kind == BasisKind::TvdPlain)?);
         }
         // One rule for every command: a g beyond the POD's modes is an error, never clamped.
         let available = p.lambda.len();

@@ -64,7 +64,7 @@ pub use competitors::{
 };
 pub use craig_bampton::craig_bampton;
 pub use estimate::{CurveErrors, ErrorEstimator, Estimate, JointFlexibility, RunStates};
-pub use pod::{pod, pod_tvd, sigma_zero, Pod, DEFAULT_THRESHOLD, ZERO_EIGENVALUE};
+pub use pod::{pod, pod_tvd, pod_tvd_ratios, sigma_zero, Pod, DEFAULT_THRESHOLD, ZERO_EIGENVALUE};
 pub use tvd::{
     active_pairs, displacement_scales, trial_vector_derivatives, Tvd, TvdFactor, TvdIndex,
     TvdOptions,
