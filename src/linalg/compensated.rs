@@ -173,20 +173,37 @@ pub(crate) fn solve_refined(a: &SymCsc, chol: &SparseCholesky, b: &Mat<f64>) -> 
     solve_refined_steps(a, chol, b, REFINEMENT_STEPS)
 }
 
+/// Columns of one block of [`solve_refined_steps`].
+const SOLVE_BLOCK: usize = 32;
+
 /// [`solve_refined`] with `steps` refinement steps.
+///
+/// The columns go in blocks of 32, in parallel (rayon), each block solved and refined on its
+/// own: the residual of one block (n × 32) instead of an n × w residual, and the right-hand
+/// sides' solves spread over the cores (the 496 TVD solves of a 10⁵-DOF model). The blocks
+/// are fixed (not by thread count), so the result does not depend on the threads; and faer's
+/// supernodal solve gives a column the same bits in a block as alone (tested).
 pub(crate) fn solve_refined_steps(
     a: &SymCsc,
     chol: &SparseCholesky,
     b: &Mat<f64>,
     steps: usize,
 ) -> Mat<f64> {
+    use faer::reborrow::{Reborrow, ReborrowMut};
+    use rayon::prelude::*;
     let mut x = b.clone();
-    chol.solve_in_place(&mut x);
-    for _ in 0..steps {
-        let mut r = sym_mul_compensated(a, x.as_ref(), -1.0, Some(b.as_ref()));
-        chol.solve_in_place(&mut r);
-        x += &r;
-    }
+    x.as_mut()
+        .par_col_chunks_mut(SOLVE_BLOCK)
+        .enumerate()
+        .for_each(|(k, mut xb)| {
+            let bb = b.as_ref().subcols(k * SOLVE_BLOCK, xb.ncols());
+            chol.solve_in_place_mut(xb.rb_mut());
+            for _ in 0..steps {
+                let mut r = sym_mul_compensated(a, xb.rb(), -1.0, Some(bb));
+                chol.solve_in_place(&mut r);
+                xb += &r;
+            }
+        });
     x
 }
 
@@ -260,6 +277,31 @@ mod tests {
                         "w {w}, ({i}, {c})"
                     );
                 }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod solve_tests {
+    use super::*;
+    use crate::model::Model;
+
+    /// The blocked refined solve gives every column bit for bit as solving it alone does (the
+    /// friction bar's K, 70 columns: blocks of 32, 32 and 6): the blocks do not change the result.
+    #[test]
+    fn blocked_refined_solve_is_columnwise() {
+        let model = Model::from_case_name("friction_bar").unwrap();
+        let k = &model.stiffness;
+        let chol = SparseCholesky::new(k).unwrap();
+        let n = k.n;
+        let b = Mat::from_fn(n, 70, |i, c| ((i * 31 + c * 17) as f64).sin());
+        let x = solve_refined_steps(k, &chol, &b, 1);
+        for c in [0, 31, 32, 33, 69] {
+            let bc = Mat::from_fn(n, 1, |i, _| b[(i, c)]);
+            let xc = solve_refined_steps(k, &chol, &bc, 1);
+            for i in 0..n {
+                assert_eq!(x[(i, c)].to_bits(), xc[(i, 0)].to_bits(), "({i}, {c})");
             }
         }
     }
