@@ -45,4 +45,12 @@ for r in rows:
                  "%.2f" % (math.log(float(mb) / float(prev[6])) / k)]
     print(f"| x{f} | {n} | {w} | {si} | {mi} | {sb} | {mb} | {slope[0]} | {slope[1]} |")
     prev = r
+# The slope over the whole 10^4 .. 10^5 range: first row with >= 10 000 DOF to the last row.
+big = [r for r in rows if int(r[1]) >= 10000]
+if len(big) >= 2 and all("fail" not in r[5] for r in (big[0], big[-1])):
+    a, b = big[0], big[-1]
+    k = math.log(int(b[1]) / int(a[1]))
+    fmt = lambda i: "%.2f" % (math.log(float(b[i]) / float(a[i])) / k)
+    print(f"\nlog-log slope x{a[0]} -> x{b[0]} ({a[1]} -> {b[1]} DOF): info time {fmt(3)}, "
+          f"info memory {fmt(4)}, basis time {fmt(5)}, basis memory {fmt(6)}")
 '

@@ -242,6 +242,12 @@ impl SparseCholesky {
         }
     }
 
+    /// Whether faer chose the supernodal factor (tests: which solve path is exercised).
+    #[cfg(test)]
+    pub(crate) fn is_supernodal(&self) -> bool {
+        matches!(self.symbolic.raw(), SymbolicCholeskyRaw::Supernodal(_))
+    }
+
     /// Dimension.
     pub fn dim(&self) -> usize {
         self.n
