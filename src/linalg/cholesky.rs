@@ -165,6 +165,11 @@ impl SparseCholesky {
 
     /// Solves in place for all columns of `rhs` (NaN if the last factorization failed).
     pub fn solve_in_place(&self, rhs: &mut Mat<f64>) {
+        self.solve_in_place_mut(rhs.as_mut());
+    }
+
+    /// [`Self::solve_in_place`] on a matrix view (e.g. a block of columns).
+    pub fn solve_in_place_mut(&self, mut rhs: MatMut<'_, f64>) {
         if !self.factored {
             rhs.fill(f64::NAN);
             return;
@@ -175,7 +180,7 @@ impl SparseCholesky {
         );
         LltRef::new(&self.symbolic, &self.l_values).solve_in_place_with_conj(
             Conj::No,
-            rhs.as_mut(),
+            rhs,
             self.par,
             MemStack::new(&mut mem),
         );
@@ -235,6 +240,12 @@ impl SparseCholesky {
                 }
             }
         }
+    }
+
+    /// Whether faer chose the supernodal factor (tests: which solve path is exercised).
+    #[cfg(test)]
+    pub(crate) fn is_supernodal(&self) -> bool {
+        matches!(self.symbolic.raw(), SymbolicCholeskyRaw::Supernodal(_))
     }
 
     /// Dimension.

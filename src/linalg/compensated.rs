@@ -52,26 +52,57 @@ impl Dot2 {
     }
 }
 
+/// Columns of one block of [`sym_mul_compensated`].
+const COMPENSATED_BLOCK: usize = 32;
+
 /// `out[:, c] = start[:, c] + s · A x[:, c]` for every column, each entry accumulated in
 /// double-double and rounded once (A symmetric sparse, both triangles stored).
 ///
 /// Row-oriented: column i of the symmetric A is its row i, so `out[i, :]` is one pass over
-/// column i with all right-hand sides at once. `s·x` is stored row-major and pre-split
-/// (Veltkamp), the accumulators are kept as separate `hi`/`lo` arrays over the columns, so the
-/// inner loop is the same straight-line TwoProduct + TwoSum on contiguous data for every column
-/// (vectorizable). The summation order per entry is the column order of A, as in [`Dot2`].
+/// column i with all right-hand sides of a block at once. `s·x` is stored row-major and
+/// pre-split (Veltkamp), the accumulators are kept as separate `hi`/`lo` arrays over the
+/// columns, so the inner loop is the same straight-line TwoProduct + TwoSum on contiguous data
+/// for every column (vectorizable). The summation order per entry is the column order of A, as
+/// in [`Dot2`].
+///
+/// The columns go in blocks of 32, in parallel (rayon): the split copies of a block take
+/// `2 · 8 · 32 n` bytes (54 MB at 10⁵ DOF) instead of two more n × w matrices, and every entry
+/// is computed by the same operations in the same order whatever the blocks or the threads, so
+/// the result is bit-identical to a single pass.
 pub(crate) fn sym_mul_compensated(
     a: &SymCsc,
     x: MatRef<'_, f64>,
     s: f64,
     start: Option<MatRef<'_, f64>>,
 ) -> Mat<f64> {
-    let n = a.n;
-    let w = x.ncols();
-    let mut out = Mat::<f64>::zeros(n, w);
-    if w == 0 {
+    use rayon::prelude::*;
+    let mut out = Mat::<f64>::zeros(a.n, x.ncols());
+    if x.ncols() == 0 {
         return out;
     }
+    out.as_mut()
+        .par_col_chunks_mut(COMPENSATED_BLOCK)
+        .enumerate()
+        .for_each(|(b, out_b)| {
+            let c0 = b * COMPENSATED_BLOCK;
+            let w = out_b.ncols();
+            let x_b = x.subcols(c0, w);
+            let start_b = start.map(|st| st.subcols(c0, w));
+            sym_mul_compensated_block(a, x_b, s, start_b, out_b);
+        });
+    out
+}
+
+/// One block of [`sym_mul_compensated`], written to `out` (n × x.ncols()).
+fn sym_mul_compensated_block(
+    a: &SymCsc,
+    x: MatRef<'_, f64>,
+    s: f64,
+    start: Option<MatRef<'_, f64>>,
+    mut out: faer::MatMut<'_, f64>,
+) {
+    let n = a.n;
+    let w = x.ncols();
     // Row-major s·x, split into halves.
     let mut xh = vec![0.0; n * w];
     let mut xl = vec![0.0; n * w];
@@ -107,7 +138,6 @@ pub(crate) fn sym_mul_compensated(
             out[(i, c)] = hi[c] + lo[c];
         }
     }
-    out
 }
 
 /// `hi[c] + lo[c] += a · (bh[c] + bl[c])` for every c: Dekker's TwoProduct (`a = ah + al` and
@@ -143,20 +173,37 @@ pub(crate) fn solve_refined(a: &SymCsc, chol: &SparseCholesky, b: &Mat<f64>) -> 
     solve_refined_steps(a, chol, b, REFINEMENT_STEPS)
 }
 
+/// Columns of one block of [`solve_refined_steps`].
+const SOLVE_BLOCK: usize = 32;
+
 /// [`solve_refined`] with `steps` refinement steps.
+///
+/// The columns go in blocks of 32, in parallel (rayon), each block solved and refined on its
+/// own: the residual of one block (n × 32) instead of an n × w residual, and the right-hand
+/// sides' solves spread over the cores (the 496 TVD solves of a 10⁵-DOF model). The blocks
+/// are fixed (not by thread count), so the result does not depend on the threads; and faer's
+/// supernodal solve gives a column the same bits in a block as alone (tested).
 pub(crate) fn solve_refined_steps(
     a: &SymCsc,
     chol: &SparseCholesky,
     b: &Mat<f64>,
     steps: usize,
 ) -> Mat<f64> {
+    use faer::reborrow::{Reborrow, ReborrowMut};
+    use rayon::prelude::*;
     let mut x = b.clone();
-    chol.solve_in_place(&mut x);
-    for _ in 0..steps {
-        let mut r = sym_mul_compensated(a, x.as_ref(), -1.0, Some(b.as_ref()));
-        chol.solve_in_place(&mut r);
-        x += &r;
-    }
+    x.as_mut()
+        .par_col_chunks_mut(SOLVE_BLOCK)
+        .enumerate()
+        .for_each(|(k, mut xb)| {
+            let bb = b.as_ref().subcols(k * SOLVE_BLOCK, xb.ncols());
+            chol.solve_in_place_mut(xb.rb_mut());
+            for _ in 0..steps {
+                let mut r = sym_mul_compensated(a, xb.rb(), -1.0, Some(bb));
+                chol.solve_in_place(&mut r);
+                xb += &r;
+            }
+        });
     x
 }
 
@@ -182,4 +229,119 @@ pub(crate) fn compensated_gram(a: &SymCsc, phi: faer::MatRef<'_, f64>) -> Mat<f6
         }
     }
     g
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The blocked, parallel product equals the entry-by-entry [`Dot2`] sums bit for bit, for
+    /// column counts below, at and across the block width (ragged last block).
+    #[test]
+    fn blocked_product_is_the_dot2_sum() {
+        // A 1-D Laplacian-like symmetric pattern with spread values, both triangles stored.
+        let n: usize = 50;
+        let (mut col_ptr, mut row_idx, mut values) = (vec![0], Vec::new(), Vec::new());
+        for j in 0..n {
+            for i in j.saturating_sub(2)..(j + 3).min(n) {
+                row_idx.push(i);
+                let (lo, hi) = (i.min(j) as f64, i.max(j) as f64);
+                values.push(if i == j {
+                    4.0 + 1e6 * lo
+                } else {
+                    -1.0 / (1.0 + lo * hi)
+                });
+            }
+            col_ptr.push(row_idx.len());
+        }
+        let a = SymCsc {
+            n,
+            col_ptr,
+            row_idx,
+            values,
+        };
+        for w in [1, 31, 32, 33, 70] {
+            let x = Mat::from_fn(n, w, |i, c| ((i * 7 + c * 13) as f64).sin() * 1e3);
+            let b = Mat::from_fn(n, w, |i, c| ((i + 3 * c) as f64).cos());
+            let s = -0.7;
+            let out = sym_mul_compensated(&a, x.as_ref(), s, Some(b.as_ref()));
+            for c in 0..w {
+                for i in 0..n {
+                    let mut acc = Dot2::new(b[(i, c)]);
+                    for p in a.col_ptr[i]..a.col_ptr[i + 1] {
+                        acc.add_product(a.values[p], s * x[(a.row_idx[p], c)]);
+                    }
+                    assert_eq!(
+                        out[(i, c)].to_bits(),
+                        acc.value().to_bits(),
+                        "w {w}, ({i}, {c})"
+                    );
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod solve_tests {
+    use super::*;
+
+    /// An SPD stiffness-like matrix: 3 DOF per node on a g × g grid, every node coupled to its
+    /// 8 neighbours (a shell mesh's pattern), diagonally dominant with spread diagonal scales.
+    fn grid_matrix(g: usize) -> SymCsc {
+        let n = 3 * g * g;
+        let node = |i: usize| (i / 3 / g, i / 3 % g);
+        let (mut col_ptr, mut row_idx, mut values) = (vec![0], Vec::new(), Vec::new());
+        for j in 0..n {
+            let (jy, jx) = node(j);
+            let mut col: Vec<(usize, f64)> = Vec::new();
+            for iy in jy.saturating_sub(1)..(jy + 2).min(g) {
+                for ix in jx.saturating_sub(1)..(jx + 2).min(g) {
+                    for d in 0..3 {
+                        let i = 3 * (iy * g + ix) + d;
+                        if i != j {
+                            col.push((i, -1.0 / (1.0 + ((i + j) % 7) as f64)));
+                        }
+                    }
+                }
+            }
+            let off: f64 = col.iter().map(|(_, v)| v.abs()).sum();
+            col.push((j, off * (1.0 + 1e-3) + 1e3 * (j % 5) as f64));
+            col.sort_by_key(|e| e.0);
+            for (i, v) in col {
+                row_idx.push(i);
+                values.push(v);
+            }
+            col_ptr.push(row_idx.len());
+        }
+        SymCsc {
+            n,
+            col_ptr,
+            row_idx,
+            values,
+        }
+    }
+
+    /// The blocked refined solve gives every column bit for bit as solving it alone does (a
+    /// 4 800-DOF supernodal factor, 70 columns: blocks of 32, 32 and 6): the blocks do not
+    /// change the result.
+    #[test]
+    fn blocked_refined_solve_is_columnwise() {
+        let k = grid_matrix(40);
+        let chol = SparseCholesky::new(&k).unwrap();
+        assert!(
+            chol.is_supernodal(),
+            "the 10⁵-DOF models' factor is supernodal"
+        );
+        let n = k.n;
+        let b = Mat::from_fn(n, 70, |i, c| ((i * 31 + c * 17) as f64).sin());
+        let x = solve_refined_steps(&k, &chol, &b, 1);
+        for c in [0, 31, 32, 33, 69] {
+            let bc = Mat::from_fn(n, 1, |i, _| b[(i, c)]);
+            let xc = solve_refined_steps(&k, &chol, &bc, 1);
+            for i in 0..n {
+                assert_eq!(x[(i, c)].to_bits(), xc[(i, 0)].to_bits(), "({i}, {c})");
+            }
+        }
+    }
 }

@@ -139,13 +139,28 @@ pub(crate) fn sym_mul_vec_into(a: &SymCsc, x: &[f64], y: &mut [f64]) {
 const BLOCK: usize = 16;
 
 /// `A Y` for a [`SymCsc`] A (n × n, both triangles stored) and a dense Y (n × p), in blocks of
-/// 32 columns: each block is copied row-major, so every stored entry of A multiplies 32
-/// contiguous values (four cache lines, independent accumulators) — `nnz(A) · p` multiply-adds,
-/// A read `p / 32` times.
+/// 16 columns: each block is copied row-major, so every stored entry of A multiplies 16
+/// contiguous values (two cache lines, independent accumulators) — `nnz(A) · p` multiply-adds,
+/// A read `p / 16` times.
+///
+/// One column (the Krylov–Schur operator's apply) goes without the block: the same
+/// multiply-adds in the same order from 0.0 as a block lane (bit-identical), without copying the
+/// column to an n × 16 row-major block and computing 15 zero lanes.
 pub(crate) fn sym_mul_mat(a: &SymCsc, y: MatRef<'_, f64>) -> Mat<f64> {
     let n = a.n;
     let p = y.ncols();
     let mut out = Mat::<f64>::zeros(n, p);
+    if p == 1 {
+        let x = y.col(0);
+        for (j, o) in out.col_mut(0).iter_mut().enumerate() {
+            let mut acc = 0.0f64;
+            for p in a.col_ptr[j]..a.col_ptr[j + 1] {
+                acc += a.values[p] * x[a.row_idx[p]];
+            }
+            *o = acc;
+        }
+        return out;
+    }
     let mut block = vec![[0.0f64; BLOCK]; n];
     for c0 in (0..p).step_by(BLOCK) {
         let bw = BLOCK.min(p - c0);

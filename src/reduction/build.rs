@@ -7,7 +7,7 @@ use faer::Mat;
 use super::basis::{final_basis, modal_rotation, Basis, BasisOptions};
 use super::competitors::{alldof_vectors, jim_vectors};
 use super::craig_bampton::craig_bampton;
-use super::pod::pod_tvd;
+use super::pod::{pod_tvd, pod_tvd_ratios};
 use super::tvd::trial_vector_derivatives;
 use crate::error::Error;
 use crate::model::Model;
@@ -84,15 +84,48 @@ impl BasisKind {
 /// choose g exactly as `Tvd` would (the smallest g with `w(g) ≥ opts.threshold`), so the
 /// competitors are compared at the same number of added vectors; `Basis::w` is then that POD's.
 pub fn build_basis(model: &Model, kind: BasisKind, opts: &BasisOptions) -> Result<Basis, Error> {
+    Ok(build(model, kind, opts, false)?.0)
+}
+
+/// [`build_basis`] of a TVD kind (`Tvd` or `TvdPlain`) together with the energy ratios w(g) of
+/// the other POD of the same TVD (plain for `Tvd`, K-weighted for `TvdPlain`): one
+/// Craig–Bampton and one TVD for both curves (what `jointrom basis` prints). Errors for the
+/// other kinds.
+pub fn build_tvd_basis_both_pods(
+    model: &Model,
+    kind: BasisKind,
+    opts: &BasisOptions,
+) -> Result<(Basis, Vec<f64>), Error> {
+    if !matches!(kind, BasisKind::Tvd | BasisKind::TvdPlain) {
+        return Err(Error::Invalid(format!(
+            "basis `{}` has no TVD POD: expected tvd or tvd-plain",
+            kind.name()
+        )));
+    }
+    let (basis, other) = build(model, kind, opts, true)?;
+    Ok((basis, other.unwrap_or_default()))
+}
+
+/// [`build_basis`], and with `other_pod` the other POD's w(g) of the TVD (when computed).
+fn build(
+    model: &Model,
+    kind: BasisKind,
+    opts: &BasisOptions,
+    other_pod: bool,
+) -> Result<(Basis, Option<Vec<f64>>), Error> {
     let need_tvd = match kind {
         BasisKind::Tvd | BasisKind::TvdPlain => true,
         BasisKind::Modes | BasisKind::Jim => opts.g.is_none(),
         BasisKind::AllDof => false,
     };
     let cb = craig_bampton(model, opts.nu)?;
+    let mut other_w = None;
     let (w, g, tvd_total, tvd_nonzero, joint_modes) = if need_tvd {
         let tvd = trial_vector_derivatives(model, cb.as_ref(), &opts.tvd)?;
         let p = pod_tvd(model, &tvd, kind != BasisKind::TvdPlain)?;
+        if other_pod {
+            other_w = Some(pod_tvd_ratios(model, &tvd, kind == BasisKind::TvdPlain)?);
+        }
         // One rule for every command: a g beyond the POD's modes is an error, never clamped.
         let available = p.lambda.len();
         let g = match opts.g {
@@ -148,7 +181,7 @@ pub fn build_basis(model: &Model, kind: BasisKind, opts: &BasisOptions) -> Resul
     } else {
         (phi, Vec::new())
     };
-    Ok(Basis {
+    let basis = Basis {
         phi,
         w,
         g,
@@ -156,5 +189,6 @@ pub fn build_basis(model: &Model, kind: BasisKind, opts: &BasisOptions) -> Resul
         tvd_nonzero,
         dropped,
         eigenvalues,
-    })
+    };
+    Ok((basis, other_w))
 }

@@ -57,14 +57,14 @@ pub mod rom_file;
 pub mod tvd;
 
 pub use basis::{final_basis, modal_rotation, Basis, BasisOptions, JimSet, DEFAULT_DROP_TOL};
-pub use build::{build_basis, BasisKind};
+pub use build::{build_basis, build_tvd_basis_both_pods, BasisKind};
 pub use competitors::{
     alldof_vectors, jim_dofs, jim_vectors, joint_interface_modes, snapshot_basis, snapshot_pod,
     JointInterfaceModes,
 };
 pub use craig_bampton::craig_bampton;
 pub use estimate::{CurveErrors, ErrorEstimator, Estimate, JointFlexibility, RunStates};
-pub use pod::{pod, pod_tvd, sigma_zero, Pod, DEFAULT_THRESHOLD, ZERO_EIGENVALUE};
+pub use pod::{pod, pod_tvd, pod_tvd_ratios, sigma_zero, Pod, DEFAULT_THRESHOLD, ZERO_EIGENVALUE};
 pub use tvd::{
     active_pairs, displacement_scales, trial_vector_derivatives, Tvd, TvdFactor, TvdIndex,
     TvdOptions,

@@ -295,6 +295,18 @@ pub fn sigma_zero(m: usize, p: usize) -> f64 {
 /// Without a factor form (the eq. (15) inertia variant, [`TvdOptions::inertia`]) this falls back
 /// to [`pod`] on `tvd.vectors` (weight `model.stiffness` when `weighted`).
 pub fn pod_tvd(model: &Model, tvd: &Tvd, weighted: bool) -> Result<Pod, Error> {
+    pod_tvd_with(model, tvd, weighted, true)
+}
+
+/// The energy ratios w(g) of [`pod_tvd`] alone (the same numbers), without forming the POMs:
+/// for the plain POD this skips the orthonormal factor Q of `Z = Q R_Z` and its product with
+/// the singular vectors (two n × p × p products; `jointrom basis` prints both PODs' curves).
+pub fn pod_tvd_ratios(model: &Model, tvd: &Tvd, weighted: bool) -> Result<Vec<f64>, Error> {
+    Ok(pod_tvd_with(model, tvd, weighted, false)?.w)
+}
+
+/// [`pod_tvd`]; with `want_poms` false the returned POMs are empty (n × 0).
+fn pod_tvd_with(model: &Model, tvd: &Tvd, weighted: bool, want_poms: bool) -> Result<Pod, Error> {
     let weight = weighted.then_some(&model.stiffness);
     let Some(f) = &tvd.factor else {
         return pod(tvd.vectors.as_ref(), weight);
@@ -331,12 +343,16 @@ pub fn pod_tvd(model: &Model, tvd: &Tvd, weighted: bool) -> Result<Pod, Error> {
         let v = evd.U();
         let vt_c = v.transpose() * &f.coefficients;
         let a = Mat::from_fn(m, p, |r, c| d[r].max(0.0).sqrt() * vt_c[(r, c)]);
-        (a, None)
+        (a, PomMap::Flexibility)
     } else {
         let qr = f.flexibility.qr();
-        let q = qr.compute_thin_Q();
+        let q = if want_poms {
+            PomMap::Orthonormal(qr.compute_thin_Q())
+        } else {
+            PomMap::Skip
+        };
         let r = qr.thin_R().to_owned();
-        (&r * &f.coefficients, Some(q))
+        (&r * &f.coefficients, q)
     };
     let svd = a.thin_svd().map_err(|e| {
         Error::LinearAlgebra(format!("POD: SVD of the TVD coefficients: {e:?}").into())
@@ -356,15 +372,17 @@ pub fn pod_tvd(model: &Model, tvd: &Tvd, weighted: bool) -> Result<Pod, Error> {
     let dropped = p - kept.len();
     let lambda: Vec<f64> = kept.iter().map(|&i| s[i] * s[i]).collect();
     let mut poms = match q {
+        PomMap::Skip => Mat::zeros(n, 0),
+        PomMap::Flexibility if !want_poms => Mat::zeros(n, 0),
         // u_i = Z (C w_i) / σ_i.
-        None => {
+        PomMap::Flexibility => {
             let w = svd.V();
             let cw = Mat::from_fn(p, kept.len(), |r, c| w[(r, kept[c])] / s[kept[c]]);
             let ccw = &f.coefficients * &cw;
             &f.flexibility * &ccw
         }
         // u_i = Q u_i.
-        Some(q) => {
+        PomMap::Orthonormal(q) => {
             let u = svd.U();
             let uk = Mat::from_fn(m, kept.len(), |r, c| u[(r, kept[c])]);
             &q * &uk
@@ -372,6 +390,16 @@ pub fn pod_tvd(model: &Model, tvd: &Tvd, weighted: bool) -> Result<Pod, Error> {
     };
     fix_signs(&mut poms);
     Ok(finish(lambda, poms, dropped, p, weighted))
+}
+
+/// How [`pod_tvd`] maps the SVD of its small matrix to the POMs.
+enum PomMap {
+    /// K-weighted: `u_i = Z (C w_i) / σ_i` with the right singular vectors.
+    Flexibility,
+    /// Plain: `u_i = Q u_i` with the left singular vectors, Q of `Z = Q R_Z`.
+    Orthonormal(Mat<f64>),
+    /// No POMs wanted ([`pod_tvd_ratios`]).
+    Skip,
 }
 
 fn fix_signs(poms: &mut Mat<f64>) {
@@ -417,6 +445,33 @@ mod tests {
     use super::*;
     use crate::model::Model;
     use crate::reduction::{craig_bampton, trial_vector_derivatives, TvdOptions};
+
+    /// [`pod_tvd_ratios`] gives the energy ratios of [`pod_tvd`] bit for bit, uncompressed
+    /// (ν = 10) and compressed (multilayer, Φ_S alone: fewer TVD than pairs).
+    #[test]
+    fn ratios_alone_equal_the_full_pod() {
+        for (name, nu) in [
+            ("friction_bar", 10),
+            ("multilayer_sheet", 10),
+            ("multilayer_sheet", 0),
+        ] {
+            let model = Model::from_case_name(name).unwrap();
+            let cb = craig_bampton(&model, nu).unwrap();
+            let tvd =
+                trial_vector_derivatives(&model, cb.as_ref(), &TvdOptions::default()).unwrap();
+            for weighted in [true, false] {
+                let full = pod_tvd(&model, &tvd, weighted).unwrap();
+                let ratios = pod_tvd_ratios(&model, &tvd, weighted).unwrap();
+                assert_eq!(full.poms.ncols(), full.lambda.len());
+                let bits = |w: &[f64]| w.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+                assert_eq!(
+                    bits(&full.w),
+                    bits(&ratios),
+                    "{name} ν = {nu}, weighted {weighted}"
+                );
+            }
+        }
+    }
 
     /// The low-rank route agrees with the dense eigensolver of `Yᵀ A Y` on the built-in TVD:
     /// eigenvalues above 1e-6 λ_max to 1e-6 relative, w(g) to 1e-9, the POMs of λ > 1e-4 λ_max to

@@ -44,13 +44,24 @@
 //! with K.
 //!
 //! # Factor form
-//! The static TVD are kept as `Y = Z C` ([`Tvd::factor`], [`TvdFactor`]): Z refined twice with
-//! double-double residuals (so `B_u Z = Zᵀ K Z` to working precision), `G = B_u Z`, C the
+//! The static TVD are kept as `Y = Z C` ([`Tvd::factor`], [`TvdFactor`]): Z solved and refined
+//! once with a double-double residual (so `B_u Z = Zᵀ K Z` to working precision), `G = B_u Z`, C the
 //! K-normalized coefficients. [`super::pod_tvd`] computes the K-weighted POD as the SVD of
 //! `D^½ Vᵀ C` (`G = V D Vᵀ`) instead of the eigenproblem of `Yᵀ K Y`, which squares the
 //! condition number: the directions carrying the last per cent of the contact force have POD
 //! eigenvalues below the Gram route's round-off (measured in `docs/measurements.md`, section
 //! `reduction::tvd`).
+//!
+//! # Compressed flexibility (many pairs)
+//! Z has one column per joint row: n × m, dense. A refined 10⁵-DOF friction bar has m ≈ 6 000
+//! pairs, so Z alone would be 5 GB and m solves, while the p ≤ 2(v+s)² = 512 TVD only need the
+//! range of C. When `p < m`, C is factored first, `C = Q R` (thin QR, Q m × p orthonormal,
+//! R p × p), and the factor form is kept on that range:
+//! `Y = Z C = (K⁻¹ B_uᵀ Q) R = Z_Q R`, `Yᵀ K Y = Rᵀ (Qᵀ G Q) R = Rᵀ G_Q R` with
+//! `G_Q = Qᵀ B_u Z_Q` (p × p). The same algebra with `Z → Z_Q`, `G → G_Q`, `C → R`: p refined
+//! solves instead of m, memory n·p instead of n·m, and [`super::pod_tvd`] unchanged (its "m" is
+//! then p). `B_uᵀ Q` is formed from the sparse rows of B. With `p ≥ m` (the built-in scenes:
+//! 54 and 86 pairs) nothing is compressed and the arithmetic is the one above.
 
 use faer::linalg::solvers::Solve;
 use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
@@ -152,13 +163,16 @@ pub struct Tvd {
 #[derive(Clone, Debug)]
 pub struct TvdFactor {
     /// The joint flexibility columns `Z = K⁻¹ B_uᵀ` (n × m, mm/N), m the joint rows that receive
-    /// stiffness (one per pair, or three with [`TvdOptions::tangential`]); solved with two
-    /// double-double residual refinements.
+    /// stiffness (one per pair, or three with [`TvdOptions::tangential`]); or, with fewer TVD p
+    /// than joint rows, the compressed `Z_Q = K⁻¹ B_uᵀ Q` (n × p, module docs, "Compressed
+    /// flexibility"); solved with one double-double residual refinement.
     pub flexibility: Mat<f64>,
-    /// `G = B_u Z = B_u K⁻¹ B_uᵀ` (m × m, mm/N), symmetrized: `Zᵀ K Z` to the solve's residual.
+    /// `G = B_u Z = B_u K⁻¹ B_uᵀ` (m × m, mm/N), or `G_Q = Qᵀ B_u Z_Q` (p × p) when compressed;
+    /// symmetrized: `Zᵀ K Z` to the solve's residual.
     pub joint_flexibility: Mat<f64>,
     /// The K-normalized pseudoforce coefficients C (m × p, N per unit of the base over the
-    /// column's K-norm): `vectors = Z C`, `cᵀ G c = 1` per column.
+    /// column's K-norm), or R of `C = Q R` (p × p) when compressed: `vectors = Z C`,
+    /// `cᵀ G c = 1` per column.
     pub coefficients: Mat<f64>,
 }
 
@@ -411,7 +425,8 @@ impl<'a> TvdRun<'a> {
 
     /// The static columns `static_cols` (eqs. 16/18) through one Cholesky of K: their
     /// K-normalized vectors `Z C` (n × static_cols.len()) and the factor form Z, G, C; the
-    /// K-norms go to `k_norms`.
+    /// K-norms go to `k_norms`. With fewer columns p than joint rows m, the flexibility is
+    /// solved on the range of C only (module docs, "Compressed flexibility").
     fn static_columns(
         &self,
         cand: &Candidates,
@@ -420,12 +435,24 @@ impl<'a> TvdRun<'a> {
     ) -> Result<(Mat<f64>, TvdFactor), Error> {
         let (model, used) = (self.model, &self.used);
         let m = used.len();
-        let chol = SparseCholesky::new(&model.stiffness)?;
-        let bt = joint_rows_transposed(&model.joint, used, model.dofs());
-        let z = solve_refined_steps(&model.stiffness, &chol, &bt, 1);
-        let g = symmetric(&rows_times(&model.joint, used, z.as_ref()));
         let pc = Mat::from_fn(m, static_cols.len(), |r, c| cand.col(static_cols[c], m)[r]);
-        let scaled = normalize(&g, pc, static_cols, &cand.index, k_norms)?;
+        // C = Q R (thin QR, Q m × p orthonormal) when that makes fewer right-hand sides.
+        let (q, coef) = if pc.ncols() < m {
+            let qr = pc.qr();
+            (Some(qr.compute_thin_Q()), qr.thin_R().to_owned())
+        } else {
+            (None, pc)
+        };
+        let chol = SparseCholesky::new(&model.stiffness)?;
+        let bt = joint_rows_transposed(&model.joint, used, q.as_ref(), model.dofs());
+        let z = solve_refined_steps(&model.stiffness, &chol, &bt, 1);
+        drop(bt);
+        let bz = rows_times(&model.joint, used, z.as_ref());
+        let g = symmetric(&match &q {
+            Some(q) => q.transpose() * &bz,
+            None => bz,
+        });
+        let scaled = normalize(&g, coef, static_cols, &cand.index, k_norms)?;
         let xs = &z * &scaled;
         let factor = TvdFactor {
             flexibility: z,
@@ -529,12 +556,35 @@ fn mode_eigenvalues(model: &Model, base: MatRef<'_, f64>) -> Result<Vec<f64>, Er
         .collect()
 }
 
-/// `B_uᵀ`: n × m, column a the joint row `used[a]`.
-fn joint_rows_transposed(joint: &JointOperator, used: &[usize], n: usize) -> Mat<f64> {
-    let mut out = Mat::<f64>::zeros(n, used.len());
-    for (a, &r) in used.iter().enumerate() {
-        for (c, v) in joint.row(r) {
-            out[(c, a)] += v;
+/// `B_uᵀ Q` (n × Q.ncols()) for a dense Q (m × r), or `B_uᵀ` (n × m, column a the joint row
+/// `used[a]`) without Q; formed row by row from the sparse joint operator.
+fn joint_rows_transposed(
+    joint: &JointOperator,
+    used: &[usize],
+    q: Option<&Mat<f64>>,
+    n: usize,
+) -> Mat<f64> {
+    let Some(q) = q else {
+        let mut out = Mat::<f64>::zeros(n, used.len());
+        for (a, &r) in used.iter().enumerate() {
+            for (c, v) in joint.row(r) {
+                out[(c, a)] += v;
+            }
+        }
+        return out;
+    };
+    let mut out = Mat::<f64>::zeros(n, q.ncols());
+    for b in 0..q.ncols() {
+        let col = out
+            .col_mut(b)
+            .try_as_col_major_mut()
+            .expect("Mat columns are contiguous");
+        let col = col.as_slice_mut();
+        for (a, &r) in used.iter().enumerate() {
+            let s = q[(a, b)];
+            for (c, v) in joint.row(r) {
+                col[c] += v * s;
+            }
         }
     }
     out
@@ -746,9 +796,51 @@ mod tests {
         let base = craig_bampton(&model, 10).unwrap();
         let tvd = trial_vector_derivatives(&model, base.as_ref(), &TvdOptions::default()).unwrap();
         assert!(tvd.omega2.iter().all(|&o| o == 0.0));
+        // More TVD (496) than pairs (54): the uncompressed factor form.
+        let f = tvd.factor.as_ref().unwrap();
+        assert_eq!(f.flexibility.ncols(), model.joint.pairs());
+        check_static_columns(&model, base.as_ref(), &tvd, &[0, 17, 100, 255, 400]);
+    }
+
+    /// Fewer TVD than pairs (multilayer sheet, 86 pairs, base Φ_S alone: ≤ 72 TVD): the
+    /// compressed factor form `Z_Q = K⁻¹ B_uᵀ Q` (module docs) gives the TVD of eq. (16) and the
+    /// K-weighted POD of the vectors themselves.
+    #[test]
+    fn compressed_factor_solves_eq16() {
+        let model = Model::from_case_name("multilayer_sheet").unwrap();
+        let base = craig_bampton(&model, 0).unwrap();
+        let tvd = trial_vector_derivatives(&model, base.as_ref(), &TvdOptions::default()).unwrap();
+        let p = tvd.nonzero();
+        let f = tvd.factor.as_ref().unwrap();
+        assert!(
+            p < model.joint.pairs(),
+            "{p} TVD, {} pairs",
+            model.joint.pairs()
+        );
+        assert_eq!(f.flexibility.shape(), (model.dofs(), p));
+        assert_eq!(f.coefficients.shape(), (p, p));
+        check_static_columns(&model, base.as_ref(), &tvd, &[0, p / 3, p / 2]);
+        let fast = crate::reduction::pod_tvd(&model, &tvd, true).unwrap();
+        let gram = pod(tvd.vectors.as_ref(), Some(&model.stiffness)).unwrap();
+        let lmax = gram.lambda[0];
+        for (i, l) in gram
+            .lambda
+            .iter()
+            .enumerate()
+            .filter(|(_, l)| **l > 1e-6 * lmax)
+        {
+            let rel = (fast.lambda[i] - l).abs() / l;
+            assert!(rel < 1e-6, "λ_{i}: {} vs {l}", fast.lambda[i]);
+        }
+        assert!(fast.choose_g(0.999) == gram.choose_g(0.999));
+    }
+
+    /// Columns `cols` (and the last) of a static TVD solve `K φ = f` with the independently
+    /// formed pseudoforce (a direct sparse solve) and have `φᵀKφ = 1`.
+    fn check_static_columns(model: &Model, base: MatRef<'_, f64>, tvd: &Tvd, cols: &[usize]) {
         let chol = SparseCholesky::new(&model.stiffness).unwrap();
-        for c in [0, 17, 100, 255, 400, tvd.nonzero() - 1] {
-            let f = pseudoforce(&model, base.as_ref(), &tvd, c);
+        for &c in cols.iter().chain([tvd.nonzero() - 1].iter()) {
+            let f = pseudoforce(model, base, tvd, c);
             let mut x = Mat::from_fn(f.len(), 1, |r, _| f[r]);
             chol.solve_in_place(&mut x);
             let x = col(x.as_ref(), 0);
