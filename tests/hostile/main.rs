@@ -148,3 +148,22 @@ fn concurrent_runs_into_one_folder_leave_whole_files() {
         );
     }
 }
+
+/// A reader that closes the pipe early (`jointrom info X | head -0`) ends jointrom quietly with
+/// SIGPIPE's status 141, not with a panic.
+#[test]
+fn a_closed_stdout_is_not_a_panic() {
+    use std::process::{Command, Stdio};
+    let case = common::repo_path("cases/scale/friction_bar_x4.json");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_jointrom"))
+        .args(["info", case.to_str().unwrap()])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take());
+    let out = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    assert_eq!(out.status.code(), Some(141), "{stderr}");
+}

@@ -12,6 +12,7 @@ use clap::Parser;
 use cli::Cli;
 
 fn main() -> ExitCode {
+    quiet_broken_pipe();
     // Bit-identical results for any number of threads: faer's parallel kernels split their
     // sums by the thread count, so the dense linear algebra runs sequentially (the offline
     // stage of the built-in scenes takes well under a second either way); parallel work is
@@ -45,6 +46,25 @@ fn main() -> ExitCode {
             fail(&e)
         }
     }
+}
+
+/// A closed standard output (`jointrom info X | head -0`) ends the process quietly with status
+/// 141, as SIGPIPE would end a C program, instead of a panic in `println!` (Rust ignores
+/// SIGPIPE, so the write fails with EPIPE and `println!` panics on it).
+fn quiet_broken_pipe() {
+    let default = std::panic::take_hook();
+    std::panic::set_hook(Box::new(move |info| {
+        let payload = info.payload();
+        let text = payload
+            .downcast_ref::<String>()
+            .map(String::as_str)
+            .or_else(|| payload.downcast_ref::<&str>().copied())
+            .unwrap_or("");
+        if text.starts_with("failed printing to stdout") && text.contains("Broken pipe") {
+            std::process::exit(141);
+        }
+        default(info);
+    }));
 }
 
 fn fail(e: &jointrom::Error) -> ExitCode {
