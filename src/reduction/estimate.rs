@@ -87,28 +87,35 @@
 //! ([`Estimate::pair_error`]); `crate::studies::tolerance` enriches the basis with them (and ν)
 //! until the estimate meets a tolerance, and adds the integration error of the run.
 
+use std::sync::{Arc, Mutex};
+
 use faer::linalg::solvers::{Llt, Solve};
 use faer::{Mat, MatRef, Side};
 
 use crate::error::Error;
 use crate::joint::law::PairLaw;
+use crate::joint::JointOperator;
 use crate::joint::{NORMAL, T1, T2};
 use crate::linalg::cholesky::SparseCholesky;
 use crate::linalg::compensated::{compensated_gram, solve_refined};
 use crate::linalg::sparse::sym_mul_mat;
 use crate::linalg::LinalgError;
+use crate::linalg::SymCsc;
 use crate::model::{Interface, Model};
 use crate::reduction::final_basis;
 use crate::system::{ReducedSystem, SecondOrderSystem};
 
-/// The joint flexibility of a model: the static responses to unit pair forces and unit master
-/// loads, from one sparse Cholesky of `K` (module docs).
-#[derive(Clone, Debug)]
+/// The joint flexibility of a model: one sparse Cholesky of `K`, the static responses to unit
+/// master loads, and the columns of the pair flexibility `F` that the contact problems touch,
+/// solved on first use (module docs, "Cost").
 pub struct JointFlexibility {
-    /// `Z = K⁻¹ [Bᵀ E_m]` (n × (3w + 6)): mm (rad) per N (N·mm).
-    z: Mat<f64>,
-    /// `F = B K⁻¹ Bᵀ` (3w × 3w, symmetric), mm/N.
-    flex: Mat<f64>,
+    /// `K` (for the refined solves) and its factorization.
+    stiffness: SymCsc,
+    chol: SparseCholesky,
+    /// The joint operator B (3w × n).
+    joint: JointOperator,
+    /// The six master DOF.
+    master: [usize; 6],
     /// `H = B K⁻¹ E_m` (3w × 6), mm per N (N·mm).
     h: Mat<f64>,
     /// `C = E_mᵀ K⁻¹ E_m` (6 × 6, symmetric).
@@ -118,43 +125,39 @@ pub struct JointFlexibility {
     /// The lowest [`TRUNCATION_MODES`] fixed-interface modes (n × count, M-orthonormal, zero at
     /// the master), for the truncation part of the estimate.
     modes: Mat<f64>,
+    /// Per pair k, once solved: the normal rows of the flexibility column `F_{n,k} = B_n K⁻¹
+    /// b_kᵀ` (w values, mm/N; `b_k` the normal row of pair k). Shared by every estimate of the
+    /// model (sweeps run in parallel), so behind a lock.
+    columns: Mutex<Vec<Option<Arc<[f64]>>>>,
 }
 
 /// Fixed-interface modes computed for the truncation part of the estimate (module docs): the
 /// modes of these beyond a basis's span are the ones whose dynamics it checks.
 pub const TRUNCATION_MODES: usize = 40;
 
+/// Right-hand sides per blocked solve of the flexibility (bounds the n × block scratch).
+const SOLVE_CHUNK: usize = 256;
+
 impl JointFlexibility {
-    /// Factors the model's `K` once and solves for all `3w + 6` unit loads (refined twice with
-    /// double-double residuals, as the other static vectors of [`crate::reduction`]).
+    /// Factors the model's `K` once and solves for the six unit master loads (refined twice
+    /// with double-double residuals, as the other static vectors of [`crate::reduction`]);
+    /// pair columns follow on demand.
     pub fn new(model: &Model) -> Result<JointFlexibility, Error> {
         let n = model.dofs();
-        let rows = model.joint.rows();
         let master = model.master_dofs();
-        let mut rhs = Mat::<f64>::zeros(n, rows + 6);
-        for r in 0..rows {
-            for (c, v) in model.joint.row(r) {
-                rhs[(c, r)] += v;
-            }
-        }
+        let mut rhs = Mat::<f64>::zeros(n, 6);
         for (d, &m) in master.iter().enumerate() {
-            rhs[(m, rows + d)] = 1.0;
+            rhs[(m, d)] = 1.0;
         }
         let chol = SparseCholesky::new(&model.stiffness)?;
         let z = solve_refined(&model.stiffness, &chol, &rhs);
         if z.col_iter().any(|c| c.iter().any(|v| !v.is_finite())) {
             return Err(Error::LinearAlgebra(
-                "joint flexibility K⁻¹ Bᵀ is not finite".into(),
+                "joint flexibility K⁻¹ E_m is not finite".into(),
             ));
         }
-        let bz = Mat::from_fn(rows, rows + 6, |r, c| {
-            model.joint.row(r).map(|(i, v)| v * z[(i, c)]).sum::<f64>()
-        });
-        let flex = Mat::from_fn(rows, rows, |a, b| 0.5 * (bz[(a, b)] + bz[(b, a)]));
-        let h = bz.subcols(rows, 6).to_owned();
-        let c = Mat::from_fn(6, 6, |a, b| {
-            0.5 * (z[(master[a], rows + b)] + z[(master[b], rows + a)])
-        });
+        let h = model.joint.reduce(z.as_ref());
+        let c = Mat::from_fn(6, 6, |a, b| 0.5 * (z[(master[a], b)] + z[(master[b], a)]));
         let count = TRUNCATION_MODES.min(n.saturating_sub(6) / 2);
         let modes = if count > 0 {
             let fixed = model.modes(count, Interface::Fixed)?;
@@ -170,26 +173,147 @@ impl JointFlexibility {
             Mat::zeros(n, 0)
         };
         Ok(JointFlexibility {
-            z,
-            flex,
+            stiffness: model.stiffness.clone(),
+            chol,
+            joint: model.joint.clone(),
+            master,
             h,
             c,
             k_n: model.contact.normal_stiffness,
             modes,
+            columns: Mutex::new(vec![None; model.joint.pairs()]),
         })
     }
 
     /// Number of joint pairs w.
     pub fn pairs(&self) -> usize {
-        self.flex.nrows() / 3
+        self.joint.pairs()
+    }
+
+    /// Number of pairs whose flexibility column has been solved so far (the estimate's memory
+    /// beyond the factorization is this × w × 8 bytes).
+    pub fn solved_columns(&self) -> usize {
+        self.lock_columns().iter().filter(|c| c.is_some()).count()
+    }
+
+    fn lock_columns(&self) -> std::sync::MutexGuard<'_, Vec<Option<Arc<[f64]>>>> {
+        // A panic elsewhere cannot leave a half-written column: entries are replaced whole.
+        self.columns
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner)
+    }
+
+    /// `K⁻¹ R` (refined) for right-hand sides `R` (n × m), in chunks of [`SOLVE_CHUNK`] columns,
+    /// each chunk handed to `each(first column, K⁻¹ R_chunk)`.
+    fn solve_chunks(
+        &self,
+        cols: usize,
+        mut fill: impl FnMut(usize, &mut Mat<f64>),
+        mut each: impl FnMut(usize, &Mat<f64>),
+    ) {
+        let n = self.stiffness.n;
+        for first in (0..cols).step_by(SOLVE_CHUNK) {
+            let m = SOLVE_CHUNK.min(cols - first);
+            let mut rhs = Mat::<f64>::zeros(n, m);
+            fill(first, &mut rhs);
+            let x = solve_refined(&self.stiffness, &self.chol, &rhs);
+            each(first, &x);
+        }
+    }
+
+    /// The flexibility columns `F_{n,k}` of `pairs` (each w values), solving the missing ones
+    /// in one blocked multi-right-hand-side solve.
+    fn normal_columns(&self, pairs: &[usize]) -> Result<Vec<Arc<[f64]>>, Error> {
+        let missing: Vec<usize> = {
+            let cols = self.lock_columns();
+            let mut m: Vec<usize> = pairs.iter().copied().filter(|&k| cols[k].is_none()).collect();
+            m.sort_unstable();
+            m.dedup();
+            m
+        };
+        if !missing.is_empty() {
+            let w = self.pairs();
+            let mut solved: Vec<(usize, Arc<[f64]>)> = Vec::with_capacity(missing.len());
+            let mut bad = false;
+            self.solve_chunks(
+                missing.len(),
+                |first, rhs| {
+                    for j in 0..rhs.ncols() {
+                        for (i, v) in self.joint.row(3 * missing[first + j] + NORMAL) {
+                            rhs[(i, j)] += v;
+                        }
+                    }
+                },
+                |first, x| {
+                    for j in 0..x.ncols() {
+                        let col: Arc<[f64]> = (0..w)
+                            .map(|k| {
+                                self.joint
+                                    .row(3 * k + NORMAL)
+                                    .map(|(i, v)| v * x[(i, j)])
+                                    .sum::<f64>()
+                            })
+                            .collect();
+                        bad |= col.iter().any(|v| !v.is_finite());
+                        solved.push((missing[first + j], col));
+                    }
+                },
+            );
+            if bad {
+                return Err(Error::LinearAlgebra(
+                    "joint flexibility K⁻¹ Bᵀ is not finite".into(),
+                ));
+            }
+            let mut cols = self.lock_columns();
+            for (k, col) in solved {
+                cols[k] = Some(col);
+            }
+        }
+        let cols = self.lock_columns();
+        Ok(pairs
+            .iter()
+            .map(|&k| cols[k].clone().expect("solved above"))
+            .collect())
+    }
+
+    /// `B K⁻¹ B_tᵀ p_t` (3w rows) for the tangential forces of each column of `p` (3w ×
+    /// outputs): the pair kinematics under the run's friction forces, one blocked solve.
+    fn tangential_response(&self, p: MatRef<'_, f64>) -> Mat<f64> {
+        let rows = self.joint.rows();
+        let mut out = Mat::<f64>::zeros(rows, p.ncols());
+        let mut pt = vec![0.0; rows];
+        self.solve_chunks(
+            p.ncols(),
+            |first, rhs| {
+                for j in 0..rhs.ncols() {
+                    for (r, v) in pt.iter_mut().enumerate() {
+                        *v = if r % 3 == NORMAL { 0.0 } else { p[(r, first + j)] };
+                    }
+                    let mut col = vec![0.0; rhs.nrows()];
+                    self.joint.apply_transpose_add(&pt, &mut col);
+                    for (i, v) in col.into_iter().enumerate() {
+                        rhs[(i, j)] = v;
+                    }
+                }
+            },
+            |first, x| {
+                let bx = self.joint.reduce(x.as_ref());
+                out.subcols_mut(first, x.ncols()).copy_from(&bx);
+            },
+        );
+        out
     }
 
     /// The attachment modes `K⁻¹ b_kᵀ` of the normal rows of `pairs` (n × |pairs|, mm/N): the
     /// static response of the structure to a unit normal force on each pair.
     pub fn attachment_modes(&self, pairs: &[usize]) -> Mat<f64> {
-        Mat::from_fn(self.z.nrows(), pairs.len(), |i, j| {
-            self.z[(i, 3 * pairs[j] + NORMAL)]
-        })
+        let mut rhs = Mat::<f64>::zeros(self.stiffness.n, pairs.len());
+        for (j, &k) in pairs.iter().enumerate() {
+            for (i, v) in self.joint.row(3 * k + NORMAL) {
+                rhs[(i, j)] += v;
+            }
+        }
+        solve_refined(&self.stiffness, &self.chol, &rhs)
     }
 
     /// The frictionless contact statics (the model's `k_n`) under the master load `load` (`[Fx, Fy, Fz (N), Mx, My,
@@ -212,12 +336,8 @@ impl JointFlexibility {
         Ok(pc.iter().step_by(3).copied().collect())
     }
 
-    /// The joint flexibility `F = B K⁻¹ Bᵀ` (3w × 3w, mm/N).
-    pub fn flexibility(&self) -> MatRef<'_, f64> {
-        self.flex.as_ref()
-    }
-
-    /// The estimator of a reduced model on the basis `phi` (n × r) of `model`: `G = Zᵀ M Φ`.
+    /// The estimator of a reduced model on the basis `phi` (n × r) of `model`: `G = B K⁻¹ M Φ`
+    /// and `G_m = E_mᵀ K⁻¹ M Φ` from r refined solves.
     pub fn estimator<'a>(
         &'a self,
         model: &Model,
@@ -228,23 +348,22 @@ impl JointFlexibility {
                 "error estimate: the reduced model carries no basis Φ (read from a file)".into(),
             )
         })?;
-        if phi.nrows() != self.z.nrows() || rom.pairs() != self.pairs() {
+        if phi.nrows() != self.stiffness.n || rom.pairs() != self.pairs() {
             return Err(Error::Invalid(format!(
                 "error estimate: basis {}×{} with {} pairs does not fit the model ({} DOF, {} pairs)",
                 phi.nrows(),
                 phi.ncols(),
                 rom.pairs(),
-                self.z.nrows(),
+                self.stiffness.n,
                 self.pairs()
             )));
         }
         let m_phi = sym_mul_mat(&model.mass, phi.as_ref());
-        let zt_mphi = self.z.transpose() * &m_phi;
-        let rows = 3 * self.pairs();
+        let y = solve_refined(&self.stiffness, &self.chol, &m_phi);
         Ok(ErrorEstimator {
             flex: self,
-            g: zt_mphi.subrows(0, rows).to_owned(),
-            g_m: zt_mphi.subrows(rows, 6).to_owned(),
+            g: self.joint.reduce(y.as_ref()),
+            g_m: Mat::from_fn(6, y.ncols(), |d, j| y[(self.master[d], j)]),
             truncation: Truncation::new(model, phi.as_ref(), self.modes.as_ref())?,
             rom: rom.clone(),
         })
@@ -436,13 +555,11 @@ impl ErrorEstimator<'_> {
         }
         let qdd = self.accelerations(states)?;
         let load = Mat::from_fn(6, outputs, |d, j| self.rom.load.master_at(states.t[j])[d]);
-        // û = H f_m − G q̈ for every output at once (3w × outputs), plus the dynamic excess of
-        // the truncated modes (module docs, "Truncation").
+        // The dynamic excess of the truncated modes (module docs, "Truncation") and the master
+        // kinematics for every output at once (small: modes × outputs, 6 × outputs).
         let q_all = MatRef::from_column_major_slice(states.q, r, outputs);
         let p_all = MatRef::from_column_major_slice(states.p, 3 * w, outputs);
         let excess = self.truncation.excess(states.t, &load, q_all, p_all);
-        let u_joint = &self.flex.h * &load - &self.g * &qdd;
-        let u_hat = &u_joint + &self.truncation.b_psi * &excess;
         let x_hat = &self.flex.c * &load - &self.g_m * &qdd + &self.truncation.psi_m * &excess;
         let mut out = Estimate {
             pair_error: vec![0.0; w],
@@ -461,41 +578,55 @@ impl ErrorEstimator<'_> {
                 e => e,
             }
         };
-        for j in 0..outputs {
-            let p = &states.p[3 * w * j..3 * w * (j + 1)];
-            let u: Vec<f64> = u_hat.col(j).iter().copied().collect();
-            let pc = corr.correct(&u, p).map_err(at(j))?;
-            // The joint part alone (no truncated-mode dynamics): it ranks the pairs.
-            let u: Vec<f64> = u_joint.col(j).iter().copied().collect();
-            let pj = corr_joint.correct(&u, p).map_err(at(j))?;
-            let (mut fc, mut fr, mut fc_rom, mut fr_rom, mut fcj) = (0.0, 0.0, 0.0, 0.0, 0.0);
-            for k in 0..w {
-                fc += pc[3 * k + NORMAL].powi(2);
-                fr += pc[3 * k + T1].powi(2) + pc[3 * k + T2].powi(2);
-                fc_rom += p[3 * k + NORMAL].powi(2);
-                fr_rom += p[3 * k + T1].powi(2) + p[3 * k + T2].powi(2);
-                fcj += pj[3 * k + NORMAL].powi(2);
-                out.pair_error[k] += (pj[3 * k + NORMAL] - p[3 * k + NORMAL]).powi(2);
+        // The pair kinematics go chunk by chunk of outputs (3w × chunk at a time): û = H f_m −
+        // G q̈ − F_{·,t} p_t, plus the truncated modes' excess for the full correction.
+        for first in (0..outputs).step_by(SOLVE_CHUNK) {
+            let cols = SOLVE_CHUNK.min(outputs - first);
+            let mut u_joint = &self.flex.h * load.subcols(first, cols)
+                - &self.g * qdd.subcols(first, cols);
+            if law.friction {
+                u_joint -= self.flex.tangential_response(p_all.subcols(first, cols));
             }
-            fc_joint.push(fcj.sqrt());
-            // x_m* = C f_m − G_m q̈ − Hᵀ p* (the tangential part of p* as in the gaps: the run's).
-            let mut uy = x_hat[(1, j)];
-            for (i, pi) in pc.iter().enumerate() {
-                let load = if i % 3 == NORMAL { *pi } else { p[i] };
-                uy -= self.flex.h[(i, 1)] * load;
-            }
-            let q = &states.q[r * j..r * (j + 1)];
-            let uy_rom = self.rom.master_displacement(q)[1];
-            let values = [
-                fc.sqrt(),
-                fr.sqrt(),
-                uy,
-                fc_rom.sqrt(),
-                fr_rom.sqrt(),
-                uy_rom,
-            ];
-            for (c, v) in curves.iter_mut().zip(values) {
-                c.push(v);
+            let u_hat =
+                &u_joint + &self.truncation.b_psi * excess.subcols(first, cols);
+            for c in 0..cols {
+                let j = first + c;
+                let p = &states.p[3 * w * j..3 * w * (j + 1)];
+                let u: Vec<f64> = u_hat.col(c).iter().copied().collect();
+                let pc = corr.correct(&u, p).map_err(at(j))?;
+                // The joint part alone (no truncated-mode dynamics): it ranks the pairs.
+                let u: Vec<f64> = u_joint.col(c).iter().copied().collect();
+                let pj = corr_joint.correct(&u, p).map_err(at(j))?;
+                let (mut fc, mut fr, mut fc_rom, mut fr_rom, mut fcj) = (0.0, 0.0, 0.0, 0.0, 0.0);
+                for k in 0..w {
+                    fc += pc[3 * k + NORMAL].powi(2);
+                    fr += pc[3 * k + T1].powi(2) + pc[3 * k + T2].powi(2);
+                    fc_rom += p[3 * k + NORMAL].powi(2);
+                    fr_rom += p[3 * k + T1].powi(2) + p[3 * k + T2].powi(2);
+                    fcj += pj[3 * k + NORMAL].powi(2);
+                    out.pair_error[k] += (pj[3 * k + NORMAL] - p[3 * k + NORMAL]).powi(2);
+                }
+                fc_joint.push(fcj.sqrt());
+                // x_m* = C f_m − G_m q̈ − Hᵀ p* (the tangential part of p* as in the gaps: the
+                // run's).
+                let mut uy = x_hat[(1, j)];
+                for (i, pi) in pc.iter().enumerate() {
+                    let load = if i % 3 == NORMAL { *pi } else { p[i] };
+                    uy -= self.flex.h[(i, 1)] * load;
+                }
+                let q = &states.q[r * j..r * (j + 1)];
+                let uy_rom = self.rom.master_displacement(q)[1];
+                let values = [
+                    fc.sqrt(),
+                    fr.sqrt(),
+                    uy,
+                    fc_rom.sqrt(),
+                    fr_rom.sqrt(),
+                    uy_rom,
+                ];
+                for (c, v) in curves.iter_mut().zip(values) {
+                    c.push(v);
+                }
             }
         }
         let [fc, fr, uy, fc_rom, fr_rom, uy_rom] = curves;
@@ -560,8 +691,9 @@ struct Corrector<'a> {
     w: usize,
     /// The converged active set of the last output.
     active: Vec<bool>,
-    /// The set and Cholesky factor of `I + k_n F_AA` last factored.
-    factor: Option<(Vec<usize>, Llt<f64>)>,
+    /// The set last factored, its flexibility columns and the Cholesky factor of
+    /// `I + k_n F_AA`.
+    factor: Option<(Vec<usize>, Vec<Arc<[f64]>>, Llt<f64>)>,
 }
 
 /// Active-set iterations per output before the projected Gauss–Seidel fallback.
@@ -581,18 +713,17 @@ impl<'a> Corrector<'a> {
     /// The gaps `g = ĝ − k_n F_{n,A} g_A` with `(I + k_n F_AA) g_A = ĝ_A` for the active set
     /// `set`.
     fn gaps(&mut self, set: &[usize], g_hat: &[f64], gaps: &mut [f64]) -> Result<(), Error> {
-        let f = &self.flex.flex;
         let k_n = self.law.k_n;
-        let nrm = |k: usize| 3 * k + NORMAL;
         gaps.copy_from_slice(g_hat);
         if set.is_empty() {
             return Ok(());
         }
-        if self.factor.as_ref().is_none_or(|(s, _)| s != set) {
+        if self.factor.as_ref().is_none_or(|(s, _, _)| s != set) {
+            let cols = self.flex.normal_columns(set)?;
             let a = set.len();
             let s_mat = Mat::from_fn(a, a, |i, j| {
                 let d = if i == j { 1.0 } else { 0.0 };
-                d + k_n * f[(nrm(set[i]), nrm(set[j]))]
+                d + k_n * 0.5 * (cols[j][set[i]] + cols[i][set[j]])
             });
             let llt = s_mat.llt(Side::Lower).map_err(|e| {
                 Error::LinearAlgebra(LinalgError::caused_by(
@@ -600,33 +731,25 @@ impl<'a> Corrector<'a> {
                     e,
                 ))
             })?;
-            self.factor = Some((set.to_vec(), llt));
+            self.factor = Some((set.to_vec(), cols, llt));
         }
-        let (_, llt) = self.factor.as_ref().expect("factored above");
+        let (_, cols, llt) = self.factor.as_ref().expect("factored above");
         let rhs = Mat::from_fn(set.len(), 1, |i, _| g_hat[set[i]]);
         let g_a = llt.solve(&rhs);
-        for (k, gk) in gaps.iter_mut().enumerate() {
-            for (i, &ki) in set.iter().enumerate() {
-                *gk -= k_n * f[(nrm(k), nrm(ki))] * g_a[(i, 0)];
+        for (i, col) in cols.iter().enumerate() {
+            let s = k_n * g_a[(i, 0)];
+            for (gk, fk) in gaps.iter_mut().zip(col.iter()) {
+                *gk -= s * fk;
             }
         }
         Ok(())
     }
 
-    /// The corrected pair forces `p*` (3w) from `û = H f_m − G q̈` and the run's forces `p`.
-    fn correct(&mut self, u_hat: &[f64], p: &[f64]) -> Result<Vec<f64>, Error> {
+    /// The corrected pair forces `p*` (3w) from the pair kinematics `u0 = û − F_{·,t} p_t`
+    /// (with the run's tangential forces as loads) and the run's forces `p`.
+    fn correct(&mut self, u0: &[f64], p: &[f64]) -> Result<Vec<f64>, Error> {
         let w = self.w;
-        let f = &self.flex.flex;
         let k_n = self.law.k_n;
-        // û − F_{·,t} p_t: the kinematics with the run's tangential forces as loads.
-        let mut u0 = u_hat.to_vec();
-        for (i, ui) in u0.iter_mut().enumerate() {
-            let mut acc = 0.0;
-            for k in 0..w {
-                acc += f[(i, 3 * k + T1)] * p[3 * k + T1] + f[(i, 3 * k + T2)] * p[3 * k + T2];
-            }
-            *ui -= acc;
-        }
         let g_hat: Vec<f64> = (0..w).map(|k| u0[3 * k + NORMAL]).collect();
         let nrm = |k: usize| 3 * k + NORMAL;
         // Semismooth Newton on the active set (see `crate::joint::statics`), warm-started.
@@ -656,7 +779,7 @@ impl<'a> Corrector<'a> {
         } else {
             // The semismooth iteration can cycle between active sets; the problem is a strictly
             // convex QP, which projected Gauss–Seidel solves without fail.
-            let forces = projected_gauss_seidel(f, k_n, &g_hat)?;
+            let forces = projected_gauss_seidel(self.flex, k_n, &g_hat, &active)?;
             active = forces.iter().map(|&p| p < 0.0).collect();
             forces
         };
@@ -695,26 +818,77 @@ impl<'a> Corrector<'a> {
 /// `c = −p_n ≥ 0` and gaps `g = ĝ + F_nn c`, the law `c = k_n (−g)₊` is the optimality condition
 /// of `min ½ cᵀ (F_nn + I/k_n) c + ĝᵀ c` subject to `c ≥ 0` (KKT multiplier = g). Projected
 /// Gauss–Seidel converges for any SPD matrix; it runs until no force moves by more than 1e-13
-/// of the largest (at most 100 000 sweeps, else an error). Returns `p_n = −c` (w values, N).
-fn projected_gauss_seidel(f: &Mat<f64>, k_n: f64, g_hat: &[f64]) -> Result<Vec<f64>, Error> {
+/// of the largest (at most 100 000 sweeps, else an error).
+///
+/// Only the pairs that can carry force enter the sweeps: the candidates S start as the pairs
+/// with `ĝ < 0` or in the last active set `hint`; once PGS has converged on S, a pair outside S
+/// whose gap `ĝ + F_{n,S} c_S` is negative joins S and PGS resumes (S only grows, so this ends).
+/// Returns `p_n = −c` (w values, N).
+fn projected_gauss_seidel(
+    flex: &JointFlexibility,
+    k_n: f64,
+    g_hat: &[f64],
+    hint: &[bool],
+) -> Result<Vec<f64>, Error> {
     let w = g_hat.len();
-    let nrm = |k: usize| 3 * k + NORMAL;
-    let diag: Vec<f64> = (0..w).map(|k| f[(nrm(k), nrm(k))] + 1.0 / k_n).collect();
-    let mut c = vec![0.0; w];
+    let mut set: Vec<usize> = (0..w).filter(|&k| g_hat[k] < 0.0 || hint[k]).collect();
+    let mut c_all = vec![0.0; w];
+    loop {
+        let cols = flex.normal_columns(&set)?;
+        let c: Vec<f64> = set.iter().map(|&k| c_all[k]).collect();
+        let c = pgs_on(&set, &cols, k_n, g_hat, c)?;
+        for (&k, &ck) in set.iter().zip(&c) {
+            c_all[k] = ck;
+        }
+        // Gaps of every pair under the forces found on S.
+        let mut gaps = g_hat.to_vec();
+        for (col, ck) in cols.iter().zip(&c) {
+            if *ck != 0.0 {
+                for (g, f) in gaps.iter_mut().zip(col.iter()) {
+                    *g += f * ck;
+                }
+            }
+        }
+        let mut in_set = vec![false; w];
+        for &k in &set {
+            in_set[k] = true;
+        }
+        let more: Vec<usize> = (0..w).filter(|&k| !in_set[k] && gaps[k] < 0.0).collect();
+        if more.is_empty() {
+            return Ok(c_all.iter().map(|v| -v).collect());
+        }
+        set.extend(more);
+        set.sort_unstable();
+    }
+}
+
+/// Projected Gauss–Seidel on the candidate pairs `set` (their flexibility columns `cols`),
+/// from the compressive forces `c`; see [`projected_gauss_seidel`].
+fn pgs_on(
+    set: &[usize],
+    cols: &[Arc<[f64]>],
+    k_n: f64,
+    g_hat: &[f64],
+    mut c: Vec<f64>,
+) -> Result<Vec<f64>, Error> {
+    let diag: Vec<f64> = (0..set.len())
+        .map(|i| cols[i][set[i]] + 1.0 / k_n)
+        .collect();
     for _ in 0..100_000 {
         let (mut moved, mut largest) = (0.0f64, 0.0f64);
-        for k in 0..w {
-            let mut grad = g_hat[k] + c[k] / k_n;
+        for i in 0..set.len() {
+            let k = set[i];
+            let mut grad = g_hat[k] + c[i] / k_n;
             for (j, cj) in c.iter().enumerate() {
-                grad += f[(nrm(k), nrm(j))] * cj;
+                grad += 0.5 * (cols[j][k] + cols[i][set[j]]) * cj;
             }
-            let next = (c[k] - grad / diag[k]).max(0.0);
-            moved = moved.max((next - c[k]).abs());
+            let next = (c[i] - grad / diag[i]).max(0.0);
+            moved = moved.max((next - c[i]).abs());
             largest = largest.max(next);
-            c[k] = next;
+            c[i] = next;
         }
         if moved <= 1e-13 * largest || largest == 0.0 {
-            return Ok(c.iter().map(|v| -v).collect());
+            return Ok(c);
         }
     }
     Err(Error::LinearAlgebra(
