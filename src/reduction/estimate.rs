@@ -125,8 +125,8 @@ pub struct JointFlexibility {
     /// The lowest [`TRUNCATION_MODES`] fixed-interface modes (n × count, M-orthonormal, zero at
     /// the master), for the truncation part of the estimate.
     modes: Mat<f64>,
-    /// Per pair k, once solved: the normal rows of the flexibility column `F_{n,k} = B_n K⁻¹
-    /// b_kᵀ` (w values, mm/N; `b_k` the normal row of pair k). Shared by every estimate of the
+    /// Per joint row r (3w: normal, t1, t2 of each pair), once solved: the normal rows of its
+    /// flexibility column `B_n K⁻¹ b_rᵀ` (w values, mm/N). Shared by every estimate of the
     /// model (sweeps run in parallel), so behind a lock.
     columns: Mutex<Vec<Option<Arc<[f64]>>>>,
 }
@@ -187,7 +187,7 @@ impl JointFlexibility {
             c,
             k_n: model.contact.normal_stiffness,
             modes,
-            columns: Mutex::new(vec![None; model.joint.pairs()]),
+            columns: Mutex::new(vec![None; model.joint.rows()]),
         })
     }
 
@@ -196,8 +196,8 @@ impl JointFlexibility {
         self.joint.pairs()
     }
 
-    /// Number of pairs whose flexibility column has been solved so far (the estimate's memory
-    /// beyond the factorization is this × w × 8 bytes).
+    /// Number of flexibility columns solved so far (normal and tangential; the estimate's
+    /// memory beyond the factorization is this × w × 8 bytes).
     pub fn solved_columns(&self) -> usize {
         self.lock_columns().iter().filter(|c| c.is_some()).count()
     }
@@ -209,108 +209,86 @@ impl JointFlexibility {
             .unwrap_or_else(std::sync::PoisonError::into_inner)
     }
 
-    /// `K⁻¹ R` (refined) for right-hand sides `R` (n × m), in chunks of [`SOLVE_CHUNK`] columns,
-    /// each chunk handed to `each(first column, K⁻¹ R_chunk)`.
-    fn solve_chunks(
-        &self,
-        cols: usize,
-        steps: usize,
-        mut fill: impl FnMut(usize, &mut Mat<f64>),
-        mut each: impl FnMut(usize, &Mat<f64>),
-    ) {
-        let n = self.stiffness.n;
-        for first in (0..cols).step_by(SOLVE_CHUNK) {
-            let m = SOLVE_CHUNK.min(cols - first);
-            let mut rhs = Mat::<f64>::zeros(n, m);
-            fill(first, &mut rhs);
-            let x = solve_refined_steps(&self.stiffness, &self.chol, &rhs, steps);
-            each(first, &x);
-        }
-    }
-
-    /// The flexibility columns `F_{n,k}` of `pairs` (each w values), solving the missing ones
-    /// in one blocked multi-right-hand-side solve.
-    fn normal_columns(&self, pairs: &[usize]) -> Result<Vec<Arc<[f64]>>, Error> {
+    /// The flexibility columns `B_n K⁻¹ b_rᵀ` (each w values, mm/N) of the joint rows `rows`
+    /// (`3k + NORMAL` for pair k's normal force, `3k + T1`, `3k + T2` for its tangential ones),
+    /// solving the missing ones in blocked multi-right-hand-side solves of [`SOLVE_CHUNK`]
+    /// columns. Only the normal rows of the response are kept: the pair-space contact problem
+    /// is posed on the gaps.
+    fn columns(&self, rows: &[usize]) -> Result<Vec<Arc<[f64]>>, Error> {
         let missing: Vec<usize> = {
             let cols = self.lock_columns();
-            let mut m: Vec<usize> = pairs.iter().copied().filter(|&k| cols[k].is_none()).collect();
+            let mut m: Vec<usize> = rows.iter().copied().filter(|&r| cols[r].is_none()).collect();
             m.sort_unstable();
             m.dedup();
             m
         };
-        if !missing.is_empty() {
-            let w = self.pairs();
-            let mut solved: Vec<(usize, Arc<[f64]>)> = Vec::with_capacity(missing.len());
-            let mut bad = false;
-            self.solve_chunks(
-                missing.len(),
-                COLUMN_REFINEMENT,
-                |first, rhs| {
-                    for j in 0..rhs.ncols() {
-                        for (i, v) in self.joint.row(3 * missing[first + j] + NORMAL) {
-                            rhs[(i, j)] += v;
-                        }
-                    }
-                },
-                |first, x| {
-                    for j in 0..x.ncols() {
-                        let col: Arc<[f64]> = (0..w)
-                            .map(|k| {
-                                self.joint
-                                    .row(3 * k + NORMAL)
-                                    .map(|(i, v)| v * x[(i, j)])
-                                    .sum::<f64>()
-                            })
-                            .collect();
-                        bad |= col.iter().any(|v| !v.is_finite());
-                        solved.push((missing[first + j], col));
-                    }
-                },
-            );
-            if bad {
+        let w = self.pairs();
+        let n = self.stiffness.n;
+        for chunk in missing.chunks(SOLVE_CHUNK) {
+            let mut rhs = Mat::<f64>::zeros(n, chunk.len());
+            for (j, &r) in chunk.iter().enumerate() {
+                for (i, v) in self.joint.row(r) {
+                    rhs[(i, j)] += v;
+                }
+            }
+            let x = solve_refined_steps(&self.stiffness, &self.chol, &rhs, COLUMN_REFINEMENT);
+            let solved: Vec<Arc<[f64]>> = (0..chunk.len())
+                .map(|j| {
+                    (0..w)
+                        .map(|k| {
+                            self.joint
+                                .row(3 * k + NORMAL)
+                                .map(|(i, v)| v * x[(i, j)])
+                                .sum::<f64>()
+                        })
+                        .collect()
+                })
+                .collect();
+            if solved.iter().any(|c| c.iter().any(|v| !v.is_finite())) {
                 return Err(Error::LinearAlgebra(
                     "joint flexibility K⁻¹ Bᵀ is not finite".into(),
                 ));
             }
             let mut cols = self.lock_columns();
-            for (k, col) in solved {
-                cols[k] = Some(col);
+            for (&r, col) in chunk.iter().zip(solved) {
+                cols[r] = Some(col);
             }
         }
         let cols = self.lock_columns();
-        Ok(pairs
+        Ok(rows
             .iter()
-            .map(|&k| cols[k].clone().expect("solved above"))
+            .map(|&r| cols[r].clone().expect("solved above"))
             .collect())
     }
 
-    /// `B K⁻¹ B_tᵀ p_t` (3w rows) for the tangential forces of each column of `p` (3w ×
-    /// outputs): the pair kinematics under the run's friction forces, one blocked solve.
-    fn tangential_response(&self, p: MatRef<'_, f64>) -> Mat<f64> {
-        let rows = self.joint.rows();
-        let mut out = Mat::<f64>::zeros(rows, p.ncols());
-        let mut pt = vec![0.0; rows];
-        self.solve_chunks(
-            p.ncols(),
-            COLUMN_REFINEMENT,
-            |first, rhs| {
-                for j in 0..rhs.ncols() {
-                    for (r, v) in pt.iter_mut().enumerate() {
-                        *v = if r % 3 == NORMAL { 0.0 } else { p[(r, first + j)] };
-                    }
-                    let mut col = vec![0.0; rhs.nrows()];
-                    self.joint.apply_transpose_add(&pt, &mut col);
-                    for (i, v) in col.into_iter().enumerate() {
-                        rhs[(i, j)] = v;
+    /// The normal flexibility columns `F_{n,k}` of `pairs` ([`JointFlexibility::columns`]).
+    fn normal_columns(&self, pairs: &[usize]) -> Result<Vec<Arc<[f64]>>, Error> {
+        let rows: Vec<usize> = pairs.iter().map(|&k| 3 * k + NORMAL).collect();
+        self.columns(&rows)
+    }
+
+    /// `g_t = B_n K⁻¹ B_tᵀ p_t` (w × outputs): the gaps under the run's tangential forces, each
+    /// column of `p` (3w × outputs) one output. Built from the tangential flexibility columns
+    /// of the pairs that carry a tangential force at some output (solved once, cached).
+    fn tangential_gaps(&self, p: MatRef<'_, f64>) -> Result<Mat<f64>, Error> {
+        let w = self.pairs();
+        let rows: Vec<usize> = (0..w)
+            .flat_map(|k| [3 * k + T1, 3 * k + T2])
+            .filter(|&r| (0..p.ncols()).any(|j| p[(r, j)] != 0.0))
+            .collect();
+        let cols = self.columns(&rows)?;
+        let mut out = Mat::<f64>::zeros(w, p.ncols());
+        for j in 0..p.ncols() {
+            for (&r, col) in rows.iter().zip(&cols) {
+                let pr = p[(r, j)];
+                if pr != 0.0 {
+                    for (o, f) in out.col_mut(j).iter_mut().zip(col.iter()) {
+                        *o += f * pr;
                     }
                 }
-            },
-            |first, x| {
-                let bx = self.joint.reduce(x.as_ref());
-                out.subcols_mut(first, x.ncols()).copy_from(&bx);
-            },
-        );
-        out
+            }
+        }
+        Ok(out)
     }
 
     /// The attachment modes `K⁻¹ b_kᵀ` of the normal rows of `pairs` (n × |pairs|, mm/N): the
@@ -594,7 +572,12 @@ impl ErrorEstimator<'_> {
             let mut u_joint = &self.flex.h * load.subcols(first, cols)
                 - &self.g * qdd.subcols(first, cols);
             if law.friction {
-                u_joint -= self.flex.tangential_response(p_all.subcols(first, cols));
+                let g_t = self.flex.tangential_gaps(p_all.subcols(first, cols))?;
+                for c in 0..cols {
+                    for k in 0..w {
+                        u_joint[(3 * k + NORMAL, c)] -= g_t[(k, c)];
+                    }
+                }
             }
             let u_hat =
                 &u_joint + &self.truncation.b_psi * excess.subcols(first, cols);
