@@ -75,6 +75,27 @@
 //! reported separately ([`Estimate::joint`], [`Estimate::truncation`]): more pair attachment
 //! modes remove the first, more fixed-interface modes the second.
 //!
+//! ## Cost: only the columns of F the contact problems touch
+//!
+//! `F` is 3w × 3w and `K⁻¹ Bᵀ` is n × 3w: at 10⁵ DOF and 5 888 pairs, 2.5 GB and 15 GB, and
+//! 17 664 sparse solves. Neither is formed. The correction reads `F` only through
+//!
+//! - `F_{n,A} g_A`: the normal flexibility columns of the pairs in the active set A (the
+//!   semismooth Newton iteration and its projected Gauss–Seidel fallback), and
+//! - `F_{n,t} p_t`: the tangential columns of the pairs that carry a friction force in the run,
+//!
+//! and only their normal rows (the problem is posed on the gaps). Each column `B_n K⁻¹ b_rᵀ`
+//! (w values) is solved the first time a contact problem touches its row — blocked,
+//! 256 right-hand sides per multi-column solve, refined once — and kept for every
+//! later output, round and variant of the model (`H`, `C` take six solves, `G = B K⁻¹ M Φ` r per
+//! basis). The cost is one solve per pair that is ever in contact or in friction, the memory
+//! w × 8 bytes per such column. The semismooth iteration lets only the deepest penetrations
+//! join the active set per iteration (`next_active_set`): the structure without contact forces
+//! penetrates along most of a refined interface, while the forces of the deepest few open the
+//! rest. Measured on the friction bar ×8 (40 806 DOF, 2 287 pairs, with friction): the
+//! a-priori TVD run's estimate went from 130 s and 5.8 GB (dense `F` and `K⁻¹Bᵀ`) to 21 s and
+//! 0.75 GB with the same figures to 1e-12.
+//!
 //! ## When it is exact, and what it neglects
 //!
 //! In statics (`q̈ = 0`, no friction) the correction *is* the full model's contact problem,
