@@ -5,17 +5,19 @@
 #
 #     python3 scripts/refine_case.py cases/friction_bar.json cases/scale 2 4 8 13
 #     scripts/scale_table.sh [FACTOR...]        # default: 1 2 4 8 13
+#     SCENE=multilayer_sheet scripts/scale_table.sh 1 2 4 8 15
 #
 # Every run is limited to 16 GB of address space (ulimit -v); a run that fails prints its exit
 # status instead of figures.
 set -u
 bin=target/release/jointrom
+scene=${SCENE:-friction_bar}
 factors=${*:-1 2 4 8 13}
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 rows=()
 for f in $factors; do
-    if [ "$f" = 1 ]; then case=cases/friction_bar.json; else case=cases/scale/friction_bar_x$f.json; fi
+    if [ "$f" = 1 ]; then case=cases/$scene.json; else case=cases/scale/${scene}_x$f.json; fi
     "$bin" info --json "$case" > "$tmp/info.json" || exit 1
     dofs=$(python3 -c 'import json,sys; d=json.load(open(sys.argv[1])); print(d["dofs"], d["joint_pairs"])' "$tmp/info.json")
     row="$f $dofs"

@@ -10,8 +10,10 @@ pub mod eigen;
 mod error;
 pub mod kernels;
 pub mod sparse;
+pub mod subset_llt;
 
 pub use cholesky::{solve_spd, SparseCholesky};
 pub use eigen::{dense_modes, lowest_modes, Modes};
 pub use error::LinalgError;
 pub use sparse::SymCsc;
+pub use subset_llt::SubsetLlt;

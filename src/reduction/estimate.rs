@@ -110,7 +110,6 @@
 
 use std::sync::{Arc, Mutex};
 
-use faer::linalg::solvers::{Llt, Solve};
 use faer::{Mat, MatRef, Side};
 
 use crate::error::Error;
@@ -121,7 +120,7 @@ use crate::linalg::cholesky::SparseCholesky;
 use crate::linalg::compensated::{compensated_gram, solve_refined, solve_refined_steps};
 use crate::linalg::sparse::sym_mul_mat;
 use crate::linalg::LinalgError;
-use crate::linalg::SymCsc;
+use crate::linalg::{SubsetLlt, SymCsc};
 use crate::model::{Interface, Model};
 use crate::reduction::final_basis;
 use crate::system::{ReducedSystem, SecondOrderSystem};
@@ -704,9 +703,11 @@ struct Corrector<'a> {
     w: usize,
     /// The converged active set of the last output.
     active: Vec<bool>,
-    /// The set last factored, its flexibility columns and the Cholesky factor of
-    /// `I + k_n F_AA`.
-    factor: Option<(Vec<usize>, Vec<Arc<[f64]>>, Llt<f64>)>,
+    /// The Cholesky factor of `I + k_n F_AA` for the set last solved, updated as the set
+    /// changes ([`SubsetLlt`]: a few pairs in or out cost O(|A|²) each, not |A|³/3).
+    factor: SubsetLlt,
+    /// The flexibility columns of the pairs met so far (w entries, `None` before).
+    cols: Vec<Option<Arc<[f64]>>>,
 }
 
 /// Active-set iterations per output before the projected Gauss–Seidel fallback.
@@ -743,7 +744,8 @@ impl<'a> Corrector<'a> {
             law,
             w: flex.pairs(),
             active: vec![false; flex.pairs()],
-            factor: None,
+            factor: SubsetLlt::new(),
+            cols: vec![None; flex.pairs()],
         }
     }
 
@@ -755,27 +757,31 @@ impl<'a> Corrector<'a> {
         if set.is_empty() {
             return Ok(());
         }
-        if self.factor.as_ref().is_none_or(|(s, _, _)| s != set) {
-            let cols = self.flex.normal_columns(set)?;
-            let a = set.len();
-            let s_mat = Mat::from_fn(a, a, |i, j| {
+        for (&k, c) in set.iter().zip(self.flex.normal_columns(set)?) {
+            self.cols[k] = Some(c);
+        }
+        let cols = &self.cols;
+        let col = |k: usize| cols[k].as_deref().expect("fetched above");
+        self.factor
+            .update(set, |i, j| {
                 let d = if i == j { 1.0 } else { 0.0 };
-                d + k_n * 0.5 * (cols[j][set[i]] + cols[i][set[j]])
-            });
-            let llt = s_mat.llt(Side::Lower).map_err(|e| {
+                d + k_n * 0.5 * (col(j)[i] + col(i)[j])
+            })
+            .map_err(|e| {
                 Error::LinearAlgebra(LinalgError::caused_by(
-                    format!("pair-space contact matrix I + k_n F_AA ({a} pairs) is not positive definite: {e:?}"),
+                    format!(
+                        "pair-space contact matrix I + k_n F_AA ({} pairs) is not positive definite",
+                        set.len()
+                    ),
                     e,
                 ))
             })?;
-            self.factor = Some((set.to_vec(), cols, llt));
-        }
-        let (_, cols, llt) = self.factor.as_ref().expect("factored above");
-        let rhs = Mat::from_fn(set.len(), 1, |i, _| g_hat[set[i]]);
-        let g_a = llt.solve(&rhs);
-        for (i, col) in cols.iter().enumerate() {
-            let s = k_n * g_a[(i, 0)];
-            for (gk, fk) in gaps.iter_mut().zip(col.iter()) {
+        let order = self.factor.order();
+        let mut g_a: Vec<f64> = order.iter().map(|&k| g_hat[k]).collect();
+        self.factor.solve_in_place(&mut g_a);
+        for (&k, ga) in order.iter().zip(&g_a) {
+            let s = k_n * ga;
+            for (gk, fk) in gaps.iter_mut().zip(col(k).iter()) {
                 *gk -= s * fk;
             }
         }
