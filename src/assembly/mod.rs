@@ -248,7 +248,6 @@ impl Assembler {
     pub fn new<'a>(map: &DofMap, element_nodes: impl IntoIterator<Item = &'a [usize]>) -> Self {
         let n = map.n;
         let mut elements = Vec::new();
-        let mut pairs: Vec<(usize, usize)> = Vec::new(); // (col, row)
         for nodes in element_nodes {
             let deps: Vec<DofDep> = nodes.iter().flat_map(|&i| map.nodes[i]).collect();
             let mut dofs: Vec<usize> = deps.iter().flat_map(|d| d.terms().map(|t| t.0)).collect();
@@ -266,35 +265,60 @@ impl Assembler {
                 }
                 t
             });
-            for &c in &dofs {
-                for &r in &dofs {
-                    pairs.push((c, r));
-                }
-            }
             elements.push(Scatter {
                 dofs,
                 te,
                 positions: Vec::new(),
             });
         }
-        pairs.sort_unstable();
-        pairs.dedup();
-        let mut col_ptr = vec![0; n + 1];
-        for &(c, _) in &pairs {
-            col_ptr[c + 1] += 1;
+        // The pattern column by column from the DOF → element incidence: each column's rows are
+        // the DOF of its elements, sorted locally (no global list of all element DOF pairs: at
+        // 10⁶ DOF that was 10⁸ pairs to sort).
+        let mut inc_ptr = vec![0usize; n + 1];
+        for e in &elements {
+            for &d in &e.dofs {
+                inc_ptr[d + 1] += 1;
+            }
         }
         for j in 0..n {
-            col_ptr[j + 1] += col_ptr[j];
+            inc_ptr[j + 1] += inc_ptr[j];
         }
-        let row_idx: Vec<usize> = pairs.iter().map(|p| p.1).collect();
+        let mut cursor = inc_ptr.clone();
+        let mut inc = vec![0usize; inc_ptr[n]];
+        for (k, e) in elements.iter().enumerate() {
+            for &d in &e.dofs {
+                inc[cursor[d]] = k;
+                cursor[d] += 1;
+            }
+        }
+        let mut col_ptr = Vec::with_capacity(n + 1);
+        col_ptr.push(0);
+        let mut row_idx = Vec::new();
+        let mut rows = Vec::new();
+        for c in 0..n {
+            rows.clear();
+            for &k in &inc[inc_ptr[c]..inc_ptr[c + 1]] {
+                rows.extend_from_slice(&elements[k].dofs);
+            }
+            rows.sort_unstable();
+            rows.dedup();
+            row_idx.extend_from_slice(&rows);
+            col_ptr.push(row_idx.len());
+        }
+        drop(inc);
+        // Positions: the element's sorted DOF walk each of its columns' sorted rows once.
         for e in &mut elements {
             let len = e.dofs.len();
-            e.positions = Vec::with_capacity(len * len);
-            for &r in &e.dofs {
-                for &c in &e.dofs {
-                    let rows = &row_idx[col_ptr[c]..col_ptr[c + 1]];
-                    let p = rows.binary_search(&r).expect("pattern holds the pair");
-                    e.positions.push(col_ptr[c] + p);
+            e.positions = vec![0; len * len];
+            for (b, &c) in e.dofs.iter().enumerate() {
+                let rows = &row_idx[col_ptr[c]..col_ptr[c + 1]];
+                let mut p = 0;
+                for (a, &r) in e.dofs.iter().enumerate() {
+                    while rows[p] < r {
+                        p += 1;
+                    }
+                    debug_assert_eq!(rows[p], r, "pattern holds the pair");
+                    e.positions[a * len + b] = col_ptr[c] + p;
                 }
             }
         }
