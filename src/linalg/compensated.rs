@@ -189,19 +189,32 @@ pub(crate) fn solve_refined_steps(
     b: &Mat<f64>,
     steps: usize,
 ) -> Mat<f64> {
+    solve_refined_steps_owned(a, chol, b.clone(), steps)
+}
+
+/// [`solve_refined_steps`] on right-hand sides the caller gives up: the solution overwrites
+/// them, and only each block's right-hand sides are copied (n × 32 per block in flight instead
+/// of a second n × columns matrix: 4.9 GB less for the 496 TVD solves at 1.2·10⁶ DOF). The
+/// same bits as [`solve_refined_steps`].
+pub(crate) fn solve_refined_steps_owned(
+    a: &SymCsc,
+    chol: &SparseCholesky,
+    mut x: Mat<f64>,
+    steps: usize,
+) -> Mat<f64> {
     use faer::reborrow::{Reborrow, ReborrowMut};
     use rayon::prelude::*;
-    let mut x = b.clone();
     x.as_mut()
         .par_col_chunks_mut(SOLVE_BLOCK)
-        .enumerate()
-        .for_each(|(k, mut xb)| {
-            let bb = b.as_ref().subcols(k * SOLVE_BLOCK, xb.ncols());
+        .for_each(|mut xb| {
+            let bb = (steps > 0).then(|| xb.to_owned());
             chol.solve_in_place_mut(xb.rb_mut());
-            for _ in 0..steps {
-                let mut r = sym_mul_compensated(a, xb.rb(), -1.0, Some(bb));
-                chol.solve_in_place(&mut r);
-                xb += &r;
+            if let Some(bb) = bb {
+                for _ in 0..steps {
+                    let mut r = sym_mul_compensated(a, xb.rb(), -1.0, Some(bb.as_ref()));
+                    chol.solve_in_place(&mut r);
+                    xb += &r;
+                }
             }
         });
     x

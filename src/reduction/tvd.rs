@@ -76,7 +76,7 @@ use crate::linalg::LinalgError;
 use crate::linalg::SymCsc;
 use crate::model::Model;
 
-use crate::linalg::compensated::solve_refined_steps;
+use crate::linalg::compensated::solve_refined_steps_owned;
 
 /// Options of [`trial_vector_derivatives`]. Defaults: `tol = 1e-9`, `zero_gap_active = true`,
 /// `tangential = false`, `inertia = false`.
@@ -445,8 +445,7 @@ impl<'a> TvdRun<'a> {
         };
         let chol = SparseCholesky::new(&model.stiffness)?;
         let bt = joint_rows_transposed(&model.joint, used, q.as_ref(), model.dofs());
-        let z = solve_refined_steps(&model.stiffness, &chol, &bt, 1);
-        drop(bt);
+        let z = solve_refined_steps_owned(&model.stiffness, &chol, bt, 1);
         let bz = rows_times(&model.joint, used, z.as_ref());
         let g = symmetric(&match &q {
             Some(q) => q.transpose() * &bz,
