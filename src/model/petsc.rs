@@ -224,7 +224,7 @@ pub fn read_dense(path: &Path) -> Result<Mat<f64>, Error> {
     } else {
         let nnz = usize::try_from(nz)
             .map_err(|_| err(path, "header: nnz", format!("unknown matrix format {nz}")))?;
-        let (ptr, idx, val) = read_aij_body(&mut f, rows, cols, nnz)?;
+        let Aij { ptr, idx, val } = read_aij_body(&mut f, rows, cols, nnz)?;
         let mut x = Mat::<f64>::zeros(rows, cols);
         for i in 0..rows {
             for p in ptr[i]..ptr[i + 1] {
@@ -237,14 +237,19 @@ pub fn read_dense(path: &Path) -> Result<Mat<f64>, Error> {
     Ok(x)
 }
 
+/// The body of an AIJ matrix in compressed rows.
+struct Aij {
+    /// Row pointers (rows + 1).
+    ptr: Vec<usize>,
+    /// Column indices, increasing within each row.
+    idx: Vec<usize>,
+    /// Values.
+    val: Vec<f64>,
+}
+
 /// Row lengths, column indices and values of an AIJ matrix after its header: row pointers,
 /// column indices (checked in range and increasing within each row) and values.
-fn read_aij_body(
-    f: &mut Input<'_>,
-    rows: usize,
-    cols: usize,
-    nnz: usize,
-) -> Result<(Vec<usize>, Vec<usize>, Vec<f64>), Error> {
+fn read_aij_body(f: &mut Input<'_>, rows: usize, cols: usize, nnz: usize) -> Result<Aij, Error> {
     f.need("row lengths", rows, 4)?;
     let mut ptr = Vec::with_capacity(rows + 1);
     ptr.push(0usize);
@@ -268,9 +273,7 @@ fn read_aij_body(
                 return Err(err(
                     f.path,
                     "column indices",
-                    format!(
-                        "row {i}: column {c} out of range (< {cols}) or not increasing"
-                    ),
+                    format!("row {i}: column {c} out of range (< {cols}) or not increasing"),
                 ));
             }
             idx.push(c);
@@ -280,7 +283,7 @@ fn read_aij_body(
     for _ in 0..nnz {
         val.push(f.f64("values")?);
     }
-    Ok((ptr, idx, val))
+    Ok(Aij { ptr, idx, val })
 }
 
 /// Reads a square AIJ matrix whose pattern and values are symmetric into a [`SymCsc`] (row i
@@ -299,7 +302,11 @@ pub fn read_sym_aij(path: &Path) -> Result<SymCsc, Error> {
             format!("{rows} × {cols} is not square"),
         ));
     }
-    let (col_ptr, row_idx, values) = read_aij_body(&mut f, rows, cols, nnz)?;
+    let Aij {
+        ptr: col_ptr,
+        idx: row_idx,
+        val: values,
+    } = read_aij_body(&mut f, rows, cols, nnz)?;
     f.finish()?;
     let a = SymCsc {
         n: rows,

@@ -133,7 +133,11 @@ fn job_files() -> Vec<JobFile> {
             "K_ii: stiffness without the six master DOF (fixed interface), AIJ",
             "N/mm, N·mm/rad",
         ),
-        f("Mii.petsc", "M_ii: mass without the six master DOF, AIJ", "t, t·mm²"),
+        f(
+            "Mii.petsc",
+            "M_ii: mass without the six master DOF, AIJ",
+            "t, t·mm²",
+        ),
         f(
             "K.petsc",
             "K: whole stiffness (master free, the case's clamps), AIJ",

@@ -68,6 +68,5 @@ pub use estimate::{CurveErrors, ErrorEstimator, Estimate, JointFlexibility, RunS
 pub use pod::{pod, pod_tvd, pod_tvd_ratios, sigma_zero, Pod, DEFAULT_THRESHOLD, ZERO_EIGENVALUE};
 pub use tvd::{
     active_pairs, displacement_scales, static_right_hand_sides, trial_vector_derivatives, Tvd,
-    TvdFactor, TvdIndex,
-    TvdOptions,
+    TvdFactor, TvdIndex, TvdOptions,
 };

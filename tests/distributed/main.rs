@@ -61,15 +61,20 @@ fn check(case: &str, nu: usize, dofs: u64) {
     }
     eprintln!(
         "{case} ν = {nu}: {}",
-        serde_json::to_string(&runs.iter().map(|r| {
-            serde_json::json!({
-                "ranks": r["ranks"],
-                "freq": r["frequency_rel_diff"],
-                "span": r["span_sine"],
-                "z": r["solve_rel_diff"],
-                "seconds": r["petsc"]["seconds"],
-            })
-        }).collect::<Vec<_>>())
+        serde_json::to_string(
+            &runs
+                .iter()
+                .map(|r| {
+                    serde_json::json!({
+                        "ranks": r["ranks"],
+                        "freq": r["frequency_rel_diff"],
+                        "span": r["span_sine"],
+                        "z": r["solve_rel_diff"],
+                        "seconds": r["petsc"]["seconds"],
+                    })
+                })
+                .collect::<Vec<_>>()
+        )
         .unwrap()
     );
 }

@@ -37,7 +37,9 @@ fn sym_aij_round_trips_bit_for_bit() {
 #[test]
 fn dense_and_vectors_round_trip() {
     let d = dir("dense");
-    let x = Mat::from_fn(7, 3, |i, j| (i as f64 + 0.1) * (j as f64 - 1.3).powi(3) / 3.0);
+    let x = Mat::from_fn(7, 3, |i, j| {
+        (i as f64 + 0.1) * (j as f64 - 1.3).powi(3) / 3.0
+    });
     let path = d.join("X.petsc");
     petsc::write_dense(&path, x.as_ref()).unwrap();
     let bytes = std::fs::read(&path).unwrap();
@@ -103,6 +105,12 @@ fn damaged_files_are_rejected_naming_the_file() {
     // A dense reader on a vector file, a vector reader on a matrix.
     let v = d.join("v.petsc");
     petsc::write_vec(&v, &[1.0]).unwrap();
-    assert!(petsc::read_dense(&v).unwrap_err().to_string().contains("class id"));
-    assert!(petsc::read_vecs(&path).unwrap_err().to_string().contains("class id"));
+    assert!(petsc::read_dense(&v)
+        .unwrap_err()
+        .to_string()
+        .contains("class id"));
+    assert!(petsc::read_vecs(&path)
+        .unwrap_err()
+        .to_string()
+        .contains("class id"));
 }
