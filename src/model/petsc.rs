@@ -18,8 +18,8 @@
 //! A [`SymCsc`] (both triangles stored) is written as the full AIJ matrix: column j of the
 //! symmetric CSC is row j, so the rows come out sorted, as `MatLoad` wants them.
 //!
-//! Readers check the class id, non-negative sizes, that the sizes fit the file before anything
-//! is allocated, indices in range, and the file's exact length; errors name the file and the
+//! Readers check the class id, non-negative sizes, that the sizes fit the file (a dense matrix
+//! stored sparsely: the input budget) before anything is allocated, indices in range, and the file's exact length; errors name the file and the
 //! part of it ([`Error::Document`]).
 
 use std::io::{BufReader, BufWriter, Read, Write};
@@ -224,6 +224,20 @@ pub fn read_dense(path: &Path) -> Result<Mat<f64>, Error> {
     } else {
         let nnz = usize::try_from(nz)
             .map_err(|_| err(path, "header: nnz", format!("unknown matrix format {nz}")))?;
+        // A sparse file may declare a dense size far beyond its bytes: bound the dense copy
+        // by the input budget, as if it had been stored densely.
+        let bytes = (rows as u64).saturating_mul(cols as u64).saturating_mul(8);
+        if bytes > files::input_budget() {
+            return Err(err(
+                path,
+                "header",
+                format!(
+                    "{rows} × {cols} dense is {bytes} bytes, over the input budget of {} (set {})",
+                    files::input_budget(),
+                    files::INPUT_BUDGET_VAR
+                ),
+            ));
+        }
         let Aij { ptr, idx, val } = read_aij_body(&mut f, rows, cols, nnz)?;
         let mut x = Mat::<f64>::zeros(rows, cols);
         for i in 0..rows {
