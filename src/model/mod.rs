@@ -17,6 +17,7 @@ mod contact;
 mod load;
 pub mod matrices;
 pub mod mtx;
+pub mod petsc;
 
 pub use contact::contact_static_full;
 

@@ -51,6 +51,7 @@ pub mod basis;
 mod build;
 pub mod competitors;
 pub mod craig_bampton;
+pub mod distributed;
 pub mod estimate;
 pub mod pod;
 pub mod rom_file;
@@ -66,6 +67,6 @@ pub use craig_bampton::craig_bampton;
 pub use estimate::{CurveErrors, ErrorEstimator, Estimate, JointFlexibility, RunStates};
 pub use pod::{pod, pod_tvd, pod_tvd_ratios, sigma_zero, Pod, DEFAULT_THRESHOLD, ZERO_EIGENVALUE};
 pub use tvd::{
-    active_pairs, displacement_scales, trial_vector_derivatives, Tvd, TvdFactor, TvdIndex,
-    TvdOptions,
+    active_pairs, displacement_scales, static_right_hand_sides, trial_vector_derivatives, Tvd,
+    TvdFactor, TvdIndex, TvdOptions,
 };

@@ -315,6 +315,29 @@ pub fn trial_vector_derivatives(
     })
 }
 
+/// The block of right-hand sides that the static TVD solve with the full `K` (eqs. 16/18, no
+/// inertia): `B_uᵀ Q` (n × p, N per unit of the base) with `C = Q R` when the p kept TVD are
+/// fewer than the m joint rows that receive stiffness, else `B_uᵀ` (n × m) — module docs,
+/// "Compressed flexibility". `K⁻¹` of this block is [`TvdFactor::flexibility`]. The
+/// distributed path ([`super::distributed`]) solves it on PETSc and compares.
+pub fn static_right_hand_sides(
+    model: &Model,
+    base: MatRef<'_, f64>,
+    opts: &TvdOptions,
+) -> Result<Mat<f64>, Error> {
+    let n = model.dofs();
+    if base.nrows() != n {
+        return Err(Error::Invalid(format!(
+            "TVD base has {} rows, the model {n} DOF",
+            base.nrows()
+        )));
+    }
+    let run = TvdRun::new(model, base, opts);
+    let cand = run.candidates(opts);
+    let cols: Vec<usize> = (0..cand.index.len()).collect();
+    Ok(run.static_rhs(&cand, &cols).2)
+}
+
 /// One [`trial_vector_derivatives`] run: the model, the base, its joint displacements and the
 /// joint rows that receive stiffness.
 struct TvdRun<'a> {
@@ -423,6 +446,28 @@ impl<'a> TvdRun<'a> {
         out
     }
 
+    /// The right-hand sides of the static columns `static_cols`: `(Q, R, B_uᵀ Q)` with
+    /// `C = Q R` when there are fewer columns p than joint rows m (module docs, "Compressed
+    /// flexibility"), else `(None, C, B_uᵀ)`; C the pseudoforce coefficients (m × p).
+    fn static_rhs(
+        &self,
+        cand: &Candidates,
+        static_cols: &[usize],
+    ) -> (Option<Mat<f64>>, Mat<f64>, Mat<f64>) {
+        let used = &self.used;
+        let m = used.len();
+        let pc = Mat::from_fn(m, static_cols.len(), |r, c| cand.col(static_cols[c], m)[r]);
+        // C = Q R (thin QR, Q m × p orthonormal) when that makes fewer right-hand sides.
+        let (q, coef) = if pc.ncols() < m {
+            let qr = pc.qr();
+            (Some(qr.compute_thin_Q()), qr.thin_R().to_owned())
+        } else {
+            (None, pc)
+        };
+        let bt = joint_rows_transposed(&self.model.joint, used, q.as_ref(), self.model.dofs());
+        (q, coef, bt)
+    }
+
     /// The static columns `static_cols` (eqs. 16/18) through one Cholesky of K: their
     /// K-normalized vectors `Z C` (n × static_cols.len()) and the factor form Z, G, C; the
     /// K-norms go to `k_norms`. With fewer columns p than joint rows m, the flexibility is
@@ -434,17 +479,8 @@ impl<'a> TvdRun<'a> {
         k_norms: &mut [f64],
     ) -> Result<(Mat<f64>, TvdFactor), Error> {
         let (model, used) = (self.model, &self.used);
-        let m = used.len();
-        let pc = Mat::from_fn(m, static_cols.len(), |r, c| cand.col(static_cols[c], m)[r]);
-        // C = Q R (thin QR, Q m × p orthonormal) when that makes fewer right-hand sides.
-        let (q, coef) = if pc.ncols() < m {
-            let qr = pc.qr();
-            (Some(qr.compute_thin_Q()), qr.thin_R().to_owned())
-        } else {
-            (None, pc)
-        };
+        let (q, coef, bt) = self.static_rhs(cand, static_cols);
         let chol = SparseCholesky::new(&model.stiffness)?;
-        let bt = joint_rows_transposed(&model.joint, used, q.as_ref(), model.dofs());
         let z = solve_refined_steps_owned(&model.stiffness, &chol, bt, 1);
         let bz = rows_times(&model.joint, used, z.as_ref());
         let g = symmetric(&match &q {

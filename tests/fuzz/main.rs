@@ -180,3 +180,44 @@ fn sweep_variants() {
         jointrom::studies::sweep::read_variants(&target).is_ok()
     });
 }
+
+/// PETSc's binary format (`jointrom::model::petsc`, what the distributed path reads back): a
+/// small symmetric AIJ matrix, a dense block in both of PETSc's layouts and two vectors; every
+/// reader on every mutant.
+#[test]
+fn petsc_binary_files() {
+    use jointrom::model::petsc;
+    let dir = scratch("petsc");
+    let n: usize = 8;
+    let mut col_ptr = vec![0];
+    let (mut row_idx, mut values) = (Vec::new(), Vec::new());
+    for j in 0..n {
+        for i in j.saturating_sub(1)..(j + 2).min(n) {
+            row_idx.push(i);
+            values.push(if i == j { 2.0 } else { -1.0 });
+        }
+        col_ptr.push(row_idx.len());
+    }
+    let a = jointrom::linalg::SymCsc {
+        n,
+        col_ptr,
+        row_idx,
+        values,
+    };
+    let x = faer::Mat::from_fn(5, 3, |i, j| i as f64 - 0.5 * j as f64);
+    let (fa, fx, fv) = (dir.join("a"), dir.join("x"), dir.join("v"));
+    petsc::write_sym_aij(&fa, &a).unwrap();
+    petsc::write_dense(&fx, x.as_ref()).unwrap();
+    petsc::write_vec(&fv, &[1.0, 2.0, 3.0]).unwrap();
+    let mut vv = std::fs::read(&fv).unwrap();
+    vv.extend_from_slice(&vv.clone());
+    let seeds = vec![std::fs::read(&fa).unwrap(), std::fs::read(&fx).unwrap(), vv];
+    let target = dir.join("mutant.petsc");
+    fuzz("petsc", &seeds, 5, |bytes| {
+        std::fs::write(&target, bytes).unwrap();
+        let a = petsc::read_sym_aij(&target).is_ok();
+        let d = petsc::read_dense(&target).is_ok();
+        let v = petsc::read_vecs(&target).is_ok();
+        a || d || v
+    });
+}

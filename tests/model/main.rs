@@ -8,3 +8,4 @@ mod contact_statics;
 mod deck;
 mod matrices;
 mod model;
+mod petsc;

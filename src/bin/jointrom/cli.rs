@@ -10,7 +10,7 @@ use jointrom::studies::stability::{IterKind, ModelKind};
 use jointrom::{Error, Interface};
 
 use crate::commands::{
-    basis, export, export_matrices, info, modes, run, shapes, stability, statics,
+    basis, distributed, export, export_matrices, info, modes, run, shapes, stability, statics,
     study as study_cmd, sweep, transient,
 };
 
@@ -62,6 +62,10 @@ pub enum Command {
     /// The main job on a case (default: the friction bar): static study, full FE and reduced
     /// transients, speed against accuracy → DIR/CASE/report.md, charts, results.json.
     Run(run::RunArgs),
+    /// The Craig–Bampton eigen solve and the TVD multi-right-hand-side solve on PETSc/SLEPc
+    /// (+ MUMPS) under `mpirun -n R`, compared with the native path: frequencies, span of the
+    /// modes, the solve's difference and backward error, timings (opt-in: docs/distributed.md).
+    Distributed(distributed::DistributedArgs),
 }
 
 #[derive(Clone, Copy, ValueEnum)]

@@ -1,6 +1,7 @@
 //! One module per subcommand: its flags (`…Args`) and `run`.
 
 pub mod basis;
+pub mod distributed;
 pub mod export;
 pub mod export_matrices;
 pub mod info;
@@ -32,5 +33,6 @@ pub fn run(command: Command) -> Result<(), Error> {
         Command::Export(a) => export::run(a),
         Command::ExportMatrices(a) => export_matrices::run(a),
         Command::Run(a) => run::run(a),
+        Command::Distributed(a) => distributed::run(a),
     }
 }
