@@ -156,7 +156,10 @@ impl SubsetLlt {
         )
         .map_err(|e| {
             LinalgError::caused_by(
-                format!("Cholesky downdate removing {} of {n} indices: {e:?}", removed.len()),
+                format!(
+                    "Cholesky downdate removing {} of {n} indices: {e:?}",
+                    removed.len()
+                ),
                 e,
             )
         })?;
@@ -188,7 +191,9 @@ impl SubsetLlt {
         let l22 = llt.L();
         let mut l = Mat::<f64>::zeros(n + a, n + a);
         l.as_mut().submatrix_mut(0, 0, n, n).copy_from(&self.l);
-        l.as_mut().submatrix_mut(n, 0, a, n).copy_from(x.transpose());
+        l.as_mut()
+            .submatrix_mut(n, 0, a, n)
+            .copy_from(x.transpose());
         l.as_mut().submatrix_mut(n, n, a, a).copy_from(l22);
         self.l = l;
         self.order.extend_from_slice(added);

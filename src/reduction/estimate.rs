@@ -237,7 +237,11 @@ impl JointFlexibility {
     fn columns(&self, rows: &[usize]) -> Result<Vec<Arc<[f64]>>, Error> {
         let missing: Vec<usize> = {
             let cols = self.lock_columns();
-            let mut m: Vec<usize> = rows.iter().copied().filter(|&r| cols[r].is_none()).collect();
+            let mut m: Vec<usize> = rows
+                .iter()
+                .copied()
+                .filter(|&r| cols[r].is_none())
+                .collect();
             m.sort_unstable();
             m.dedup();
             m
@@ -589,8 +593,8 @@ impl ErrorEstimator<'_> {
         // G q̈ − F_{·,t} p_t, plus the truncated modes' excess for the full correction.
         for first in (0..outputs).step_by(SOLVE_CHUNK) {
             let cols = SOLVE_CHUNK.min(outputs - first);
-            let mut u_joint = &self.flex.h * load.subcols(first, cols)
-                - &self.g * qdd.subcols(first, cols);
+            let mut u_joint =
+                &self.flex.h * load.subcols(first, cols) - &self.g * qdd.subcols(first, cols);
             if law.friction {
                 let g_t = self.flex.tangential_gaps(p_all.subcols(first, cols))?;
                 for c in 0..cols {
@@ -599,8 +603,7 @@ impl ErrorEstimator<'_> {
                     }
                 }
             }
-            let u_hat =
-                &u_joint + &self.truncation.b_psi * excess.subcols(first, cols);
+            let u_hat = &u_joint + &self.truncation.b_psi * excess.subcols(first, cols);
             for c in 0..cols {
                 let j = first + c;
                 let p = &states.p[3 * w * j..3 * w * (j + 1)];

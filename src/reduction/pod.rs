@@ -347,7 +347,10 @@ fn pod_tvd_with(model: &Model, tvd: &Tvd, weighted: bool, want_poms: bool) -> Re
     } else {
         let (r, q) = if want_poms {
             let qr = f.flexibility.qr();
-            (qr.thin_R().to_owned(), PomMap::Orthonormal(qr.compute_thin_Q()))
+            (
+                qr.thin_R().to_owned(),
+                PomMap::Orthonormal(qr.compute_thin_Q()),
+            )
         } else {
             (tall_r_factor(f.flexibility.as_ref()), PomMap::Skip)
         };
