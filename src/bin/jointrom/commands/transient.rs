@@ -83,6 +83,11 @@ pub struct TransientArgs {
     /// more than this re-linearizes and refactors the Newton matrix), or `off`. Default 1e-8.
     #[arg(long)]
     refresh: Option<String>,
+    /// `--model full`: capacity of the exact low-rank update of the Newton factor at active-set
+    /// refreshes, columns (one per changed pair row; a refresh that would exceed it refactors);
+    /// 0 refactors at every refresh. Default 96.
+    #[arg(long)]
+    low_rank: Option<usize>,
     /// Smallest step-size growth CVODE acts on after a successful step (≥ 1; CVODE's own
     /// default 1.5).
     #[arg(long)]
@@ -403,6 +408,12 @@ fn run_model(
     vtu_every: Option<usize>,
 ) -> Result<Outcome, Error> {
     let name = model_name(a);
+    if a.low_rank.is_some() && name != "full" {
+        return Err(Error::Invalid(
+            "--low-rank applies to --model full (the reduced model refactors its dense matrix)"
+                .into(),
+        ));
+    }
     if let Some(tol) = a.tolerance {
         return run_tolerance(a, &name, tol, model, opts, vtu_every);
     }
@@ -422,8 +433,11 @@ fn run_model(
             if a.train_end.is_some() {
                 return Err(train_end_error());
             }
-            let (res, frames) =
-                run_keeping(FullSystem::new(model)?, &Scene::of(model), opts, vtu_every)?;
+            let mut sys = FullSystem::new(model)?;
+            if let Some(cap) = a.low_rank {
+                sys.set_low_rank_capacity(cap);
+            }
+            let (res, frames) = run_keeping(sys, &Scene::of(model), opts, vtu_every)?;
             Ok(Outcome {
                 res,
                 basis_size: model.dofs(),
