@@ -81,6 +81,18 @@
 //! history's sensitivity, see `cases/reference/SOURCE.md`). Both the full and the reduced models
 //! use it: the baseline gets faster too.
 //!
+//! A refresh re-linearizes the pairs whose branch differs from the stored one (at the
+//! iterate; pairs on the same branch are left as linearized) and first asks the system to
+//! update its factor by their blocks alone at the factored γ
+//! ([`SecondOrderSystem::newton_update`]): the full model does that exactly by a low-rank
+//! (capacitance) correction, without refactoring ([`crate::system::FullSystem`]). If the system
+//! declines (the reduced model, whose dense refactorization is cheap, or a full correction),
+//! every pair is re-linearized and the matrix refactored at the current γ, as before. The pairs
+//! on a branch with a constant tangent (open, stick) are then exactly as a full
+//! re-linearization would leave them; the sliding ones keep the tangent of their last
+//! linearization — on the refined friction bars the step counts stay within their run-to-run
+//! scatter (README, *Full FE reference at scale*).
+//!
 //! ## What sets the step size (measured, friction bar, 0.2 s with friction, paper tolerances)
 //!
 //! | suspect | how measured | finding |

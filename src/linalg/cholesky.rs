@@ -221,7 +221,7 @@ impl SparseCholesky {
     /// [`Self::half_solve`] of one column in preallocated scratch (no allocation: the Newton
     /// solve of a low-rank corrected factor, [`crate::linalg::lowrank`]). NaN if the last
     /// factorization failed.
-    pub fn half_solve_vec_in_place(&mut self, x: &mut [f64]) {
+    pub(crate) fn half_solve_vec_in_place(&mut self, x: &mut [f64]) {
         if !self.factored {
             x.fill(f64::NAN);
             return;
@@ -238,7 +238,7 @@ impl SparseCholesky {
     }
 
     /// [`Self::half_solve_transpose`] of one column in preallocated scratch.
-    pub fn half_solve_transpose_vec_in_place(&mut self, x: &mut [f64]) {
+    pub(crate) fn half_solve_transpose_vec_in_place(&mut self, x: &mut [f64]) {
         if !self.factored {
             x.fill(f64::NAN);
             return;

@@ -25,12 +25,12 @@
 //!
 //! ## Cost
 //!
-//! Adding k columns costs k half solves (`L⁻¹ P u`, half a full solve each, blocked) and the
-//! products `Hᵀ H_new` (n · m · k); every later solve costs `4 n m` flops more than a plain
-//! solve. A refactorization of the full friction bar's Newton matrix costs about 10–15 single
-//! solves (10⁴–10⁵ DOF), so a correction of a few dozen columns pays as long as few columns are
-//! added per refactorization avoided; the owner chooses the capacity [`LowRankCholesky::new`]
-//! and refactors when it is full.
+//! Adding k columns costs k half solves (`L⁻¹ P u`, blocked) and the products `Hᵀ H_new`
+//! (n · m · k); every later solve costs `4 n m` flops more than a plain solve. Measured on the
+//! friction bar's Newton matrix at 10⁵ DOF (x13, this 2-core machine): a refactorization
+//! 0.58–0.70 s, a solve 47 ms, 48 new columns 0.16 s (3.4 ms each), a solve with 96 columns
+//! 79 ms. The owner chooses the capacity ([`LowRankCholesky::new`]) and refactors when it is
+//! full.
 //!
 //! Adding columns allocates (faer's blocked half solve and product workspace); solves do not.
 

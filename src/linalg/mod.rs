@@ -1,8 +1,9 @@
 //! Linear algebra under everything else: symmetric sparse storage and products ([`sparse`]), the
-//! sparse SPD Cholesky factorization ([`cholesky`]) and its low-rank corrections ([`lowrank`]), compensated double-double arithmetic for the
-//! ill-conditioned shell stiffness ([`compensated`]) and the generalized symmetric eigenproblem
-//! ([`eigen`]), and the blocked dense matrix–vector kernels of the reduced model's steps
-//! ([`kernels`]). Depends on nothing of jointrom but its error type.
+//! sparse SPD Cholesky factorization ([`cholesky`]) and its exact low-rank corrections
+//! ([`lowrank`]), compensated double-double arithmetic for the ill-conditioned shell stiffness
+//! ([`compensated`]) and the generalized symmetric eigenproblem ([`eigen`]), and the blocked
+//! dense matrix–vector kernels of the reduced model's steps ([`kernels`]). Depends on nothing
+//! of jointrom but its error type.
 
 pub mod cholesky;
 pub mod compensated;

@@ -20,7 +20,9 @@
 //! `K_c` block diagonal with one symmetric 3×3 block per pair. [`FullSystem`]: sparse, the
 //! pattern of `M + K + Bᵀ B` and its symbolic Cholesky analysis (AMD) built once at construction,
 //! a numeric refactorization per setup into preallocated storage. [`ReducedSystem`]: dense r × r,
-//! dense Cholesky in place. Neither allocates after construction.
+//! dense Cholesky in place. Neither allocates in a right-hand side or a Newton solve; the full
+//! model's exact low-rank refresh ([`SecondOrderSystem::newton_update`]) allocates when it adds
+//! columns (faer's blocked half solves).
 
 //!
 //! A system holds the structure and its load only: the contact law, the end time and the
