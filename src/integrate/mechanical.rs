@@ -81,6 +81,18 @@
 //! history's sensitivity, see `cases/reference/SOURCE.md`). Both the full and the reduced models
 //! use it: the baseline gets faster too.
 //!
+//! A refresh re-linearizes the pairs whose branch differs from the stored one (at the
+//! iterate; pairs on the same branch are left as linearized) and first asks the system to
+//! update its factor by their blocks alone at the factored γ
+//! ([`SecondOrderSystem::newton_update`]): the full model does that exactly by a low-rank
+//! (capacitance) correction, without refactoring ([`crate::system::FullSystem`]). If the system
+//! declines (the reduced model, whose dense refactorization is cheap, or a full correction),
+//! every pair is re-linearized and the matrix refactored at the current γ, as before. The pairs
+//! on a branch with a constant tangent (open, stick) are then exactly as a full
+//! re-linearization would leave them; the sliding ones keep the tangent of their last
+//! linearization — on the refined friction bars the step counts stay within their run-to-run
+//! scatter (README, *Full FE reference at scale*).
+//!
 //! ## What sets the step size (measured, friction bar, 0.2 s with friction, paper tolerances)
 //!
 //! | suspect | how measured | finding |
@@ -252,6 +264,12 @@ pub struct MechanicalOde<S: SecondOrderSystem> {
     refresh: Option<f64>,
     /// Re-linearizations inside Newton iterations (active-set refreshes).
     refreshes: u64,
+    /// Of those, the ones done by a low-rank update of the factor.
+    low_rank_refreshes: u64,
+    /// Pairs that had switched branch at a refresh, summed over the refreshes.
+    refresh_pairs: u64,
+    /// The pairs on another branch than linearized at a refresh (scratch, capacity w).
+    changed: Vec<usize>,
     /// The last right-hand side's `q`, slip states and joint kinematics `B q`: CVODE's Newton
     /// iteration evaluates the right-hand side at the iterate it then solves at, so the
     /// refresh check reuses the product when the iterate is the same.
@@ -334,6 +352,9 @@ impl<S: SecondOrderSystem> MechanicalOde<S> {
             branch: vec![PairState::Open; w],
             refresh: opts.refresh,
             refreshes: 0,
+            low_rank_refreshes: 0,
+            refresh_pairs: 0,
+            changed: Vec::with_capacity(w),
             rhs_q: vec![f64::NAN; n],
             rhs_s: vec![f64::NAN; if opts.friction { 2 * w } else { 0 }],
             rhs_u: vec![0.0; 3 * w],
@@ -619,26 +640,32 @@ impl<S: SecondOrderSystem> MechanicalOde<S> {
             self.sys.joint_apply_into(&y[..n], &mut self.u);
         }
         self.load_slip(y);
-        let switched = (0..self.w).any(|k| {
-            let uk = [self.u[3 * k], self.u[3 * k + 1], self.u[3 * k + 2]];
-            let sk = if self.law.friction {
-                [self.s_phys[2 * k], self.s_phys[2 * k + 1]]
-            } else {
-                [0.0; 2]
-            };
+        // The pairs on another branch than linearized (`changed`); a refresh when one of them
+        // is past its switch by more than the margin.
+        self.changed.clear();
+        let mut switched = false;
+        for k in 0..self.w {
+            let (uk, sk) = self.pair_kinematics(k);
             let (now, then) = (self.law.state(uk, sk), self.branch[k]);
-            if (now == PairState::Open) != (then == PairState::Open) {
-                uk[0].abs() > margin
-            } else if now != then {
-                self.law.cone_distance(uk, sk).abs() > slip_margin
-            } else {
-                false
+            if now == then {
+                continue;
             }
-        });
+            self.changed.push(k);
+            switched |= if (now == PairState::Open) != (then == PairState::Open) {
+                uk[0].abs() > margin
+            } else {
+                self.law.cone_distance(uk, sk).abs() > slip_margin
+            };
+        }
         if !switched {
             return Ok(());
         }
         self.refreshes += 1;
+        self.refresh_pairs += self.changed.len() as u64;
+        if self.update_changed() {
+            self.low_rank_refreshes += 1;
+            return Ok(());
+        }
         self.linearize();
         self.apply_gamma(gamma);
         self.sys
@@ -646,35 +673,95 @@ impl<S: SecondOrderSystem> MechanicalOde<S> {
             .map_err(|e| CallbackError::Recoverable(e.to_string()))
     }
 
+    /// Pair k's kinematics `[g, u_t1, u_t2]` in `u` and slip memory in `s_phys` (zero with
+    /// friction off), mm.
+    fn pair_kinematics(&self, k: usize) -> ([f64; 3], [f64; 2]) {
+        let uk = [self.u[3 * k], self.u[3 * k + 1], self.u[3 * k + 2]];
+        let sk = if self.law.friction {
+            [self.s_phys[2 * k], self.s_phys[2 * k + 1]]
+        } else {
+            [0.0; 2]
+        };
+        (uk, sk)
+    }
+
+    /// Re-linearizes the pairs in `changed` (those on another branch than linearized) at `u`,
+    /// `s_phys` and the factored γ, and asks the system to change its factor by their blocks
+    /// alone ([`SecondOrderSystem::newton_update`]). `false` if it did not: the caller then
+    /// re-linearizes every pair and refactors at the current γ. The other pairs keep their
+    /// linearization; the ones on a branch whose tangent is constant (open, stick) are then
+    /// exactly as a full re-linearization would make them, the sliding ones as at the last
+    /// linearization (as between setups).
+    fn update_changed(&mut self) -> bool {
+        for i in 0..self.changed.len() {
+            let k = self.changed[i];
+            let (uk, sk) = self.pair_kinematics(k);
+            let state = self.law.state(uk, sk);
+            let friction = self.law.friction;
+            let slip = |s: PairState| usize::from(friction && s == PairState::Slip);
+            self.slipping_at_setup = self.slipping_at_setup + slip(state) - slip(self.branch[k]);
+            self.branch[k] = state;
+            let tg = self.law.tangent(uk, sk);
+            self.lin[k] = PairLin {
+                sdot_u: tg.sdot_u,
+                sdot_g: tg.sdot_g,
+                pt_u: tg.pt_u,
+                pn_g: tg.pn_g,
+                diss_u: tg.diss_u,
+                diss_g: tg.diss_g,
+                ..PairLin::default()
+            };
+            self.apply_gamma_pair(k, self.lin_gamma);
+        }
+        self.sys.newton_update(&self.kc, &self.changed)
+    }
+
     /// Active-set refreshes so far ([`ProblemOptions::refresh`]).
     pub fn refreshes(&self) -> u64 {
         self.refreshes
     }
 
+    /// Of the [`MechanicalOde::refreshes`], those done by a low-rank update of the factor
+    /// ([`SecondOrderSystem::newton_update`]) instead of a refactorization.
+    pub fn low_rank_refreshes(&self) -> u64 {
+        self.low_rank_refreshes
+    }
+
+    /// Pairs that had switched branch at a refresh, summed over the refreshes.
+    pub fn refresh_pairs(&self) -> u64 {
+        self.refresh_pairs
+    }
+
     /// Builds K_c and the per-pair data for γ from the stored linearization.
     fn apply_gamma(&mut self, gamma: f64) {
-        for (k, l) in self.lin.iter_mut().enumerate() {
-            let a = [
-                [1.0 + gamma * l.sdot_u[0][0], gamma * l.sdot_u[0][1]],
-                [gamma * l.sdot_u[1][0], 1.0 + gamma * l.sdot_u[1][1]],
-            ];
-            let det = a[0][0] * a[1][1] - a[0][1] * a[1][0];
-            l.inv = [
-                [a[1][1] / det, -a[0][1] / det],
-                [-a[1][0] / det, a[0][0] / det],
-            ];
-            let te = matmul2(&l.pt_u, &l.inv);
-            let off = 0.5 * (te[0][1] + te[1][0]);
-            l.t_eff = [[te[0][0], off], [off, te[1][1]]];
-            let b = &mut self.kc[9 * k..9 * k + 9];
-            b.fill(0.0);
-            b[0] = l.pn_g;
-            b[4] = l.t_eff[0][0];
-            b[5] = l.t_eff[0][1];
-            b[7] = l.t_eff[1][0];
-            b[8] = l.t_eff[1][1];
+        for k in 0..self.w {
+            self.apply_gamma_pair(k, gamma);
         }
         self.lin_gamma = gamma;
+    }
+
+    /// [`MechanicalOde::apply_gamma`] of pair k.
+    fn apply_gamma_pair(&mut self, k: usize, gamma: f64) {
+        let l = &mut self.lin[k];
+        let a = [
+            [1.0 + gamma * l.sdot_u[0][0], gamma * l.sdot_u[0][1]],
+            [gamma * l.sdot_u[1][0], 1.0 + gamma * l.sdot_u[1][1]],
+        ];
+        let det = a[0][0] * a[1][1] - a[0][1] * a[1][0];
+        l.inv = [
+            [a[1][1] / det, -a[0][1] / det],
+            [-a[1][0] / det, a[0][0] / det],
+        ];
+        let te = matmul2(&l.pt_u, &l.inv);
+        let off = 0.5 * (te[0][1] + te[1][0]);
+        l.t_eff = [[te[0][0], off], [off, te[1][1]]];
+        let b = &mut self.kc[9 * k..9 * k + 9];
+        b.fill(0.0);
+        b[0] = l.pn_g;
+        b[4] = l.t_eff[0][0];
+        b[5] = l.t_eff[0][1];
+        b[7] = l.t_eff[1][0];
+        b[8] = l.t_eff[1][1];
     }
 }
 

@@ -221,4 +221,9 @@ pub struct OdeStats {
     /// Newton matrices refactored inside a Newton iteration by the problem itself (the
     /// mechanical problem's active-set refresh; not counted in `linear_setups`).
     pub newton_refreshes: u64,
+    /// Of the `newton_refreshes`, those done by an exact low-rank update of the factor instead
+    /// of a refactorization (the full model, [`crate::system::FullSystem`]).
+    pub newton_low_rank: u64,
+    /// Pairs that had switched branch at the refreshes, summed.
+    pub newton_refresh_pairs: u64,
 }

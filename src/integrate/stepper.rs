@@ -181,6 +181,8 @@ impl<S: SecondOrderSystem> Stepper<S> {
     pub fn stats(&self) -> OdeStats {
         let mut stats = self.cv.stats();
         stats.newton_refreshes = self.cv.problem().refreshes();
+        stats.newton_low_rank = self.cv.problem().low_rank_refreshes();
+        stats.newton_refresh_pairs = self.cv.problem().refresh_pairs();
         stats
     }
 

@@ -35,8 +35,10 @@ pub struct SparseCholesky {
     l_values: Vec<f64>,
     /// Parallelism of the numeric factorization and of many-column solves.
     par: Par,
-    /// Scratch of the numeric factorization and of a one-column solve.
+    /// Scratch of the numeric factorization and of a one-column solve or half solve.
     mem: MemBuffer,
+    /// n values: the permutation of a one-column half solve.
+    tmp: Vec<f64>,
     factored: bool,
 }
 
@@ -106,6 +108,7 @@ impl SparseCholesky {
             n,
             l_values: vec![0.0; symbolic.len_val()],
             mem: MemBuffer::new(req),
+            tmp: vec![0.0; n],
             pattern,
             symbolic,
             par,
@@ -189,57 +192,79 @@ impl SparseCholesky {
     /// Half solve `x ← L⁻¹ P x` for all columns (sequential): with [`Self::half_solve_transpose`],
     /// `A⁻¹ = (Pᵀ L⁻ᵀ)(L⁻¹ P)`.
     pub(crate) fn half_solve(&self, mut x: MatMut<'_, f64>) {
-        self.permute(x.rb_mut(), false);
-        self.triangular(x, false);
+        let mut tmp = vec![0.0; self.n];
+        let mut mem = MemBuffer::new(self.triangular_scratch(x.ncols()));
+        permute(&self.symbolic, x.rb_mut(), false, &mut tmp);
+        triangular(
+            &self.symbolic,
+            &self.l_values,
+            x,
+            false,
+            MemStack::new(&mut mem),
+        );
     }
 
     /// Half solve `x ← Pᵀ L⁻ᵀ x` for all columns (sequential).
     pub(crate) fn half_solve_transpose(&self, mut x: MatMut<'_, f64>) {
-        self.triangular(x.rb_mut(), true);
-        self.permute(x, true);
-    }
-
-    /// `x ← P x` (`inverse` false) or `x ← Pᵀ x`, in faer's convention `(P x)_i = x_{fwd(i)}`.
-    fn permute(&self, mut x: MatMut<'_, f64>, inverse: bool) {
-        let Some(perm) = self.symbolic.perm() else {
-            return;
-        };
-        let (fwd, inv) = perm.arrays();
-        let map = if inverse { inv } else { fwd };
         let mut tmp = vec![0.0; self.n];
-        for j in 0..x.ncols() {
-            for (t, &src) in tmp.iter_mut().zip(map) {
-                *t = x[(src, j)];
-            }
-            for (i, &t) in tmp.iter().enumerate() {
-                x[(i, j)] = t;
-            }
+        let mut mem = MemBuffer::new(self.triangular_scratch(x.ncols()));
+        triangular(
+            &self.symbolic,
+            &self.l_values,
+            x.rb_mut(),
+            true,
+            MemStack::new(&mut mem),
+        );
+        permute(&self.symbolic, x, true, &mut tmp);
+    }
+
+    /// [`Self::half_solve`] of one column in preallocated scratch (no allocation: the Newton
+    /// solve of a low-rank corrected factor, [`crate::linalg::lowrank`]). NaN if the last
+    /// factorization failed.
+    pub(crate) fn half_solve_vec_in_place(&mut self, x: &mut [f64]) {
+        if !self.factored {
+            x.fill(f64::NAN);
+            return;
+        }
+        let mut x = MatMut::from_column_major_slice_mut(x, self.n, 1);
+        permute(&self.symbolic, x.rb_mut(), false, &mut self.tmp);
+        triangular(
+            &self.symbolic,
+            &self.l_values,
+            x,
+            false,
+            MemStack::new(&mut self.mem),
+        );
+    }
+
+    /// [`Self::half_solve_transpose`] of one column in preallocated scratch.
+    pub(crate) fn half_solve_transpose_vec_in_place(&mut self, x: &mut [f64]) {
+        if !self.factored {
+            x.fill(f64::NAN);
+            return;
+        }
+        let mut x = MatMut::from_column_major_slice_mut(x, self.n, 1);
+        triangular(
+            &self.symbolic,
+            &self.l_values,
+            x.rb_mut(),
+            true,
+            MemStack::new(&mut self.mem),
+        );
+        permute(&self.symbolic, x, true, &mut self.tmp);
+    }
+
+    /// Scratch of a triangular half solve with `ncols` columns.
+    fn triangular_scratch(&self, ncols: usize) -> StackReq {
+        match self.symbolic.raw() {
+            SymbolicCholeskyRaw::Simplicial(_) => StackReq::EMPTY,
+            SymbolicCholeskyRaw::Supernodal(s) => s.solve_in_place_scratch::<f64>(ncols, Par::Seq),
         }
     }
 
-    /// `x ← L⁻¹ x` or (`transpose`) `x ← L⁻ᵀ x` with the (permuted) factor L.
-    fn triangular(&self, x: MatMut<'_, f64>, transpose: bool) {
-        let par = Par::Seq;
-        match self.symbolic.raw() {
-            SymbolicCholeskyRaw::Simplicial(s) => {
-                let l = SparseColMatRef::<'_, usize, f64>::new(s.factor(), &self.l_values);
-                if transpose {
-                    solve_lower_triangular_transpose_in_place(l, Conj::No, x, par);
-                } else {
-                    solve_lower_triangular_in_place(l, Conj::No, x, par);
-                }
-            }
-            SymbolicCholeskyRaw::Supernodal(s) => {
-                let scratch = s.solve_in_place_scratch::<f64>(x.ncols(), par);
-                let stack = &mut MemBuffer::new(scratch);
-                let l = SupernodalLltRef::new(s, &self.l_values);
-                if transpose {
-                    l.l_transpose_solve_with_conj(Conj::No, x, par, MemStack::new(stack));
-                } else {
-                    l.l_solve_with_conj(Conj::No, x, par, MemStack::new(stack));
-                }
-            }
-        }
+    /// Whether the last numeric factorization succeeded.
+    pub fn is_factored(&self) -> bool {
+        self.factored
     }
 
     /// Whether faer chose the supernodal factor (tests: which solve path is exercised).
@@ -251,6 +276,58 @@ impl SparseCholesky {
     /// Dimension.
     pub fn dim(&self) -> usize {
         self.n
+    }
+}
+
+/// `x ← P x` (`inverse` false) or `x ← Pᵀ x`, in faer's convention `(P x)_i = x_{fwd(i)}`;
+/// `tmp` holds n values.
+fn permute(
+    symbolic: &SymbolicCholesky<usize>,
+    mut x: MatMut<'_, f64>,
+    inverse: bool,
+    tmp: &mut [f64],
+) {
+    let Some(perm) = symbolic.perm() else {
+        return;
+    };
+    let (fwd, inv) = perm.arrays();
+    let map = if inverse { inv } else { fwd };
+    for j in 0..x.ncols() {
+        for (t, &src) in tmp.iter_mut().zip(map) {
+            *t = x[(src, j)];
+        }
+        for (i, &t) in tmp.iter().enumerate() {
+            x[(i, j)] = t;
+        }
+    }
+}
+
+/// `x ← L⁻¹ x` or (`transpose`) `x ← L⁻ᵀ x` with the (permuted) factor L (sequential).
+fn triangular(
+    symbolic: &SymbolicCholesky<usize>,
+    l_values: &[f64],
+    x: MatMut<'_, f64>,
+    transpose: bool,
+    stack: &mut MemStack,
+) {
+    let par = Par::Seq;
+    match symbolic.raw() {
+        SymbolicCholeskyRaw::Simplicial(s) => {
+            let l = SparseColMatRef::<'_, usize, f64>::new(s.factor(), l_values);
+            if transpose {
+                solve_lower_triangular_transpose_in_place(l, Conj::No, x, par);
+            } else {
+                solve_lower_triangular_in_place(l, Conj::No, x, par);
+            }
+        }
+        SymbolicCholeskyRaw::Supernodal(s) => {
+            let l = SupernodalLltRef::new(s, l_values);
+            if transpose {
+                l.l_transpose_solve_with_conj(Conj::No, x, par, stack);
+            } else {
+                l.l_solve_with_conj(Conj::No, x, par, stack);
+            }
+        }
     }
 }
 

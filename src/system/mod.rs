@@ -20,7 +20,9 @@
 //! `K_c` block diagonal with one symmetric 3×3 block per pair. [`FullSystem`]: sparse, the
 //! pattern of `M + K + Bᵀ B` and its symbolic Cholesky analysis (AMD) built once at construction,
 //! a numeric refactorization per setup into preallocated storage. [`ReducedSystem`]: dense r × r,
-//! dense Cholesky in place. Neither allocates after construction.
+//! dense Cholesky in place. Neither allocates in a right-hand side or a Newton solve; the full
+//! model's exact low-rank refresh ([`SecondOrderSystem::newton_update`]) allocates when it adds
+//! columns (faer's blocked half solves).
 
 //!
 //! A system holds the structure and its load only: the contact law, the end time and the
@@ -86,8 +88,20 @@ pub trait SecondOrderSystem {
     /// Factors `M + γ² (K + Bᵀ K_c B)`; `kc` holds one 3×3 row-major symmetric block per pair
     /// (N/mm). Errors if the matrix is not positive definite.
     fn newton_factor(&mut self, gamma: f64, kc: &[f64]) -> Result<(), Error>;
-    /// `x ← A⁻¹ x` with the last [`SecondOrderSystem::newton_factor`].
+    /// `x ← A⁻¹ x` with the last [`SecondOrderSystem::newton_factor`] (and the
+    /// [`SecondOrderSystem::newton_update`]s since).
     fn newton_solve_in_place(&mut self, x: &mut [f64]);
+    /// Changes the factored Newton matrix in the blocks of the pairs `changed` only, to their
+    /// blocks in `kc` (every other pair's block must be the one factored), at the γ of the last
+    /// [`SecondOrderSystem::newton_factor`] `γ_f`:
+    /// `A ← A + γ_f² Σ_{i ∈ changed} B_iᵀ (K_c,i − K_c,i^factored) B_i`, exactly, without
+    /// refactoring. `false` if the system does not do this (the default; the reduced model's
+    /// dense refactorization is cheap) or cannot now (its correction is full): the caller then
+    /// refactors with [`SecondOrderSystem::newton_factor`].
+    fn newton_update(&mut self, kc: &[f64], changed: &[usize]) -> bool {
+        let _ = (kc, changed);
+        false
+    }
     /// The master node's `[ux, uy, uz (mm), rx, ry, rz (rad)]` at `q`.
     fn master_displacement(&self, q: &[f64]) -> [f64; 6];
     /// The physical size of a unit of each coordinate: the largest nodal displacement (mm) or

@@ -720,6 +720,8 @@ impl<P: OdeProblem> Cvode<P> {
             last_step: if step != 0.0 { step } else { b.last_step },
             stab_lim_order_reductions: b.stab_lim_order_reductions + c(CVodeGetNumStabLimOrderReds),
             newton_refreshes: 0,
+            newton_low_rank: 0,
+            newton_refresh_pairs: 0,
         }
     }
 

@@ -11,6 +11,7 @@ use jointrom::integrate::problem::{Iteration, NewtonLinear};
 use jointrom::integrate::{self as driver, integrate, Curves, Run, TransientOptions};
 use jointrom::reduction::rom_file as export;
 use jointrom::reduction::{build_basis, BasisKind, BasisOptions, JointFlexibility};
+use jointrom::studies::reference::{ReferenceCurves, ReferenceErrors};
 use jointrom::studies::tolerance::{run_estimated, tolerance_model, RunEstimate, ToleranceOptions};
 use jointrom::studies::training::train_snapshot_basis;
 use jointrom::system::{FullSystem, ReducedSystem, Scene, SecondOrderSystem};
@@ -83,6 +84,11 @@ pub struct TransientArgs {
     /// more than this re-linearizes and refactors the Newton matrix), or `off`. Default 1e-8.
     #[arg(long)]
     refresh: Option<String>,
+    /// `--model full`: capacity of the exact low-rank update of the Newton factor at active-set
+    /// refreshes, columns (one per changed pair row; a refresh that would exceed it refactors);
+    /// 0 refactors at every refresh. Default 96.
+    #[arg(long)]
+    low_rank: Option<usize>,
     /// Smallest step-size growth CVODE acts on after a successful step (≥ 1; CVODE's own
     /// default 1.5).
     #[arg(long)]
@@ -97,6 +103,12 @@ pub struct TransientArgs {
     /// an error (and the curves up to the time reached in --json/--out).
     #[arg(long, default_value_t = jointrom::integrate::driver::DEFAULT_MAX_WALL_S)]
     max_wall: f64,
+    /// Compare the run with stored reference curves (CSV with columns t, contact_force_norm,
+    /// friction_force_norm, master_uy — e.g. `cases/reference/scale/*.csv` or a run's
+    /// curves.csv — or a compact JSON reference): relative L2 errors of ‖f_c‖, ‖f_R‖ and u_y
+    /// over the shared output times, JSON `"reference_error"`.
+    #[arg(long)]
+    reference: Option<PathBuf>,
     /// One JSON document on stdout (with the curves).
     #[arg(long)]
     json: bool,
@@ -165,12 +177,31 @@ struct Outcome {
 
 pub fn run(a: TransientArgs) -> Result<(), Error> {
     let opts = transient_options(&a)?;
+    let reference = match &a.reference {
+        Some(path) => {
+            let r = ReferenceCurves::read(path)?;
+            crate::common::record_input(format!("reference curves {}", path.display()));
+            Some(r)
+        }
+        None => None,
+    };
     let model = crate::common::load_model(&a.case)?;
     let vtu_every = vtu_every(&a, &opts, &model)?;
     let t0 = Instant::now();
     let mut o = run_model(&a, &model, &opts, vtu_every)?;
     let total_s = t0.elapsed().as_secs_f64();
     let c = &o.res.curves;
+    let reference_error = reference.as_ref().map(|r| {
+        let e = r.errors(c);
+        json!({
+            "path": a.reference.as_ref().map(|p| p.display().to_string()),
+            "contact_force": e.contact_force,
+            "friction_force": e.friction_force,
+            "master_uy": e.master_uy,
+            "compared_outputs": e.compared_outputs,
+            "compared_until": e.compared_until,
+        })
+    });
     let doc = json!({
         "case": model.name,
         "model": model_name(&a),
@@ -186,6 +217,7 @@ pub fn run(a: TransientArgs) -> Result<(), Error> {
         "cpu_s": o.res.cpu_s,
         "total_s": total_s,
         "error_estimate": estimate_json(&o.estimate),
+        "reference_error": reference_error,
         "curves": c,
         "energy_balance": c.balance(),
         "energy_check": c.energy_check(opts.energy_resolution()),
@@ -214,6 +246,9 @@ pub fn run(a: TransientArgs) -> Result<(), Error> {
         print_json(&doc);
     } else {
         print_summary(&a, &model, &o, total_s);
+        if let Some(r) = &reference {
+            print_reference_errors(&r.errors(c));
+        }
     }
     let met = o
         .tolerance
@@ -403,6 +438,12 @@ fn run_model(
     vtu_every: Option<usize>,
 ) -> Result<Outcome, Error> {
     let name = model_name(a);
+    if a.low_rank.is_some() && name != "full" {
+        return Err(Error::Invalid(
+            "--low-rank applies to --model full (the reduced model refactors its dense matrix)"
+                .into(),
+        ));
+    }
     if let Some(tol) = a.tolerance {
         return run_tolerance(a, &name, tol, model, opts, vtu_every);
     }
@@ -422,8 +463,11 @@ fn run_model(
             if a.train_end.is_some() {
                 return Err(train_end_error());
             }
-            let (res, frames) =
-                run_keeping(FullSystem::new(model)?, &Scene::of(model), opts, vtu_every)?;
+            let mut sys = FullSystem::new(model)?;
+            if let Some(cap) = a.low_rank {
+                sys.set_low_rank_capacity(cap);
+            }
+            let (res, frames) = run_keeping(sys, &Scene::of(model), opts, vtu_every)?;
             Ok(Outcome {
                 res,
                 basis_size: model.dofs(),
@@ -662,4 +706,17 @@ fn print_summary(a: &TransientArgs, model: &Model, o: &Outcome, total_s: f64) {
         Some(Err(why)) => println!("error estimate unavailable: {why}"),
         None => {}
     }
+}
+
+/// `--reference`: the relative L2 errors against the stored curves.
+fn print_reference_errors(e: &ReferenceErrors) {
+    let pct = |v: Option<f64>| v.map_or("–".to_string(), |v| format!("{:.3} %", 100.0 * v));
+    println!(
+        "against the reference ({} outputs to {:.4e} s, relative L2): |f_c| {}, |f_R| {}, uy {}",
+        e.compared_outputs,
+        e.compared_until,
+        pct(e.contact_force),
+        pct(e.friction_force),
+        pct(e.master_uy)
+    );
 }

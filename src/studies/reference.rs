@@ -1,0 +1,267 @@
+//! Stored reference curves (full-FE runs kept under `cases/reference/`) and the relative L2
+//! errors of a run against them: `jointrom transient CASE --reference PATH`.
+//!
+//! A reference holds, at its output times `t` (s), ‖f_c‖ and ‖f_R‖ (N) and the master node's
+//! u_y (mm). The error of a run's curve `a` against the reference curve `r` is
+//!
+//! ```text
+//! e = sqrt( Σ_k (a(t_k) − r(t_k))² / Σ_k r(t_k)² )
+//! ```
+//!
+//! over the output times `t_k` the run and the reference share (matched to 1e-6 of the smaller
+//! output spacing, [`relative_l2`]): a run over a shorter span is compared over its span, a run
+//! with a coarser output step at its own outputs.
+//!
+//! Two file formats: CSV with a header naming the columns `t`, `contact_force_norm`,
+//! `friction_force_norm`, `master_uy` (others ignored, so a run's own `curves.csv` is a
+//! reference), and the compact JSON of `cases/reference/compact.py` (arrays of those names).
+
+use std::path::Path;
+
+use serde::Serialize;
+
+use crate::error::Error;
+use crate::integrate::Curves;
+use crate::studies::stability::relative_l2;
+
+/// The compared curves of a reference run.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ReferenceCurves {
+    /// Output times, s (strictly increasing).
+    pub t: Vec<f64>,
+    /// ‖f_c‖, N.
+    pub contact_force_norm: Vec<f64>,
+    /// ‖f_R‖, N.
+    pub friction_force_norm: Vec<f64>,
+    /// Master u_y, mm.
+    pub master_uy: Vec<f64>,
+}
+
+/// The relative L2 errors of a run against a reference (module docs); `None` where the
+/// reference curve is zero over the compared times (e.g. ‖f_R‖ with friction off).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct ReferenceErrors {
+    /// ‖f_c‖(t).
+    pub contact_force: Option<f64>,
+    /// ‖f_R‖(t).
+    pub friction_force: Option<f64>,
+    /// Master u_y(t).
+    pub master_uy: Option<f64>,
+    /// Output times compared (shared by the run and the reference).
+    pub compared_outputs: usize,
+    /// Last compared time, s.
+    pub compared_until: f64,
+}
+
+const COLUMNS: [&str; 4] = [
+    "t",
+    "contact_force_norm",
+    "friction_force_norm",
+    "master_uy",
+];
+
+impl ReferenceCurves {
+    /// Reads a reference file: JSON if its name ends in `.json`, else CSV (module docs).
+    ///
+    /// # Errors
+    /// [`Error::Invalid`] naming the file (and the line of a CSV) for a missing column, a value
+    /// that is not a finite number, curves of different lengths, fewer than two outputs or
+    /// times that do not increase.
+    pub fn read(path: &Path) -> Result<ReferenceCurves, Error> {
+        let text = crate::files::read_text(path)?;
+        let what = path.display().to_string();
+        if path.extension().is_some_and(|e| e == "json") {
+            ReferenceCurves::parse_json(&text, &what)
+        } else {
+            ReferenceCurves::parse_csv(&text, &what)
+        }
+    }
+
+    /// Parses the CSV form; `what` names the source in errors.
+    pub fn parse_csv(text: &str, what: &str) -> Result<ReferenceCurves, Error> {
+        let bad = |m: String| Error::Invalid(format!("reference {what}: {m}"));
+        let mut r = csv::ReaderBuilder::new()
+            .trim(csv::Trim::All)
+            .from_reader(text.as_bytes());
+        let header = r.headers().map_err(|e| bad(e.to_string()))?.clone();
+        let mut index = [0usize; 4];
+        for (slot, name) in index.iter_mut().zip(COLUMNS) {
+            *slot = header
+                .iter()
+                .position(|h| h == name)
+                .ok_or_else(|| bad(format!("no column `{name}` in the header")))?;
+        }
+        let mut cols: [Vec<f64>; 4] = Default::default();
+        for (row, rec) in r.records().enumerate() {
+            let rec = rec.map_err(|e| bad(e.to_string()))?;
+            for (col, &i) in cols.iter_mut().zip(&index) {
+                let cell = rec.get(i).unwrap_or("");
+                let v = cell
+                    .parse::<f64>()
+                    .ok()
+                    .filter(|v| v.is_finite())
+                    .ok_or_else(|| {
+                        bad(format!(
+                            "line {}: `{}` is not a finite number",
+                            row + 2,
+                            crate::files::printable(cell)
+                        ))
+                    })?;
+                col.push(v);
+            }
+        }
+        let [t, fc, fr, uy] = cols;
+        ReferenceCurves::checked(t, fc, fr, uy, what)
+    }
+
+    /// Parses the compact JSON form (`cases/reference/compact.py`).
+    pub fn parse_json(text: &str, what: &str) -> Result<ReferenceCurves, Error> {
+        let bad = |m: String| Error::Invalid(format!("reference {what}: {m}"));
+        let v: serde_json::Value = serde_json::from_str(text).map_err(|e| bad(e.to_string()))?;
+        let arr = |name: &str| -> Result<Vec<f64>, Error> {
+            v[name]
+                .as_array()
+                .ok_or_else(|| bad(format!("no array `{name}`")))?
+                .iter()
+                .map(|x| {
+                    x.as_f64()
+                        .filter(|x| x.is_finite())
+                        .ok_or_else(|| bad(format!("`{name}` holds a value that is not a number")))
+                })
+                .collect()
+        };
+        ReferenceCurves::checked(
+            arr(COLUMNS[0])?,
+            arr(COLUMNS[1])?,
+            arr(COLUMNS[2])?,
+            arr(COLUMNS[3])?,
+            what,
+        )
+    }
+
+    fn checked(
+        t: Vec<f64>,
+        contact_force_norm: Vec<f64>,
+        friction_force_norm: Vec<f64>,
+        master_uy: Vec<f64>,
+        what: &str,
+    ) -> Result<ReferenceCurves, Error> {
+        let bad = |m: String| Error::Invalid(format!("reference {what}: {m}"));
+        let n = t.len();
+        if [&contact_force_norm, &friction_force_norm, &master_uy]
+            .iter()
+            .any(|c| c.len() != n)
+        {
+            return Err(bad("the curves have different lengths".into()));
+        }
+        if n < 2 {
+            return Err(bad(format!("{n} outputs; at least 2 are needed")));
+        }
+        if let Some(i) = t.windows(2).position(|w| w[1] <= w[0]) {
+            return Err(bad(format!(
+                "times do not increase at output {}: {} s after {} s",
+                i + 1,
+                t[i + 1],
+                t[i]
+            )));
+        }
+        Ok(ReferenceCurves {
+            t,
+            contact_force_norm,
+            friction_force_norm,
+            master_uy,
+        })
+    }
+
+    /// The errors of a run's curves against the reference (module docs).
+    pub fn errors(&self, c: &Curves) -> ReferenceErrors {
+        let l2 = |a: &[f64], r: &[f64]| relative_l2(&c.t, a, &self.t, r);
+        let (count, until) = self.shared_times(&c.t);
+        ReferenceErrors {
+            contact_force: l2(&c.contact_force_norm, &self.contact_force_norm),
+            friction_force: l2(&c.friction_force_norm, &self.friction_force_norm),
+            master_uy: l2(&c.master_uy, &self.master_uy),
+            compared_outputs: count,
+            compared_until: until,
+        }
+    }
+
+    /// How many of `t` the reference has too (the matching of [`relative_l2`]), and the last.
+    fn shared_times(&self, t: &[f64]) -> (usize, f64) {
+        let spacing = |t: &[f64]| {
+            t.windows(2)
+                .map(|w| w[1] - w[0])
+                .filter(|d| *d > 0.0)
+                .fold(f64::INFINITY, f64::min)
+        };
+        let tol = 1e-6 * spacing(t).min(spacing(&self.t));
+        let (mut count, mut last) = (0, f64::NAN);
+        let mut j = 0;
+        for &x in t {
+            while j < self.t.len() && self.t[j] < x - tol {
+                j += 1;
+            }
+            if j < self.t.len() && (self.t[j] - x).abs() <= tol {
+                count += 1;
+                last = x;
+            }
+        }
+        (count, last)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn curves(t: &[f64], f: impl Fn(f64) -> f64) -> Curves {
+        Curves {
+            t: t.to_vec(),
+            contact_force_norm: t.iter().map(|&x| f(x)).collect(),
+            friction_force_norm: t.iter().map(|&x| 0.25 * f(x)).collect(),
+            master_uy: t.iter().map(|&x| -x).collect(),
+            ..Curves::default()
+        }
+    }
+
+    const CSV: &str = "t,contact_force_norm,friction_force_norm,master_uy,extra\n\
+                       0,0,0,0,9\n1e-4,1,0.25,-1e-4,9\n2e-4,2,0.5,-2e-4,9\n3e-4,3,0.75,-3e-4,9\n";
+
+    #[test]
+    fn csv_reference_errors() {
+        let r = ReferenceCurves::parse_csv(CSV, "test").unwrap();
+        assert_eq!(r.t.len(), 4);
+        let exact = curves(&r.t.clone(), |x| 1e4 * x);
+        let e = r.errors(&exact);
+        assert!(e.contact_force.unwrap() < 1e-12 && e.master_uy.unwrap() < 1e-12);
+        assert_eq!(e.compared_outputs, 4);
+        // 10 % more force, over the first three outputs only (a shorter run).
+        let off = curves(&r.t[..3], |x| 1.1e4 * x);
+        let e = r.errors(&off);
+        assert!((e.contact_force.unwrap() - 0.1).abs() < 1e-12, "{e:?}");
+        assert!((e.friction_force.unwrap() - 0.1).abs() < 1e-12);
+        assert_eq!((e.compared_outputs, e.compared_until), (3, 2e-4));
+    }
+
+    #[test]
+    fn bad_references_are_refused_with_their_place() {
+        let missing = "t,contact_force_norm,master_uy\n0,0,0\n1,1,1\n";
+        let e = ReferenceCurves::parse_csv(missing, "f.csv").unwrap_err();
+        assert!(e.to_string().contains("friction_force_norm"), "{e}");
+        let nan = CSV.replace("2e-4,2,", "2e-4,nan,");
+        let e = ReferenceCurves::parse_csv(&nan, "f.csv").unwrap_err();
+        assert!(e.to_string().contains("line 4"), "{e}");
+        let back = CSV.replace("3e-4,3", "1e-4,3");
+        let e = ReferenceCurves::parse_csv(&back, "f.csv").unwrap_err();
+        assert!(e.to_string().contains("do not increase"), "{e}");
+        let json =
+            r#"{"t":[0,1],"contact_force_norm":[0,1],"friction_force_norm":[0],"master_uy":[0,1]}"#;
+        let e = ReferenceCurves::parse_json(json, "f.json").unwrap_err();
+        assert!(e.to_string().contains("different lengths"), "{e}");
+        let ok = json.replace(r#"[0],"#, r#"[0,0.5],"#);
+        assert_eq!(
+            ReferenceCurves::parse_json(&ok, "f.json").unwrap().t,
+            vec![0.0, 1.0]
+        );
+    }
+}
