@@ -79,8 +79,12 @@ fn snapshot_pod_rom_reproduces_its_training_run() {
     };
     let (fc_pod, uy_pod) = err(&pod);
     let (fc_g0, _) = err(&g0);
-    // Measured 0.021 with area welds (0.01–0.02 with point welds).
-    assert!(fc_pod < 3e-2, "POD-snapshot ROM ‖f_c‖ error {fc_pod}");
+    // Measured 0.021 with area welds (0.01–0.02 with point welds) on a training run whose
+    // refreshes refactored; 0.047 since they are low-rank updates of the factor
+    // (`FullSystem::newton_update`), which move the training run's own ‖f_c‖ in this window
+    // (≤ 0.02 N, i.e. gaps at 2e-6 mm against atol 1e-6 mm) by 2.1e-2 — the bound is the ROM's
+    // error against a curve known to about that.
+    assert!(fc_pod < 6e-2, "POD-snapshot ROM ‖f_c‖ error {fc_pod}");
     assert!(uy_pod < 1e-3, "POD-snapshot ROM u_y error {uy_pod}");
     assert!(
         fc_g0 > 10.0 * fc_pod,
