@@ -598,27 +598,11 @@ impl<S: SecondOrderSystem> MechanicalOde<S> {
     fn linearize(&mut self) {
         let mut slipping = 0;
         for k in 0..self.w {
-            let uk = [self.u[3 * k], self.u[3 * k + 1], self.u[3 * k + 2]];
-            let sk = if self.law.friction {
-                [self.s_phys[2 * k], self.s_phys[2 * k + 1]]
-            } else {
-                [0.0; 2]
-            };
-            let tg = self.law.tangent(uk, sk);
-            let state = self.law.state(uk, sk);
+            let state = self.linearize_pair(k);
             if self.law.friction && state == PairState::Slip {
                 slipping += 1;
             }
             self.branch[k] = state;
-            self.lin[k] = PairLin {
-                sdot_u: tg.sdot_u,
-                sdot_g: tg.sdot_g,
-                pt_u: tg.pt_u,
-                pn_g: tg.pn_g,
-                diss_u: tg.diss_u,
-                diss_g: tg.diss_g,
-                ..PairLin::default()
-            };
         }
         self.slipping_at_setup = slipping;
         self.have_lin = true;
@@ -675,6 +659,23 @@ impl<S: SecondOrderSystem> MechanicalOde<S> {
 
     /// Pair k's kinematics `[g, u_t1, u_t2]` in `u` and slip memory in `s_phys` (zero with
     /// friction off), mm.
+    /// Pair k's tangent at its kinematics into `lin[k]` (γ-dependent parts left to
+    /// [`MechanicalOde::apply_gamma_pair`]); returns its branch there.
+    fn linearize_pair(&mut self, k: usize) -> PairState {
+        let (uk, sk) = self.pair_kinematics(k);
+        let tg = self.law.tangent(uk, sk);
+        self.lin[k] = PairLin {
+            sdot_u: tg.sdot_u,
+            sdot_g: tg.sdot_g,
+            pt_u: tg.pt_u,
+            pn_g: tg.pn_g,
+            diss_u: tg.diss_u,
+            diss_g: tg.diss_g,
+            ..PairLin::default()
+        };
+        self.law.state(uk, sk)
+    }
+
     fn pair_kinematics(&self, k: usize) -> ([f64; 3], [f64; 2]) {
         let uk = [self.u[3 * k], self.u[3 * k + 1], self.u[3 * k + 2]];
         let sk = if self.law.friction {
@@ -695,22 +696,11 @@ impl<S: SecondOrderSystem> MechanicalOde<S> {
     fn update_changed(&mut self) -> bool {
         for i in 0..self.changed.len() {
             let k = self.changed[i];
-            let (uk, sk) = self.pair_kinematics(k);
-            let state = self.law.state(uk, sk);
+            let state = self.linearize_pair(k);
             let friction = self.law.friction;
             let slip = |s: PairState| usize::from(friction && s == PairState::Slip);
             self.slipping_at_setup = self.slipping_at_setup + slip(state) - slip(self.branch[k]);
             self.branch[k] = state;
-            let tg = self.law.tangent(uk, sk);
-            self.lin[k] = PairLin {
-                sdot_u: tg.sdot_u,
-                sdot_g: tg.sdot_g,
-                pt_u: tg.pt_u,
-                pn_g: tg.pn_g,
-                diss_u: tg.diss_u,
-                diss_g: tg.diss_g,
-                ..PairLin::default()
-            };
             self.apply_gamma_pair(k, self.lin_gamma);
         }
         self.sys.newton_update(&self.kc, &self.changed)
