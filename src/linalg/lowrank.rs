@@ -364,6 +364,14 @@ mod tests {
     }
 
     /// `A + U C Uᵀ` of sparse columns `u` (row, value) and dense symmetric C, densified.
+    /// `max_i |(A x − b)_i|` for the dense `a`.
+    fn max_residual(a: &Mat<f64>, x: &[f64], b: &[f64]) -> f64 {
+        let res = a * Mat::from_fn(x.len(), 1, |i, _| x[i]);
+        (0..b.len())
+            .map(|i| (res[(i, 0)] - b[i]).abs())
+            .fold(0.0, f64::max)
+    }
+
     fn corrected(a: &SymCsc, u: &[Vec<(usize, f64)>], c: &[Vec<f64>]) -> Mat<f64> {
         let n = a.n;
         let mut d = Mat::<f64>::zeros(n, n);
@@ -454,11 +462,7 @@ mod tests {
             let b: Vec<f64> = (0..n).map(|_| r()).collect();
             let mut x = b.clone();
             lr.solve_in_place(&mut chol, &mut x);
-            let xm = Mat::from_fn(n, 1, |i, _| x[i]);
-            let res = &dense * &xm;
-            let err = (0..n)
-                .map(|i| (res[(i, 0)] - b[i]).abs())
-                .fold(0.0, f64::max);
+            let err = max_residual(&dense, &x, &b);
             let xn = x.iter().fold(0.0f64, |a, v| a.max(v.abs()));
             assert!(
                 err <= 1e3 * n as f64 * f64::EPSILON * (1.0 + xn),
@@ -534,11 +538,7 @@ mod tests {
             let b: Vec<f64> = (0..n).map(|_| r()).collect();
             let mut x = b.clone();
             lr.solve_in_place(&mut chol, &mut x);
-            let xm = Mat::from_fn(n, 1, |i, _| x[i]);
-            let res = &dense * &xm;
-            let err = (0..n)
-                .map(|i| (res[(i, 0)] - b[i]).abs())
-                .fold(0.0, f64::max);
+            let err = max_residual(&dense, &x, &b);
             assert!(err < 1e-9, "batch {batch}, m = {m}: residual {err:e}");
         }
     }
