@@ -24,6 +24,7 @@ use faer::{c64, Col, ColRef, Mat, MatMut, MatRef, Par, Scale, Side};
 use crate::error::Error;
 use crate::linalg::cholesky::SparseCholesky;
 use crate::linalg::sparse::{sym_mul_mat, sym_mul_vec_into};
+use crate::linalg::symmetric_eigen;
 use crate::linalg::LinalgError;
 use crate::linalg::SymCsc;
 
@@ -277,10 +278,8 @@ fn refine(op: &InverseOperator<'_>, z: Mat<f64>) -> Result<(Vec<f64>, Mat<f64>, 
     op.apply(w.as_mut(), q.as_ref(), Par::Seq, MemStack::new(stack));
     let g = q.transpose() * &w;
     let g = Mat::from_fn(count, count, |i, j| 0.5 * (g[(i, j)] + g[(j, i)]));
-    let evd = g
-        .self_adjoint_eigen(Side::Lower)
-        .map_err(|e| Error::LinearAlgebra(format!("Rayleigh–Ritz eigensolver: {e:?}").into()))?;
-    let s = evd.S().column_vector();
+    let evd = symmetric_eigen(g.as_ref(), "Rayleigh–Ritz").map_err(Error::LinearAlgebra)?;
+    let s = &evd.values;
     let mu: Vec<f64> = (0..count).map(|c| s[count - 1 - c]).collect();
     if let Some(&bad) = mu.iter().find(|&&v| !(v.is_finite() && v > 0.0)) {
         return Err(Error::LinearAlgebra(
@@ -288,7 +287,7 @@ fn refine(op: &InverseOperator<'_>, z: Mat<f64>) -> Result<(Vec<f64>, Mat<f64>, 
                 .into(),
         ));
     }
-    let u = Mat::from_fn(count, count, |i, c| evd.U()[(i, count - 1 - c)]);
+    let u = Mat::from_fn(count, count, |i, c| evd.vectors[(i, count - 1 - c)]);
     let z = &q * &u;
     let cz = &w * &u;
     let residual = (0..count)
@@ -376,10 +375,8 @@ pub fn dense_modes(k: &SymCsc, m: &SymCsc, count: usize) -> Result<Modes, Error>
     let mut ct = c.transpose().to_owned();
     solve_lower_triangular_in_place(l, ct.as_mut(), Par::Seq);
     let sym = Mat::from_fn(n, n, |i, j| 0.5 * (ct[(i, j)] + ct[(j, i)]));
-    let evd = sym
-        .self_adjoint_eigen(Side::Lower)
-        .map_err(|e| Error::LinearAlgebra(format!("dense eigensolver: {e:?}").into()))?;
-    let s = evd.S().column_vector();
+    let evd = symmetric_eigen(sym.as_ref(), "dense modes").map_err(Error::LinearAlgebra)?;
+    let s = &evd.values;
     let mut eigenvalues = Vec::with_capacity(count);
     let mut shapes = Mat::<f64>::zeros(n, count);
     for c in 0..count {
@@ -393,7 +390,7 @@ pub fn dense_modes(k: &SymCsc, m: &SymCsc, count: usize) -> Result<Modes, Error>
         eigenvalues.push(1.0 / mu);
         let inv = 1.0 / mu.sqrt();
         for i in 0..n {
-            shapes[(i, c)] = evd.U()[(i, idx)] * inv;
+            shapes[(i, c)] = evd.vectors[(i, idx)] * inv;
         }
     }
     solve_upper_triangular_in_place(l.transpose(), shapes.as_mut(), Par::Seq);

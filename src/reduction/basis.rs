@@ -2,13 +2,14 @@
 //! rotation to the reduced eigenbasis, and the options and result types of
 //! [`super::build_basis`].
 
-use faer::{Mat, MatRef, Side};
+use faer::{Mat, MatRef};
 
 use super::pod::DEFAULT_THRESHOLD;
 use super::tvd::TvdOptions;
 use crate::error::Error;
 use crate::linalg::compensated::{split, two_product_sums};
 use crate::linalg::sparse::{sym_mul_vec_into, SymCsc};
+use crate::linalg::symmetric_eigen;
 use crate::model::Model;
 
 /// Default relative drop tolerance of [`final_basis`].
@@ -200,14 +201,13 @@ pub fn modal_rotation(model: &Model, phi: Mat<f64>) -> Result<(Mat<f64>, Vec<f64
         return Ok((phi, Vec::new()));
     }
     let k = crate::linalg::compensated::compensated_gram(&model.stiffness, phi.as_ref());
-    let evd = k
-        .self_adjoint_eigen(Side::Lower)
-        .map_err(|e| Error::LinearAlgebra(format!("reduced eigenproblem: {e:?}").into()))?;
-    let lambda: Vec<f64> = evd.S().column_vector().iter().copied().collect();
+    let evd =
+        symmetric_eigen(k.as_ref(), "reduced eigenproblem ΦᵀKΦ").map_err(Error::LinearAlgebra)?;
+    let lambda = evd.values;
     if let Some(l) = lambda.iter().find(|l| !(l.is_finite() && **l > 0.0)) {
         return Err(Error::LinearAlgebra(
             format!("reduced stiffness ΦᵀKΦ is not positive definite (eigenvalue {l:e})").into(),
         ));
     }
-    Ok((&phi * evd.U(), lambda))
+    Ok((&phi * &evd.vectors, lambda))
 }

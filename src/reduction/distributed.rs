@@ -41,13 +41,14 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use faer::{Mat, MatRef, Side};
+use faer::{Mat, MatRef};
 use serde::{Deserialize, Serialize};
 
 use crate::error::Error;
 use crate::files;
 use crate::linalg::compensated::{solve_refined_steps, sym_mul_compensated};
 use crate::linalg::sparse::sym_mul_mat;
+use crate::linalg::symmetric_eigenvalues;
 use crate::linalg::{Modes, SparseCholesky, SymCsc};
 use crate::model::petsc;
 use crate::model::{Interface, Model};
@@ -397,11 +398,9 @@ fn span_measure(
     let mw = sym_mul_mat(m, w.as_ref());
     let g = w.transpose() * &mw;
     let g = Mat::from_fn(nu, nu, |i, j| 0.5 * (g[(i, j)] + g[(j, i)]));
-    let evd = g
-        .self_adjoint_eigen(Side::Lower)
-        .map_err(|e| Error::LinearAlgebra(format!("distributed: span measure: {e:?}").into()))?;
-    let top = (0..nu)
-        .map(|i| evd.S().column_vector()[i])
+    let top = symmetric_eigenvalues(g.as_ref(), "distributed: span measure")
+        .map_err(Error::LinearAlgebra)?
+        .into_iter()
         .fold(0.0f64, f64::max);
     Ok((top.max(0.0).sqrt(), dev, phi_p))
 }

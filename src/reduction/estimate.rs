@@ -110,7 +110,7 @@
 
 use std::sync::{Arc, Mutex};
 
-use faer::{Mat, MatRef, Side};
+use faer::{Mat, MatRef};
 
 use crate::error::Error;
 use crate::joint::law::PairLaw;
@@ -119,6 +119,7 @@ use crate::joint::{NORMAL, T1, T2};
 use crate::linalg::cholesky::SparseCholesky;
 use crate::linalg::compensated::{compensated_gram, solve_refined, solve_refined_steps};
 use crate::linalg::sparse::sym_mul_mat;
+use crate::linalg::symmetric_eigen;
 use crate::linalg::LinalgError;
 use crate::linalg::{SubsetLlt, SymCsc};
 use crate::model::{Interface, Model};
@@ -418,11 +419,9 @@ impl Truncation {
         let w = both.subcols(r, w_cols).to_owned();
         let (psi, omega2) = if w_cols > 0 {
             let k2 = compensated_gram(&model.stiffness, w.as_ref());
-            let evd = k2.self_adjoint_eigen(Side::Lower).map_err(|e| {
-                Error::LinearAlgebra(format!("truncation modes' eigenproblem: {e:?}").into())
-            })?;
-            let omega2: Vec<f64> = evd.S().column_vector().iter().copied().collect();
-            (&w * evd.U(), omega2)
+            let evd = symmetric_eigen(k2.as_ref(), "truncation modes' eigenproblem")
+                .map_err(Error::LinearAlgebra)?;
+            (&w * &evd.vectors, evd.values)
         } else {
             (w, Vec::new())
         };

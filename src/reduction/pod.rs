@@ -1,9 +1,10 @@
 //! Proper orthogonal decomposition of the TVD (Algorithm 2, lines 21–29; eqs. 20–26).
 
-use faer::{Mat, MatRef, Side};
+use faer::{Mat, MatRef};
 
 use crate::error::Error;
 use crate::linalg::sparse::sym_mul_mat;
+use crate::linalg::symmetric_eigen;
 use crate::linalg::SymCsc;
 use crate::model::Model;
 
@@ -148,11 +149,9 @@ fn pod_dense_lambda_poms(
     let ay = apply_sym(weight, y);
     let c = y.transpose() * &ay;
     let c = Mat::from_fn(p, p, |i, j| 0.5 * (c[(i, j)] + c[(j, i)]));
-    let evd = c
-        .self_adjoint_eigen(Side::Lower)
-        .map_err(|e| Error::LinearAlgebra(format!("POD eigensolver: {e:?}").into()))?;
-    let s = evd.S().column_vector();
-    let u = evd.U();
+    let evd = symmetric_eigen(c.as_ref(), "POD: YᵀAY").map_err(Error::LinearAlgebra)?;
+    let s = &evd.values;
+    let u = evd.vectors.as_ref();
     let lmax = s[p - 1];
     if !(lmax.is_finite() && lmax > 0.0) {
         return Err(Error::LinearAlgebra(
@@ -241,11 +240,9 @@ pub fn pod(y: MatRef<'_, f64>, weight: Option<&SymCsc>) -> Result<Pod, Error> {
     let aw = apply_sym(weight, w_mat.as_ref());
     let t = w_mat.transpose() * &aw;
     let t = Mat::from_fn(k, k, |i, j| 0.5 * (t[(i, j)] + t[(j, i)]));
-    let evd = t
-        .self_adjoint_eigen(Side::Lower)
-        .map_err(|e| Error::LinearAlgebra(format!("POD eigensolver: {e:?}").into()))?;
-    let s = evd.S().column_vector();
-    let x = evd.U();
+    let evd = symmetric_eigen(t.as_ref(), "POD: YᵀAY").map_err(Error::LinearAlgebra)?;
+    let s = &evd.values;
+    let x = evd.vectors.as_ref();
     let lmax = s[k - 1];
     if !(lmax.is_finite() && lmax > 0.0) {
         return Err(Error::LinearAlgebra(
@@ -336,11 +333,10 @@ fn pod_tvd_with(model: &Model, tvd: &Tvd, weighted: bool, want_poms: bool) -> Re
     // for the plain route.
     let (a, q) = if weighted {
         let g = &f.joint_flexibility;
-        let evd = g.self_adjoint_eigen(Side::Lower).map_err(|e| {
-            Error::LinearAlgebra(format!("POD: joint flexibility eigen: {e:?}").into())
-        })?;
-        let d = evd.S().column_vector();
-        let v = evd.U();
+        let evd =
+            symmetric_eigen(g.as_ref(), "POD: joint flexibility").map_err(Error::LinearAlgebra)?;
+        let d = &evd.values;
+        let v = evd.vectors.as_ref();
         let vt_c = v.transpose() * &f.coefficients;
         let a = Mat::from_fn(m, p, |r, c| d[r].max(0.0).sqrt() * vt_c[(r, c)]);
         (a, PomMap::Flexibility)

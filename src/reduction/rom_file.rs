@@ -49,6 +49,7 @@ use serde::{Deserialize, Serialize};
 use crate::case::{ContactSpec, MasterLoadSpec, RampSpec};
 use crate::error::Error;
 use crate::joint::law::DEFAULT_TAU;
+use crate::linalg::symmetric_eigenvalues;
 use crate::model::Model;
 use crate::system::{ReducedSystem, Scene};
 
@@ -311,9 +312,8 @@ impl RomFile {
                 "not positive definite (its Cholesky factorization fails)".into(),
             ));
         }
-        let eig = k
-            .self_adjoint_eigenvalues(faer::Side::Lower)
-            .map_err(|e| ("stiffness", format!("eigenvalues failed: {e:?}")))?;
+        let eig = symmetric_eigenvalues(k.as_ref(), "stiffness")
+            .map_err(|e| ("stiffness", format!("eigenvalues failed: {e}")))?;
         let top = eig.iter().fold(0.0f64, |a, &l| a.max(l.abs()));
         if let Some(low) = eig.iter().copied().find(|&l| l < -1e-10 * top) {
             return Err((

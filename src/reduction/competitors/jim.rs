@@ -62,6 +62,7 @@ use faer::{Mat, Par, Side};
 
 use crate::error::Error;
 use crate::linalg::cholesky::SparseCholesky;
+use crate::linalg::symmetric_eigen;
 use crate::linalg::LinalgError;
 use crate::model::Model;
 
@@ -180,11 +181,9 @@ fn condensed_modes(
     let mut c = y.transpose().to_owned();
     solve_lower_triangular_in_place(l, c.as_mut(), Par::Seq);
     let c = Mat::from_fn(p, p, |a, b| 0.5 * (c[(a, b)] + c[(b, a)]));
-    let evd = c.self_adjoint_eigen(Side::Lower).map_err(|e| {
-        Error::LinearAlgebra(format!("Joint Interface Modes eigensolver: {e:?}").into())
-    })?;
-    let mu = evd.S().column_vector();
-    let mut u = evd.U().to_owned();
+    let evd = symmetric_eigen(c.as_ref(), "Joint Interface Modes").map_err(Error::LinearAlgebra)?;
+    let mu = &evd.values;
+    let mut u = evd.vectors;
     solve_upper_triangular_in_place(l.transpose(), u.as_mut(), Par::Seq);
     // Ascending λ = descending μ. Only the lowest modes are ever used; μ ≤ 1e-12 μ_max is
     // numerically an infinite frequency (the pencil (G, F) resolves the largest μ to working
