@@ -700,7 +700,7 @@ fn print_summary(a: &TransientArgs, model: &Model, o: &Outcome, total_s: f64) {
                 &e.reduction,
             );
             if let Some(i) = &e.integration {
-                line("  integration (vs 10x looser tolerances)", i);
+                line("  integration (vs 2x looser tolerances, scaled)", i);
             }
         }
         Some(Err(why)) => println!("error estimate unavailable: {why}"),
