@@ -220,25 +220,69 @@ pub(crate) fn solve_refined_steps_owned(
     x
 }
 
+/// Rows of `A Φ` split per block of [`compensated_gram`].
+const GRAM_ROWS: usize = 2048;
+
 /// `Φᵀ A Φ` (symmetrized) with `A Φ` and every inner product accumulated in double-double and
 /// rounded once. The thin-shell K is ill-conditioned (cond ≈ 2e10): `K φ` for a smooth φ is a
 /// small difference of large terms, so a plain product loses up to cond·eps of `K̃`'s smallest
 /// eigenvalues' accuracy; the compensated product keeps `K̃` the exact projection of the
 /// assembled K to working precision (measured: the alldof basis then reproduces the full contact
 /// statics to ≤ 1e-8, against ≈ 5e-7 with plain products on the multilayer sheet).
+///
+/// Entry `(i, j)`, `i ≤ j`, is the [`Dot2`] sum of `φ_i[k] · (Aφ_j)[k]` over k ascending. The
+/// sums run row block by row block ([`GRAM_ROWS`] rows of `A Φ` split into halves, row-major),
+/// and for each `i` over all `j ≥ i` at once ([`two_product_sums`]: the same operations as
+/// `Dot2::add_product(φ_i[k], (Aφ_j)[k])`, vectorized across j), the rows `i` in parallel — the
+/// same bits as the entry-by-entry sums for any thread count (tested), ~1/10 of their time: one
+/// Gram of r = 216 columns at 40 806 DOF took 3–10 s entry by entry, latency-bound.
 pub(crate) fn compensated_gram(a: &SymCsc, phi: faer::MatRef<'_, f64>) -> Mat<f64> {
+    use rayon::prelude::*;
     let aphi = sym_mul_compensated(a, phi, 1.0, None);
     let r = phi.ncols();
     let n = phi.nrows();
-    let mut g = Mat::<f64>::zeros(r, r);
-    for j in 0..r {
-        for i in 0..=j {
-            let mut acc = Dot2::new(0.0);
-            for k in 0..n {
-                acc.add_product(phi[(k, i)], aphi[(k, j)]);
+    // Row i of the upper triangle: hi and lo of the entries (i, j ≥ i).
+    let mut rows: Vec<(Vec<f64>, Vec<f64>)> = (0..r)
+        .map(|i| (vec![0.0; r - i], vec![0.0; r - i]))
+        .collect();
+    let mut bh = vec![0.0; GRAM_ROWS.min(n) * r];
+    let mut bl = vec![0.0; GRAM_ROWS.min(n) * r];
+    let mut k0 = 0;
+    while k0 < n {
+        let rows_b = GRAM_ROWS.min(n - k0);
+        for j in 0..r {
+            let col = aphi.col(j);
+            for k in 0..rows_b {
+                let (h, l) = split(col[k0 + k]);
+                bh[k * r + j] = h;
+                bl[k * r + j] = l;
             }
-            g[(i, j)] = acc.value();
-            g[(j, i)] = g[(i, j)];
+        }
+        let (bh, bl) = (&bh, &bl);
+        rows.par_iter_mut().enumerate().for_each(|(i, (hi, lo))| {
+            let phi_i = phi.col(i);
+            for k in 0..rows_b {
+                let x = phi_i[k0 + k];
+                let (xh, xl) = split(x);
+                let row = k * r + i;
+                two_product_sums(
+                    hi,
+                    lo,
+                    x,
+                    xh,
+                    xl,
+                    &bh[row..row + r - i],
+                    &bl[row..row + r - i],
+                );
+            }
+        });
+        k0 += rows_b;
+    }
+    let mut g = Mat::<f64>::zeros(r, r);
+    for (i, (hi, lo)) in rows.iter().enumerate() {
+        for (d, (h, l)) in hi.iter().zip(lo).enumerate() {
+            g[(i, i + d)] = h + l;
+            g[(i + d, i)] = h + l;
         }
     }
     g
@@ -247,6 +291,47 @@ pub(crate) fn compensated_gram(a: &SymCsc, phi: faer::MatRef<'_, f64>) -> Mat<f6
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The blocked, vectorized Gram equals the entry-by-entry [`Dot2`] sums bit for bit, across
+    /// the row-block boundary.
+    #[test]
+    fn blocked_gram_is_the_dot2_sum() {
+        let n = GRAM_ROWS + 37;
+        let (mut col_ptr, mut row_idx, mut values) = (vec![0], Vec::new(), Vec::new());
+        for j in 0..n {
+            for i in j.saturating_sub(1)..(j + 2).min(n) {
+                row_idx.push(i);
+                values.push(if i == j {
+                    2.0 + 1e5 * (j % 7) as f64
+                } else {
+                    -1.0 - 1e-3 * j as f64
+                });
+            }
+            col_ptr.push(row_idx.len());
+        }
+        let a = SymCsc {
+            n,
+            col_ptr,
+            row_idx,
+            values,
+        };
+        let r = 9;
+        let phi = Mat::from_fn(n, r, |k, c| {
+            ((k * (c + 3)) as f64 * 0.37).sin() * 10f64.powi(c as i32 - 4)
+        });
+        let g = compensated_gram(&a, phi.as_ref());
+        let aphi = sym_mul_compensated(&a, phi.as_ref(), 1.0, None);
+        for j in 0..r {
+            for i in 0..=j {
+                let mut acc = Dot2::new(0.0);
+                for k in 0..n {
+                    acc.add_product(phi[(k, i)], aphi[(k, j)]);
+                }
+                assert_eq!(g[(i, j)].to_bits(), acc.value().to_bits(), "({i}, {j})");
+                assert_eq!(g[(j, i)].to_bits(), acc.value().to_bits(), "({j}, {i})");
+            }
+        }
+    }
 
     /// The blocked, parallel product equals the entry-by-entry [`Dot2`] sums bit for bit, for
     /// column counts below, at and across the block width (ragged last block).
