@@ -313,14 +313,24 @@ mod tests {
             if y + 1 < nx {
                 col.push((j + nx, -1.0));
             }
-            col.sort_by_key(|e| e.0);
-            for (i, v) in col {
-                rows.push(i);
-                vals.push(v);
-            }
-            col_ptr.push(rows.len());
+            push_column(col, &mut col_ptr, &mut rows, &mut vals);
         }
         (n, col_ptr, rows, vals)
+    }
+
+    /// Appends one column (entries in any order) to a CSC pattern being built.
+    fn push_column(
+        mut col: Vec<(usize, f64)>,
+        col_ptr: &mut Vec<usize>,
+        rows: &mut Vec<usize>,
+        vals: &mut Vec<f64>,
+    ) {
+        col.sort_by_key(|e| e.0);
+        for (i, v) in col {
+            rows.push(i);
+            vals.push(v);
+        }
+        col_ptr.push(rows.len());
     }
 
     /// A shell-mesh-like SPD pattern: 3 DOF per node on a g × g grid, each node coupled to its
@@ -342,12 +352,7 @@ mod tests {
                 }
             }
             col.push((j, 0.1 * col.len() as f64 + 1.0));
-            col.sort_by_key(|e| e.0);
-            for (i, v) in col {
-                rows.push(i);
-                vals.push(v);
-            }
-            col_ptr.push(rows.len());
+            push_column(col, &mut col_ptr, &mut rows, &mut vals);
         }
         (n, col_ptr, rows, vals)
     }

@@ -377,11 +377,11 @@ pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<Toleran
                 changed = true;
             }
         }
-        if !changed && std::mem::replace(&mut ranking, false) {
+        let was_ranking = std::mem::replace(&mut ranking, false);
+        if !changed && was_ranking {
             // A ranking run is never the result: the same model again at the user's tolerances.
             continue;
         }
-        ranking = false;
         if !changed {
             let offline_s = (round_start - start).as_secs_f64();
             let mut estimate = estimate;
