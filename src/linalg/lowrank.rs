@@ -318,6 +318,22 @@ mod tests {
         (n, col_ptr, rows, vals)
     }
 
+    /// The matrix of a test pattern and its factorization: `(n, A, chol)`.
+    fn factored(
+        pattern: (usize, Vec<usize>, Vec<usize>, Vec<f64>),
+    ) -> (usize, SymCsc, SparseCholesky) {
+        let (n, cp, ri, v) = pattern;
+        let mut chol = SparseCholesky::analyze(n, cp.clone(), ri.clone()).unwrap();
+        chol.factor(&v, "grid").unwrap();
+        let a = SymCsc {
+            n,
+            col_ptr: cp,
+            row_idx: ri,
+            values: v,
+        };
+        (n, a, chol)
+    }
+
     /// Appends one column (entries in any order) to a CSC pattern being built.
     fn push_column(
         mut col: Vec<(usize, f64)>,
@@ -400,15 +416,7 @@ mod tests {
     #[test]
     fn corrected_solves_match_the_refactored_matrix() {
         for (nx, m, seed) in [(6, 1, 1), (12, 7, 2), (30, 24, 3)] {
-            let (n, cp, ri, v) = grid(nx, 0.1);
-            let a = SymCsc {
-                n,
-                col_ptr: cp.clone(),
-                row_idx: ri.clone(),
-                values: v.clone(),
-            };
-            let mut chol = SparseCholesky::analyze(n, cp, ri).unwrap();
-            chol.factor(&v, "grid").unwrap();
+            let (n, a, mut chol) = factored(grid(nx, 0.1));
             let mut r = rng(seed);
             // Sparse columns (3 entries each) and a block-diagonal C of 3×3 blocks with mixed
             // signs, small enough to keep A' positive definite.
@@ -486,15 +494,7 @@ mod tests {
 
     #[test]
     fn many_batches_with_changing_couplings() {
-        let (n, cp, ri, v) = shell_grid(40);
-        let a = SymCsc {
-            n,
-            col_ptr: cp.clone(),
-            row_idx: ri.clone(),
-            values: v.clone(),
-        };
-        let mut chol = SparseCholesky::analyze(n, cp, ri).unwrap();
-        chol.factor(&v, "grid").unwrap();
+        let (n, a, mut chol) = factored(shell_grid(40));
         assert!(chol.is_supernodal(), "the supernodal half solves");
         let mut r = rng(9);
         let mut lr = LowRankCholesky::new(n, 96);
@@ -550,9 +550,7 @@ mod tests {
 
     #[test]
     fn capacity_and_singular_corrections_are_refused() {
-        let (n, cp, ri, v) = grid(5, 0.0);
-        let mut chol = SparseCholesky::analyze(n, cp, ri).unwrap();
-        chol.factor(&v, "grid").unwrap();
+        let (n, _, mut chol) = factored(grid(5, 0.0));
         let mut lr = LowRankCholesky::new(n, 2);
         assert_eq!(lr.add_columns(&chol, 3, |_, _| {}), None);
         assert!(lr.is_empty());

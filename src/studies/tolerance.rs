@@ -146,35 +146,31 @@ pub fn integration_errors(
     opts: &TransientOptions,
     run: &Run,
 ) -> Result<CurveErrors, Error> {
-    let mut loose = TransientOptions {
+    let loose = TransientOptions {
         record: false,
-        ..opts.clone()
+        ..loosened(opts, INTEGRATION_CHECK_FACTOR)
     };
-    loose.ode.rtol *= INTEGRATION_CHECK_FACTOR;
-    loose.ode.atol *= INTEGRATION_CHECK_FACTOR;
     let check = integrate(rom, scene, &loose, |_, _| {}).into_result()?;
     let (a, b) = (&check.curves, &run.curves);
     let scale = 1.0 / (INTEGRATION_CHECK_FACTOR.powf(INTEGRATION_ORDER_EXPONENT) - 1.0);
-    let scaled = |d: Option<f64>| d.map(|d| d * scale);
+    let diff = |x: &[f64], y: &[f64]| relative_l2(&a.t, x, &b.t, y).map(|d| d * scale);
     Ok(CurveErrors {
-        contact_force: scaled(relative_l2(
-            &a.t,
-            &a.contact_force_norm,
-            &b.t,
-            &b.contact_force_norm,
-        )),
+        contact_force: diff(&a.contact_force_norm, &b.contact_force_norm),
         friction_force: if opts.problem.friction {
-            scaled(relative_l2(
-                &a.t,
-                &a.friction_force_norm,
-                &b.t,
-                &b.friction_force_norm,
-            ))
+            diff(&a.friction_force_norm, &b.friction_force_norm)
         } else {
             None
         },
-        master_uy: scaled(relative_l2(&a.t, &a.master_uy, &b.t, &b.master_uy)),
+        master_uy: diff(&a.master_uy, &b.master_uy),
     })
+}
+
+/// `opts` with rtol and atol times `factor`.
+fn loosened(opts: &TransientOptions, factor: f64) -> TransientOptions {
+    let mut out = opts.clone();
+    out.ode.rtol *= factor;
+    out.ode.atol *= factor;
+    out
 }
 
 /// Runs a reduced model of `model` (its trajectory recorded) under `scene` (the model's own, or
@@ -329,11 +325,10 @@ pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<Toleran
         let round_start = Instant::now();
         let rom = reduced_on_pairs(model, &cb, &flex, &pairs)?;
         let basis_s = round_start.elapsed().as_secs_f64();
-        let mut transient = opts.transient.clone();
-        if ranking {
-            transient.ode.rtol *= RANKING_LOOSENING;
-            transient.ode.atol *= RANKING_LOOSENING;
-        }
+        let transient = loosened(
+            &opts.transient,
+            if ranking { RANKING_LOOSENING } else { 1.0 },
+        );
         let (run, estimate) = run_estimated(
             model,
             &flex,
