@@ -48,7 +48,9 @@
 //!
 //! The last round's run is the result; its estimate then gains the integration part
 //! ([`integration_errors`]: one more run at 2× looser tolerances, its difference scaled to this
-//! run's error by the BDF2 error model), and `met` says whether the
+//! run's error by the BDF2 error model — that run does not depend on the one it checks, so every
+//! round at the user's tolerances starts it beside its own run on a second thread, and a round
+//! that is not the last discards it), and `met` says whether the
 //! total meets TOL. When it does not — nothing left to add, or the integration error of the
 //! user's tolerances above TOL — the best model is returned with `met = false` (the CLI warns;
 //! tighter `--rtol/--atol` lower the integration floor).
@@ -146,15 +148,35 @@ pub fn integration_errors(
     opts: &TransientOptions,
     run: &Run,
 ) -> Result<CurveErrors, Error> {
+    Ok(integration_errors_from(
+        &integration_check_run(rom, scene, opts)?,
+        run,
+        opts,
+    ))
+}
+
+/// The re-run of [`integration_errors`] at [`INTEGRATION_CHECK_FACTOR`]× looser tolerances. It
+/// does not depend on the run it checks, so callers start it on a second thread beside that run
+/// ([`run_estimated`], [`tolerance_model`]).
+pub fn integration_check_run(
+    rom: ReducedSystem,
+    scene: &Scene,
+    opts: &TransientOptions,
+) -> Result<Run, Error> {
     let loose = TransientOptions {
         record: false,
         ..loosened(opts, INTEGRATION_CHECK_FACTOR)
     };
-    let check = integrate(rom, scene, &loose, |_, _| {}).into_result()?;
+    integrate(rom, scene, &loose, |_, _| {}).into_result()
+}
+
+/// [`integration_errors`] from its re-run `check` of `run` (made by [`integration_check_run`]
+/// with the same `opts`).
+pub fn integration_errors_from(check: &Run, run: &Run, opts: &TransientOptions) -> CurveErrors {
     let (a, b) = (&check.curves, &run.curves);
     let scale = 1.0 / (INTEGRATION_CHECK_FACTOR.powf(INTEGRATION_ORDER_EXPONENT) - 1.0);
     let diff = |x: &[f64], y: &[f64]| relative_l2(&a.t, x, &b.t, y).map(|d| d * scale);
-    Ok(CurveErrors {
+    CurveErrors {
         contact_force: diff(&a.contact_force_norm, &b.contact_force_norm),
         friction_force: if opts.problem.friction {
             diff(&a.friction_force_norm, &b.friction_force_norm)
@@ -162,6 +184,20 @@ pub fn integration_errors(
             None
         },
         master_uy: diff(&a.master_uy, &b.master_uy),
+    }
+}
+
+/// Runs `check` on a scoped second thread while `main` runs on this one; a panic on the second
+/// thread resumes here, as it would have in a sequential call.
+fn beside<A, B: Send>(
+    main: impl FnOnce() -> A,
+    check: Option<impl FnOnce() -> B + Send>,
+) -> (A, Option<B>) {
+    std::thread::scope(|s| {
+        let handle = check.map(|c| s.spawn(c));
+        let a = main();
+        let b = handle.map(|h| h.join().unwrap_or_else(|p| std::panic::resume_unwind(p)));
+        (a, b)
     })
 }
 
@@ -190,30 +226,37 @@ pub fn run_estimated(
     observe: impl FnMut(f64, &[f64]),
 ) -> Result<(Run, Result<RunEstimate, Error>), Error> {
     let estimator = flex.estimator(model, &rom)?;
-    let check = check_integration.then(|| rom.clone());
+    let check_rom = check_integration.then(|| rom.clone());
     let opts = TransientOptions {
         record: true,
         ..opts.clone()
     };
-    let mut run = integrate(rom, scene, &opts, observe);
-    let estimate = match run.trajectory.take() {
-        Some(tr) if run.status.finished() => estimator.estimate(
-            &pair_law(scene, &opts.problem),
-            RunStates {
-                t: &run.curves.t,
-                q: &tr.q,
-                p: &tr.p,
-                s: &tr.s,
-            },
-        ),
-        _ => Err(Error::Invalid(format!(
-            "no error estimate: the run ended early ({})",
-            run.status
-        ))),
-    };
+    let opts = &opts;
+    let ((run, estimate), check) = beside(
+        || {
+            let mut run = integrate(rom, scene, opts, observe);
+            let estimate = match run.trajectory.take() {
+                Some(tr) if run.status.finished() => estimator.estimate(
+                    &pair_law(scene, &opts.problem),
+                    RunStates {
+                        t: &run.curves.t,
+                        q: &tr.q,
+                        p: &tr.p,
+                        s: &tr.s,
+                    },
+                ),
+                _ => Err(Error::Invalid(format!(
+                    "no error estimate: the run ended early ({})",
+                    run.status
+                ))),
+            };
+            (run, estimate)
+        },
+        check_rom.map(|rom| move || integration_check_run(rom, scene, opts)),
+    );
     let estimate = estimate.and_then(|detail| {
         let integration = match check {
-            Some(rom) => Some(integration_errors(rom, scene, &opts, &run)?),
+            Some(c) => Some(integration_errors_from(&c?, &run, opts)),
             None => None,
         };
         Ok(RunEstimate {
@@ -299,8 +342,11 @@ pub struct ToleranceModel {
     /// Every round, the last one the result.
     pub rounds: Vec<Round>,
     /// Wall time of everything before the result's run (factorization, Craig–Bampton, the
-    /// flexibility, the earlier rounds' runs and estimates), s.
+    /// flexibility, the earlier rounds' runs and estimates, the result's basis), s.
     pub offline_s: f64,
+    /// Wall time of the result's estimate after its run: the quasi-static joint correction and
+    /// the wait for the integration check (which runs beside the run on a second thread), s.
+    pub estimate_s: f64,
 }
 
 /// Builds the smallest Craig–Bampton + pair-attachment-mode model whose estimated ‖f_c‖(t)
@@ -329,15 +375,28 @@ pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<Toleran
             &opts.transient,
             if ranking { RANKING_LOOSENING } else { 1.0 },
         );
-        let (run, estimate) = run_estimated(
-            model,
-            &flex,
-            rom.clone(),
-            &Scene::of(model),
-            &transient,
-            false,
-            |_, _| {},
-        )?;
+        // Any round at the user's tolerances may be the result: its integration check runs
+        // beside it (on a second core; discarded when the round is not the last).
+        let scene = Scene::of(model);
+        let check_rom = (!ranking).then(|| rom.clone());
+        let (estimated, check) = beside(
+            || {
+                run_estimated(
+                    model,
+                    &flex,
+                    rom.clone(),
+                    &scene,
+                    &transient,
+                    false,
+                    |_, _| {},
+                )
+            },
+            check_rom.map(|rom| {
+                let (scene, transient) = (&scene, &opts.transient);
+                move || integration_check_run(rom, scene, transient)
+            }),
+        );
+        let (run, estimate) = estimated?;
         let run = run.into_result()?;
         let estimate = estimate?;
         let eta = estimate.reduction.contact_force.unwrap_or(0.0);
@@ -378,12 +437,15 @@ pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<Toleran
             continue;
         }
         if !changed {
-            let offline_s = (round_start - start).as_secs_f64();
+            let check = check.ok_or_else(|| {
+                Error::Invalid("internal: the result's round ran no integration check".into())
+            })??;
             let mut estimate = estimate;
-            let integration =
-                integration_errors(rom.clone(), &Scene::of(model), &opts.transient, &run)?;
+            let integration = integration_errors_from(&check, &run, &opts.transient);
             estimate.total = estimate.reduction.combine(&integration);
             estimate.integration = Some(integration);
+            let offline_s = (round_start - start).as_secs_f64() + basis_s;
+            let estimate_s = round_start.elapsed().as_secs_f64() - basis_s - run.wall_s;
             return Ok(ToleranceModel {
                 pairs,
                 nu,
@@ -394,6 +456,7 @@ pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<Toleran
                 estimate,
                 rounds,
                 offline_s,
+                estimate_s,
             });
         }
     }

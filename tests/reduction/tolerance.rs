@@ -10,7 +10,7 @@ use jointrom::joint::statics::ContactOptions;
 use jointrom::model::contact_static_full;
 use jointrom::reduction::{build_basis, BasisKind, BasisOptions, JointFlexibility};
 use jointrom::studies::tolerance::{
-    run_estimated, static_tolerance_model, tolerance_model, ToleranceOptions,
+    integration_errors, run_estimated, static_tolerance_model, tolerance_model, ToleranceOptions,
 };
 use jointrom::system::{ReducedSystem, Scene};
 
@@ -112,8 +112,31 @@ fn tolerance_model_meets_the_stored_full_reference() {
             t.rom.dim()
         );
         assert!(t.pairs.len() < m.pair_count());
-        assert!(t.offline_s > 0.0 && t.run.wall_s > 0.0);
+        assert!(t.offline_s > 0.0 && t.run.wall_s > 0.0 && t.estimate_s > 0.0);
     }
+}
+
+/// The integration check that runs beside its run on a second thread gives the same numbers as
+/// the sequential check after it (the runs are deterministic; nothing is shared between them).
+#[test]
+fn concurrent_integration_check_equals_the_sequential_one() {
+    let m = model("friction_bar");
+    let flex = JointFlexibility::new(&m).unwrap();
+    let basis = build_basis(&m, BasisKind::Tvd, &BasisOptions::default()).unwrap();
+    let rom = ReducedSystem::new(&m, basis.phi).unwrap();
+    let opts = TransientOptions {
+        end_time: Some(0.02),
+        ..Default::default()
+    };
+    let scene = Scene::of(&m);
+    let (run, est) = run_estimated(&m, &flex, rom.clone(), &scene, &opts, true, |_, _| {}).unwrap();
+    let run = run.into_result().unwrap();
+    let beside = est.unwrap().integration.unwrap();
+    let after = integration_errors(rom, &scene, &opts, &run).unwrap();
+    assert_eq!(beside.contact_force, after.contact_force);
+    assert_eq!(beside.friction_force, after.friction_force);
+    assert_eq!(beside.master_uy, after.master_uy);
+    assert!(beside.contact_force.unwrap() > 0.0);
 }
 
 /// The estimate of a fixed model (the paper's a-priori TVD, Craig–Bampton alone, g = 0, and the

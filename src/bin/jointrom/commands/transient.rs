@@ -404,6 +404,7 @@ fn run_tolerance(
         "pairs": t.pairs,
         "nu": t.nu,
         "setup_s": t.setup_s,
+        "estimate_s": t.estimate_s,
         "rounds": t.rounds,
     });
     if !t.met {
