@@ -10,8 +10,10 @@ The model is the ROM file's (`src/reduction/rom_file.rs`): M q'' + K q = Φ_mᵀ
 with the viscoplastic Coulomb law of `src/joint/law.rs` (penalty k_n, stick stiffness k_t, μ,
 relaxation τ), written here independently with NumPy. State y = [q, v, s / 1e-3 mm]; jointrom's
 W and D states are left out (they do not feed back). Tolerances as jointrom's defaults: rtol 1e-8,
-atol 1e-6 mm of the physical field (q_j: atol / coordinate_size_j, v_j: 1e3 × that, s: 1e-6 in
-units of 1e-3 mm). Needs numpy and scipy (pip install scipy)."""
+atol 1e-6 mm of the physical field (q_j: atol · L / coordinate_size_j, v_j: 1e3 × that, s: 1e-6 · L
+in units of 1e-3 mm, L = √((2 field_dofs + 2w + 2) / (2r + 2w + 2)): jointrom's error test of a
+reduced model, the full model's on the field — `src/integrate/mechanical.rs`; older files without
+`field_dofs`: L = 1). Needs numpy and scipy (pip install scipy)."""
 import argparse
 import json
 import math
@@ -52,6 +54,7 @@ class Rom:
         self.kn, self.mu, self.kt = c["normal_stiffness"], c["friction_coefficient"], c["stick_stiffness"]
         self.tau = doc["friction_relaxation_time"]
         self.size = np.array(doc["coordinate_size"])
+        self.field_dofs = doc.get("field_dofs", len(self.size))
         self.end = doc["end_time"]
         self.Minv = np.linalg.inv(self.M)
         self.Bn, self.B1, self.B2 = self.B[0::3], self.B[1::3], self.B[2::3]
@@ -156,7 +159,8 @@ def main():
     rom = Rom(doc)
     end = a.end_time or rom.end
     r, w = rom.r, rom.w
-    atol = np.concatenate([1e-6 / rom.size, 1e-6 * VELOCITY_SCALE / rom.size, np.full(2 * w, 1e-6)])
+    length = math.sqrt((2 * rom.field_dofs + 2 * w + 2) / (2 * r + 2 * w + 2))
+    atol = length * np.concatenate([1e-6 / rom.size, 1e-6 * VELOCITY_SCALE / rom.size, np.full(2 * w, 1e-6)])
     t_eval = np.arange(0, round(end / 1e-4) + 1) * 1e-4
     t_eval[-1] = min(t_eval[-1], end)
     start = time.perf_counter()

@@ -26,7 +26,8 @@
 //! | `load_ramp` | object | its time function (the case file's `load.ramp`) |
 //! | `contact` | object | `normal_stiffness` k_n, `stick_stiffness` k_t (N/mm), `friction_coefficient` μ |
 //! | `friction_relaxation_time` | s | τ of jointrom's viscoplastic slip memory (see `crate::joint::law`) |
-//! | `coordinate_size` | r | max |Φ| per column (mm or rad per unit q): jointrom's tolerance scale |
+//! | `coordinate_size` | r | ‖Φ_j‖₂ per column over the full model's DOF (mm or rad per unit q): jointrom's tolerance scale (files without `field_dofs`: max |Φ_j|) |
+//! | `field_dofs` | count | n, the full model's DOF: with `coordinate_size` the error test measures the physical field as the full model's does (`crate::integrate::mechanical`, *The error test of a reduced model*; absent in older files: r, and the test is the coordinates' own) |
 //! | `end_time` | s | the case's simulated span |
 //!
 //! The pair law: gap `g = (BΦq)_normal`, normal force `p_n = k_n·min(g, 0)`; Coulomb friction
@@ -51,7 +52,7 @@ use crate::error::Error;
 use crate::joint::law::DEFAULT_TAU;
 use crate::linalg::symmetric_eigenvalues;
 use crate::model::Model;
-use crate::system::{ReducedSystem, Scene};
+use crate::system::{ErrorScale, ReducedSystem, Scene};
 
 /// Schema name of the file.
 pub const SCHEMA: &str = "jointrom-rom";
@@ -126,8 +127,11 @@ pub struct RomFile {
     pub contact: ContactSpec,
     /// τ of the slip memory, s.
     pub friction_relaxation_time: f64,
-    /// max |Φ| per column (r).
+    /// The error test's scale per column (r): ‖Φ_j‖₂, mm or rad per unit coordinate.
     pub coordinate_size: Vec<f64>,
+    /// n, the DOF of the field the coordinates describe (absent in older files: r).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub field_dofs: Option<usize>,
     /// Simulated span, s.
     pub end_time: f64,
 }
@@ -143,7 +147,7 @@ impl RomFile {
     pub fn new(model: &Model, rom: &ReducedSystem, basis: BasisInfo) -> Result<RomFile, Error> {
         let r = rom.dim();
         let phi_master = &rom.phi_master;
-        let column_size = rom.column_size.clone();
+        let scale = rom.error_scale.clone();
         Ok(RomFile {
             schema: SCHEMA.into(),
             version: VERSION,
@@ -160,7 +164,8 @@ impl RomFile {
             load_ramp: model.load.ramp.clone(),
             contact: model.contact,
             friction_relaxation_time: DEFAULT_TAU,
-            coordinate_size: column_size,
+            coordinate_size: scale.column,
+            field_dofs: Some(scale.field_dofs),
             end_time: model.end_time,
         })
     }
@@ -260,6 +265,14 @@ impl RomFile {
         for (i, s) in f.coordinate_size.iter().enumerate() {
             positive(&format!("coordinate_size[{i}]"), *s)?;
         }
+        if let Some(n) = f.field_dofs {
+            if n < r {
+                return Err(bad(
+                    "field_dofs",
+                    format!("{n} DOF cannot hold a reduced model of dimension {r}"),
+                ));
+            }
+        }
         f.load_ramp
             .check("load_ramp")
             .map_err(|(field, reason)| bad(&field, reason))?;
@@ -350,7 +363,13 @@ impl RomFile {
             mat(&self.stiffness),
             mat(&self.mass),
             mat(&self.joint_operator),
-            (mat(&self.master_rows), self.coordinate_size.clone()),
+            (
+                mat(&self.master_rows),
+                ErrorScale {
+                    column: self.coordinate_size.clone(),
+                    field_dofs: self.field_dofs.unwrap_or(self.dimension),
+                },
+            ),
             crate::case::LoadSpec {
                 master: self.master_load,
                 ramp: self.load_ramp.clone(),

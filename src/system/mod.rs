@@ -34,7 +34,7 @@ mod full;
 mod reduced;
 
 pub use full::FullSystem;
-pub use reduced::ReducedSystem;
+pub use reduced::{ErrorScale, ReducedSystem};
 
 use serde::Serialize;
 
@@ -104,12 +104,18 @@ pub trait SecondOrderSystem {
     }
     /// The master node's `[ux, uy, uz (mm), rx, ry, rz (rad)]` at `q`.
     fn master_displacement(&self, q: &[f64]) -> [f64; 6];
-    /// The physical size of a unit of each coordinate: the largest nodal displacement (mm) or
-    /// rotation (rad) it produces. 1 for physical DOF (the default); for a reduced model the
-    /// largest entry of the basis column, so that a tolerance stated in mm applies to the
-    /// physical field whatever the basis normalization (a mass-normalized column of the friction
-    /// bar moves nodes by ~10² mm per unit).
+    /// The physical size of a unit of each coordinate: the Euclidean norm, over the physical
+    /// field's [`SecondOrderSystem::field_dofs`] DOF, of the nodal displacements (mm) and
+    /// rotations (rad) it produces. 1 for physical DOF (the default); for a reduced model the
+    /// norm of the basis column, so that a tolerance stated in mm applies to the physical field
+    /// whatever the basis normalization (`crate::integrate::mechanical`, *The error test of a
+    /// reduced model*).
     fn coordinate_size_into(&self, out: &mut [f64]) {
         out.iter_mut().for_each(|x| *x = 1.0);
+    }
+    /// The number of physical DOF the coordinates describe: [`SecondOrderSystem::dim`] for
+    /// physical DOF (the default), the full model's n for a reduced model.
+    fn field_dofs(&self) -> usize {
+        self.dim()
     }
 }

@@ -19,6 +19,17 @@ use crate::linalg::LinalgError;
 use crate::linalg::SymCsc;
 use crate::model::Model;
 
+/// How the integrator's error test sees a reduced model's coordinates: as the physical field
+/// they produce (`crate::integrate::mechanical`, *The error test of a reduced model*).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ErrorScale {
+    /// Per coordinate, the Euclidean norm over the full model's DOF of the field a unit of it
+    /// produces, `‖Φ_j‖₂` (mm or rad per unit coordinate).
+    pub column: Vec<f64>,
+    /// The number of DOF n of that field (the full model's).
+    pub field_dofs: usize,
+}
+
 /// A reduced model (eq. 7) as a [`SecondOrderSystem`] (r generalized coordinates), dense.
 pub struct ReducedSystem {
     r: usize,
@@ -40,9 +51,10 @@ pub struct ReducedSystem {
     b_rows: Vec<f64>,
     /// Rows of Φ at the six master DOF (6 × r: ux, uy, uz (mm), rx, ry, rz (rad) per unit).
     pub phi_master: Mat<f64>,
-    /// Largest absolute entry of each basis column (mm or rad per unit coordinate): the
-    /// coordinate scale of the absolute tolerance.
-    pub column_size: Vec<f64>,
+    /// The Euclidean norm of each basis column over the full model's DOF (mm or rad per unit
+    /// coordinate) and that number of DOF: the field the error test measures
+    /// ([`SecondOrderSystem::coordinate_size_into`], [`SecondOrderSystem::field_dofs`]).
+    pub error_scale: ErrorScale,
     /// Master load and its ramp (change it to run load variants on one basis).
     pub load: LoadSpec,
     /// `M̃ = I` to round-off (M-orthonormal basis): the M-solve is the identity.
@@ -108,14 +120,17 @@ impl ReducedSystem {
         }
         let r = phi.ncols();
         let phi_master = Mat::from_fn(6, r, |d, c| phi[(master[d], c)]);
-        let column_size: Vec<f64> = (0..r)
-            .map(|c| phi.col(c).iter().fold(0.0f64, |m, x| m.max(x.abs())))
-            .collect();
+        let error_scale = ErrorScale {
+            column: (0..r)
+                .map(|c| phi.col(c).iter().map(|x| x * x).sum::<f64>().sqrt())
+                .collect(),
+            field_dofs: k.n,
+        };
         ReducedSystem::from_matrices(
             compensated_gram(k, phi.as_ref()),
             compensated_gram(m, phi.as_ref()),
             joint.reduce(phi.as_ref()),
-            (phi_master, column_size),
+            (phi_master, error_scale),
             load,
             Some(phi),
         )
@@ -127,17 +142,18 @@ impl ReducedSystem {
     ///
     /// `k` = K̃ (r × r, N/mm per unit coordinate²), `m` = M̃ (r × r, t per unit coordinate²),
     /// `b_phi` = BΦ (3w × r, mm per unit), `master` = (the rows of Φ at the six master DOF,
-    /// 6 × r; the largest absolute entry of each basis column, r), `load` the master load and
-    /// its ramp, `phi` the basis if known (n × r).
+    /// 6 × r; the error test's scale of each coordinate and the full model's DOF count,
+    /// [`ErrorScale`]), `load` the master load and its ramp, `phi` the basis if known (n × r).
     pub fn from_matrices(
         k: Mat<f64>,
         m: Mat<f64>,
         b_phi: Mat<f64>,
-        master: (Mat<f64>, Vec<f64>),
+        master: (Mat<f64>, ErrorScale),
         load: LoadSpec,
         phi: Option<Mat<f64>>,
     ) -> Result<ReducedSystem, Error> {
-        let (phi_master, column_size) = master;
+        let (phi_master, error_scale) = master;
+        let column_size = &error_scale.column;
         let r = k.nrows();
         if let Some(phi) = &phi {
             if phi.ncols() != r {
@@ -190,6 +206,12 @@ impl ReducedSystem {
                 "basis column {c} is zero or not finite"
             )));
         }
+        if error_scale.field_dofs < r {
+            return Err(Error::Invalid(format!(
+                "reduced model of dimension {r} of a field with fewer DOF ({})",
+                error_scale.field_dofs
+            )));
+        }
         let mut dev = 0.0f64;
         for i in 0..r {
             for j in 0..r {
@@ -230,7 +252,7 @@ impl ReducedSystem {
             m_llt,
             b_phi,
             phi_master,
-            column_size,
+            error_scale,
             load,
             newton: Mat::zeros(r, r),
             newton_ok: false,
@@ -285,7 +307,7 @@ impl Clone for ReducedSystem {
             b_cols: self.b_cols.clone(),
             b_rows: self.b_rows.clone(),
             phi_master: self.phi_master.clone(),
-            column_size: self.column_size.clone(),
+            error_scale: self.error_scale.clone(),
             load: self.load.clone(),
             m_identity: self.m_identity,
             m_llt: self.m_llt.clone(),
@@ -421,6 +443,9 @@ impl SecondOrderSystem for ReducedSystem {
         std::array::from_fn(|d| (0..self.r).map(|c| self.phi_master[(d, c)] * q[c]).sum())
     }
     fn coordinate_size_into(&self, out: &mut [f64]) {
-        out.copy_from_slice(&self.column_size);
+        out.copy_from_slice(&self.error_scale.column);
+    }
+    fn field_dofs(&self) -> usize {
+        self.error_scale.field_dofs
     }
 }

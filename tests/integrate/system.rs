@@ -465,6 +465,69 @@ fn newton_solve_matches_i_minus_gamma_j() {
     }
 }
 
+/// The error test of a reduced model measures the physical field as the full model's does
+/// (`jointrom::integrate::mechanical`, *The error test of a reduced model*): for a basis of
+/// Euclidean-orthogonal columns, the WRMS norm of a reduced error `(e_q, e_v, e_s)` under the
+/// reduced weights equals the full model's WRMS norm of `(Φ e_q, Φ e_v, e_s)` under its own
+/// (atol-dominated: weights ∝ the atol scales); with Φ = I the scales are the full model's.
+#[test]
+fn reduced_error_test_is_the_full_models_on_the_field() {
+    let model = common::model("friction_bar");
+    let n = model.dofs();
+    let (r, stride) = (12, 37);
+    let phi = Mat::from_fn(n, r, |i, j| {
+        if i == 5 + stride * j {
+            0.5 + j as f64
+        } else {
+            0.0
+        }
+    });
+    let full = MechanicalOde::new(
+        FullSystem::new(&model).unwrap(),
+        &model.contact,
+        &opts(true),
+    )
+    .unwrap();
+    let red = MechanicalOde::new(
+        ReducedSystem::new(&model, phi.clone()).unwrap(),
+        &model.contact,
+        &opts(true),
+    )
+    .unwrap();
+    let (mut wf, mut wr) = (vec![0.0; full.dim()], vec![0.0; red.dim()]);
+    assert!(full.atol_scale(&mut wf) && red.atol_scale(&mut wr));
+    let ns = red.dim() - 2 * r - 2;
+    assert_eq!(full.dim() - 2 * n - 2, ns);
+    let wrms = |e: &[f64], w: &[f64]| {
+        (e.iter().zip(w).map(|(x, s)| (x / s).powi(2)).sum::<f64>() / e.len() as f64).sqrt()
+    };
+    let mut rng = common::rng(0x5eed_0e77_0f1e_1d00);
+    for _ in 0..5 {
+        let mut er: Vec<f64> = (0..red.dim()).map(|_| common::uniform(&mut rng)).collect();
+        let d = er.len();
+        er[d - 2..].fill(0.0);
+        let mut ef = vec![0.0; full.dim()];
+        for j in 0..r {
+            for i in 0..n {
+                ef[i] += phi[(i, j)] * er[j];
+                ef[n + i] += phi[(i, j)] * er[r + j];
+            }
+        }
+        ef[2 * n..2 * n + ns].copy_from_slice(&er[2 * r..2 * r + ns]);
+        let (a, b) = (wrms(&er, &wr), wrms(&ef, &wf));
+        assert!((a - b).abs() <= 1e-12 * b, "reduced {a} vs full {b}");
+    }
+    let id = MechanicalOde::new(
+        ReducedSystem::new(&model, Mat::identity(n, n)).unwrap(),
+        &model.contact,
+        &opts(true),
+    )
+    .unwrap();
+    let mut wi = vec![0.0; id.dim()];
+    assert!(id.atol_scale(&mut wi));
+    assert_eq!(wi, wf);
+}
+
 #[test]
 fn identity_reduction_agrees_with_the_full_system() {
     let model = common::model("friction_bar");
@@ -582,10 +645,15 @@ fn friction_bar_rom_runs_and_balances_energy() {
         // The structure is pushed down (fy < 0) and friction dissipates.
         assert!(c.master_uy[200] < -0.5);
         assert!(d_end > 0.0 && d_end < 0.05 * w_max);
-        assert!(c
+        // D is a CVODE state held to atol × energy_scale (N·mm); BDF2 on variable steps may
+        // dip it by less than that, never by the size of a dissipation of the wrong sign.
+        let d_tol = atol * opts.problem.energy_scale;
+        let dip = c
             .dissipated
             .windows(2)
-            .all(|p| p[1] >= p[0] - 1e-12 * w_max));
+            .map(|p| p[0] - p[1])
+            .fold(0.0f64, f64::max);
+        assert!(dip <= d_tol, "D decreases by {dip:.3e} N·mm > {d_tol:.1e}");
     }
 }
 
