@@ -108,6 +108,7 @@
 //! ([`Estimate::pair_error`]); `crate::studies::tolerance` enriches the basis with them (and ν)
 //! until the estimate meets a tolerance, and adds the integration error of the run.
 
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 
 use faer::{Mat, MatRef};
@@ -144,8 +145,9 @@ pub struct JointFlexibility {
     /// Normal penalty stiffness of the model's contact law, N/mm.
     k_n: f64,
     /// The lowest [`TRUNCATION_MODES`] fixed-interface modes (n × count, M-orthonormal, zero at
-    /// the master), for the truncation part of the estimate.
-    modes: Mat<f64>,
+    /// the master), for the truncation part of the estimate: computed on first use
+    /// ([`JointFlexibility::truncation_modes`]).
+    modes: Mutex<Option<Arc<Mat<f64>>>>,
     /// Per joint row r (3w: normal, t1, t2 of each pair), once solved: the normal rows of its
     /// flexibility column `B_n K⁻¹ b_rᵀ` (w values, mm/N). Shared by every estimate of the
     /// model (sweeps run in parallel), so behind a lock.
@@ -165,10 +167,14 @@ const COLUMN_REFINEMENT: usize = 1;
 /// Right-hand sides per blocked solve of the flexibility (bounds the n × block scratch).
 const SOLVE_CHUNK: usize = 256;
 
+/// Columns per solve of [`JointFlexibility::prefetch_normal_columns`]: how far it may run past
+/// its stop signal.
+pub const PREFETCH_BLOCK: usize = 8;
+
 impl JointFlexibility {
     /// Factors the model's `K` once and solves for the six unit master loads (refined twice
     /// with double-double residuals, as the other static vectors of [`crate::reduction`]);
-    /// pair columns follow on demand.
+    /// pair columns and the truncation modes follow on demand.
     pub fn new(model: &Model) -> Result<JointFlexibility, Error> {
         let n = model.dofs();
         let master = model.master_dofs();
@@ -185,20 +191,6 @@ impl JointFlexibility {
         }
         let h = model.joint.reduce(z.as_ref());
         let c = Mat::from_fn(6, 6, |a, b| 0.5 * (z[(master[a], b)] + z[(master[b], a)]));
-        let count = TRUNCATION_MODES.min(n.saturating_sub(6) / 2);
-        let modes = if count > 0 {
-            let fixed = model.modes(count, Interface::Fixed)?;
-            let m = n - 6;
-            Mat::from_fn(n, fixed.shapes.ncols(), |i, j| {
-                if i < m {
-                    fixed.shapes[(i, j)]
-                } else {
-                    0.0
-                }
-            })
-        } else {
-            Mat::zeros(n, 0)
-        };
         Ok(JointFlexibility {
             stiffness: model.stiffness.clone(),
             chol,
@@ -207,7 +199,7 @@ impl JointFlexibility {
             h,
             c,
             k_n: model.contact.normal_stiffness,
-            modes,
+            modes: Mutex::new(None),
             columns: Mutex::new(vec![None; model.joint.rows()]),
         })
     }
@@ -286,6 +278,33 @@ impl JointFlexibility {
             .collect())
     }
 
+    /// Solves the normal flexibility columns not yet cached, [`PREFETCH_BLOCK`] at a time in
+    /// pair order, until `stop` is set or all are cached; returns how many it solved. For a
+    /// second core while a reduced run goes on: the estimate of a run whose contact is wrong
+    /// (a Craig–Bampton ranking run) needs nearly every pair's column, and the columns are most
+    /// of its cost on refined meshes. Stops within one block of `stop`.
+    ///
+    /// # Errors
+    /// A column that is not finite.
+    pub fn prefetch_normal_columns(&self, stop: &AtomicBool) -> Result<usize, Error> {
+        let missing: Vec<usize> = {
+            let cols = self.lock_columns();
+            (0..self.pairs())
+                .map(|k| 3 * k + NORMAL)
+                .filter(|&r| cols[r].is_none())
+                .collect()
+        };
+        let mut solved = 0;
+        for block in missing.chunks(PREFETCH_BLOCK) {
+            if stop.load(Ordering::Relaxed) {
+                break;
+            }
+            self.columns(block)?;
+            solved += block.len();
+        }
+        Ok(solved)
+    }
+
     /// The normal flexibility columns `F_{n,k}` of `pairs` ([`JointFlexibility::columns`]).
     fn normal_columns(&self, pairs: &[usize]) -> Result<Vec<Arc<[f64]>>, Error> {
         let rows: Vec<usize> = pairs.iter().map(|&k| 3 * k + NORMAL).collect();
@@ -355,6 +374,61 @@ impl JointFlexibility {
         model: &Model,
         rom: &ReducedSystem,
     ) -> Result<ErrorEstimator<'a>, Error> {
+        let phi = self.basis_of(rom)?;
+        let m_phi = sym_mul_mat(&model.mass, phi.as_ref());
+        let y = solve_refined(&self.stiffness, &self.chol, &m_phi);
+        Ok(ErrorEstimator {
+            flex: self,
+            g: self.joint.reduce(y.as_ref()),
+            g_m: Mat::from_fn(6, y.ncols(), |d, j| y[(self.master[d], j)]),
+            truncation: Truncation::new(
+                model,
+                phi.as_ref(),
+                self.truncation_modes(model)?.as_ref().as_ref(),
+            )?,
+            rom: rom.clone(),
+        })
+    }
+
+    /// The [`TRUNCATION_MODES`] lowest fixed-interface modes (n × m, zero at the master DOF),
+    /// computed on first use: only the transient estimate needs them (not the pair-space
+    /// statics), and its first use is on the second core beside a reduced run
+    /// ([`crate::studies::tolerance::run_estimated`]).
+    fn truncation_modes(&self, model: &Model) -> Result<Arc<Mat<f64>>, Error> {
+        // Held while computing: a second estimator (parallel sweeps) waits for the same modes.
+        let mut slot = self
+            .modes
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner);
+        if let Some(m) = slot.as_ref() {
+            return Ok(Arc::clone(m));
+        }
+        let n = self.stiffness.n;
+        let count = TRUNCATION_MODES.min(n.saturating_sub(6) / 2);
+        let modes = if count > 0 {
+            let fixed = model.modes(count, Interface::Fixed)?;
+            let m = n - 6;
+            Mat::from_fn(n, fixed.shapes.ncols(), |i, j| {
+                if i < m {
+                    fixed.shapes[(i, j)]
+                } else {
+                    0.0
+                }
+            })
+        } else {
+            Mat::zeros(n, 0)
+        };
+        let modes = Arc::new(modes);
+        *slot = Some(Arc::clone(&modes));
+        Ok(modes)
+    }
+
+    /// The basis Φ of `rom` if an estimator of it can be built on this flexibility: `rom`
+    /// carries Φ, of this model's DOF and pairs.
+    ///
+    /// # Errors
+    /// [`Error::Invalid`] saying which of these fails.
+    pub fn basis_of<'r>(&self, rom: &'r ReducedSystem) -> Result<&'r Mat<f64>, Error> {
         let phi = rom.phi.as_ref().ok_or_else(|| {
             Error::Invalid(
                 "error estimate: the reduced model carries no basis Φ (read from a file)".into(),
@@ -370,15 +444,7 @@ impl JointFlexibility {
                 self.pairs()
             )));
         }
-        let m_phi = sym_mul_mat(&model.mass, phi.as_ref());
-        let y = solve_refined(&self.stiffness, &self.chol, &m_phi);
-        Ok(ErrorEstimator {
-            flex: self,
-            g: self.joint.reduce(y.as_ref()),
-            g_m: Mat::from_fn(6, y.ncols(), |d, j| y[(self.master[d], j)]),
-            truncation: Truncation::new(model, phi.as_ref(), self.modes.as_ref())?,
-            rom: rom.clone(),
-        })
+        Ok(phi)
     }
 }
 
@@ -603,14 +669,28 @@ impl ErrorEstimator<'_> {
                 }
             }
             let u_hat = &u_joint + &self.truncation.b_psi * excess.subcols(first, cols);
-            for c in 0..cols {
+            // The two corrections are independent sequences over the outputs (each warm-starts
+            // from its own previous active set): one per core, the same bits as one after the
+            // other.
+            let series = |corr: &mut Corrector<'_>, u: &Mat<f64>| -> Result<Vec<Vec<f64>>, Error> {
+                (0..cols)
+                    .map(|c| {
+                        let j = first + c;
+                        let u: Vec<f64> = u.col(c).iter().copied().collect();
+                        corr.correct(&u, &states.p[3 * w * j..3 * w * (j + 1)])
+                            .map_err(at(j))
+                    })
+                    .collect()
+            };
+            // The joint part alone (no truncated-mode dynamics) ranks the pairs.
+            let (full, joint) = rayon::join(
+                || series(&mut corr, &u_hat),
+                || series(&mut corr_joint, &u_joint),
+            );
+            let (full, joint) = (full?, joint?);
+            for (c, (pc, pj)) in full.into_iter().zip(joint).enumerate() {
                 let j = first + c;
                 let p = &states.p[3 * w * j..3 * w * (j + 1)];
-                let u: Vec<f64> = u_hat.col(c).iter().copied().collect();
-                let pc = corr.correct(&u, p).map_err(at(j))?;
-                // The joint part alone (no truncated-mode dynamics): it ranks the pairs.
-                let u: Vec<f64> = u_joint.col(c).iter().copied().collect();
-                let pj = corr_joint.correct(&u, p).map_err(at(j))?;
                 let (mut fc, mut fr, mut fc_rom, mut fr_rom, mut fcj) = (0.0, 0.0, 0.0, 0.0, 0.0);
                 for k in 0..w {
                     fc += pc[3 * k + NORMAL].powi(2);

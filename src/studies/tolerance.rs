@@ -55,6 +55,7 @@
 //! user's tolerances above TOL — the best model is returned with `met = false` (the CLI warns;
 //! tighter `--rtol/--atol` lower the integration floor).
 
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 use serde::Serialize;
@@ -187,18 +188,19 @@ pub fn integration_errors_from(check: &Run, run: &Run, opts: &TransientOptions) 
     }
 }
 
-/// Runs `check` on a scoped second thread while `main` runs on this one; a panic on the second
-/// thread resumes here, as it would have in a sequential call.
-fn beside<A, B: Send>(
-    main: impl FnOnce() -> A,
-    check: Option<impl FnOnce() -> B + Send>,
-) -> (A, Option<B>) {
-    std::thread::scope(|s| {
-        let handle = check.map(|c| s.spawn(c));
-        let a = main();
-        let b = handle.map(|h| h.join().unwrap_or_else(|p| std::panic::resume_unwind(p)));
-        (a, b)
-    })
+/// Runs `second` as a job of rayon's pool while `main` runs on this thread, and returns both
+/// results; a panic in either resumes here. The wait for `second` is rayon's (the thread takes
+/// other jobs meanwhile), so this is safe inside a rayon worker too — a sweep's variants run
+/// [`run_estimated`] on the workers, and an OS thread joined there would block a worker that its
+/// own nested parallel solves need (measured: the sweep test deadlocked).
+fn beside<A, B: Send>(main: impl FnOnce() -> A, second: impl FnOnce() -> B + Send) -> (A, B) {
+    let mut b = None;
+    let a = rayon::in_place_scope(|s| {
+        let slot = &mut b;
+        s.spawn(move |_| *slot = Some(second()));
+        main()
+    });
+    (a, b.expect("the scope ran its job"))
 }
 
 /// `opts` with rtol and atol times `factor`.
@@ -225,35 +227,49 @@ pub fn run_estimated(
     check_integration: bool,
     observe: impl FnMut(f64, &[f64]),
 ) -> Result<(Run, Result<RunEstimate, Error>), Error> {
-    let estimator = flex.estimator(model, &rom)?;
-    let check_rom = check_integration.then(|| rom.clone());
+    flex.basis_of(&rom)?;
     let opts = TransientOptions {
         record: true,
         ..opts.clone()
     };
     let opts = &opts;
-    let ((run, estimate), check) = beside(
+    // The estimator's setup (r refined solves, the truncated modes), the integration check and
+    // the flexibility columns the estimate will need do not depend on the run: they go on a
+    // second thread beside it, the columns only while the run lasts.
+    let aside = rom.clone();
+    let running = AtomicBool::new(false);
+    let stop = &running;
+    let (mut run, (estimator, check)) = beside(
         || {
-            let mut run = integrate(rom, scene, opts, observe);
-            let estimate = match run.trajectory.take() {
-                Some(tr) if run.status.finished() => estimator.estimate(
-                    &pair_law(scene, &opts.problem),
-                    RunStates {
-                        t: &run.curves.t,
-                        q: &tr.q,
-                        p: &tr.p,
-                        s: &tr.s,
-                    },
-                ),
-                _ => Err(Error::Invalid(format!(
-                    "no error estimate: the run ended early ({})",
-                    run.status
-                ))),
-            };
-            (run, estimate)
+            let run = integrate(rom, scene, opts, observe);
+            stop.store(true, Ordering::Relaxed);
+            run
         },
-        check_rom.map(|rom| move || integration_check_run(rom, scene, opts)),
+        move || {
+            let estimator = flex.estimator(model, &aside);
+            let check = check_integration.then(|| integration_check_run(aside, scene, opts));
+            if estimator.is_ok() {
+                // A column that fails here fails again, named, in the estimate.
+                let _ = flex.prefetch_normal_columns(stop);
+            }
+            (estimator, check)
+        },
     );
+    let estimate = match run.trajectory.take() {
+        Some(tr) if run.status.finished() => estimator?.estimate(
+            &pair_law(scene, &opts.problem),
+            RunStates {
+                t: &run.curves.t,
+                q: &tr.q,
+                p: &tr.p,
+                s: &tr.s,
+            },
+        ),
+        _ => Err(Error::Invalid(format!(
+            "no error estimate: the run ended early ({})",
+            run.status
+        ))),
+    };
     let estimate = estimate.and_then(|detail| {
         let integration = match check {
             Some(c) => Some(integration_errors_from(&c?, &run, opts)),
@@ -359,9 +375,9 @@ pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<Toleran
     let tol = opts.tolerance;
     check_tolerance(tol)?;
     let start = Instant::now();
-    let flex = JointFlexibility::new(model)?;
     let mut nu = opts.nu;
-    let mut cb = craig_bampton(model, nu)?;
+    let (flex, cb) = beside(|| JointFlexibility::new(model), || craig_bampton(model, nu));
+    let (flex, mut cb) = (flex?, cb?);
     let setup_s = start.elapsed().as_secs_f64();
     let mut pairs: Vec<usize> = Vec::new();
     let mut rounds = Vec::new();
@@ -376,27 +392,16 @@ pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<Toleran
             if ranking { RANKING_LOOSENING } else { 1.0 },
         );
         // Any round at the user's tolerances may be the result: its integration check runs
-        // beside it (on a second core; discarded when the round is not the last).
-        let scene = Scene::of(model);
-        let check_rom = (!ranking).then(|| rom.clone());
-        let (estimated, check) = beside(
-            || {
-                run_estimated(
-                    model,
-                    &flex,
-                    rom.clone(),
-                    &scene,
-                    &transient,
-                    false,
-                    |_, _| {},
-                )
-            },
-            check_rom.map(|rom| {
-                let (scene, transient) = (&scene, &opts.transient);
-                move || integration_check_run(rom, scene, transient)
-            }),
-        );
-        let (run, estimate) = estimated?;
+        // beside it (on a second core; unused when the round is not the last).
+        let (run, estimate) = run_estimated(
+            model,
+            &flex,
+            rom.clone(),
+            &Scene::of(model),
+            &transient,
+            !ranking,
+            |_, _| {},
+        )?;
         let run = run.into_result()?;
         let estimate = estimate?;
         let eta = estimate.reduction.contact_force.unwrap_or(0.0);
@@ -437,13 +442,6 @@ pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<Toleran
             continue;
         }
         if !changed {
-            let check = check.ok_or_else(|| {
-                Error::Invalid("internal: the result's round ran no integration check".into())
-            })??;
-            let mut estimate = estimate;
-            let integration = integration_errors_from(&check, &run, &opts.transient);
-            estimate.total = estimate.reduction.combine(&integration);
-            estimate.integration = Some(integration);
             let offline_s = (round_start - start).as_secs_f64() + basis_s;
             let estimate_s = round_start.elapsed().as_secs_f64() - basis_s - run.wall_s;
             return Ok(ToleranceModel {
