@@ -5,12 +5,13 @@
 
 use serde_json::Value;
 
-use jointrom::integrate::TransientOptions;
+use jointrom::integrate::{integrate, TransientOptions};
 use jointrom::joint::statics::ContactOptions;
 use jointrom::model::contact_static_full;
-use jointrom::reduction::{build_basis, BasisKind, BasisOptions, JointFlexibility};
+use jointrom::reduction::{build_basis, BasisKind, BasisOptions, JointFlexibility, RunStates};
 use jointrom::studies::tolerance::{
-    integration_errors, run_estimated, static_tolerance_model, tolerance_model, ToleranceOptions,
+    integration_errors, pair_law, run_estimated, static_tolerance_model, tolerance_model,
+    ToleranceOptions,
 };
 use jointrom::system::{ReducedSystem, Scene};
 
@@ -114,6 +115,63 @@ fn tolerance_model_meets_the_stored_full_reference() {
         assert!(t.pairs.len() < m.pair_count());
         assert!(t.offline_s > 0.0 && t.run.wall_s > 0.0 && t.estimate_s > 0.0);
     }
+}
+
+/// Prefetched flexibility columns (`prefetch_normal_columns`, solved beside a run) give the
+/// estimate the same bits as columns solved on demand, and a set stop signal solves none.
+#[test]
+fn prefetched_columns_leave_the_estimate_unchanged() {
+    use std::sync::atomic::AtomicBool;
+    let m = model("friction_bar");
+    let basis = build_basis(&m, BasisKind::Tvd, &BasisOptions::default()).unwrap();
+    let rom = ReducedSystem::new(&m, basis.phi).unwrap();
+    let opts = TransientOptions {
+        end_time: Some(0.01),
+        record: true,
+        ..Default::default()
+    };
+    let scene = Scene::of(&m);
+    let mut run = integrate(rom.clone(), &scene, &opts, |_, _| {});
+    let tr = run.trajectory.take().unwrap();
+    let estimate = |flex: &JointFlexibility| {
+        let states = RunStates {
+            t: &run.curves.t,
+            q: &tr.q,
+            p: &tr.p,
+            s: &tr.s,
+        };
+        let estimator = flex.estimator(&m, &rom).unwrap();
+        estimator
+            .estimate(&pair_law(&scene, &opts.problem), states)
+            .unwrap()
+    };
+    let cold = JointFlexibility::new(&m).unwrap();
+    assert_eq!(
+        cold.prefetch_normal_columns(&AtomicBool::new(true))
+            .unwrap(),
+        0
+    );
+    assert_eq!(cold.solved_columns(), 0);
+    let on_demand = estimate(&cold);
+    assert!(
+        cold.solved_columns() > 0,
+        "the estimate solved its columns on demand"
+    );
+    let warm = JointFlexibility::new(&m).unwrap();
+    let solved = warm
+        .prefetch_normal_columns(&AtomicBool::new(false))
+        .unwrap();
+    assert_eq!(solved, m.pair_count());
+    let prefetched = estimate(&warm);
+    assert_eq!(on_demand.pair_error, prefetched.pair_error);
+    assert_eq!(
+        on_demand.corrected_contact_force,
+        prefetched.corrected_contact_force
+    );
+    assert_eq!(
+        on_demand.errors.contact_force,
+        prefetched.errors.contact_force
+    );
 }
 
 /// The integration check that runs beside its run on a second thread gives the same numbers as
