@@ -395,12 +395,16 @@ impl JointFlexibility {
     /// statics), and its first use is on the second core beside a reduced run
     /// ([`crate::studies::tolerance::run_estimated`]).
     fn truncation_modes(&self, model: &Model) -> Result<Arc<Mat<f64>>, Error> {
-        // Held while computing: a second estimator (parallel sweeps) waits for the same modes.
-        let mut slot = self
-            .modes
-            .lock()
-            .unwrap_or_else(std::sync::PoisonError::into_inner);
-        if let Some(m) = slot.as_ref() {
+        // Not held while computing: the modes' solves may run on rayon's pool, and a worker
+        // waiting there can take another estimator's job that wants this lock (the deadlock
+        // class of `studies::tolerance::beside`). Two estimators may both compute them: the
+        // same bits, the first one kept.
+        let slot = || {
+            self.modes
+                .lock()
+                .unwrap_or_else(std::sync::PoisonError::into_inner)
+        };
+        if let Some(m) = slot().as_ref() {
             return Ok(Arc::clone(m));
         }
         let n = self.stiffness.n;
@@ -418,9 +422,7 @@ impl JointFlexibility {
         } else {
             Mat::zeros(n, 0)
         };
-        let modes = Arc::new(modes);
-        *slot = Some(Arc::clone(&modes));
-        Ok(modes)
+        Ok(Arc::clone(slot().get_or_insert_with(|| Arc::new(modes))))
     }
 
     /// The basis Φ of `rom` if an estimator of it can be built on this flexibility: `rom`

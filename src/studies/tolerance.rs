@@ -443,7 +443,7 @@ pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<Toleran
         }
         if !changed {
             let offline_s = (round_start - start).as_secs_f64() + basis_s;
-            let estimate_s = round_start.elapsed().as_secs_f64() - basis_s - run.wall_s;
+            let estimate_s = rounds.last().map_or(0.0, |r| r.estimate_s);
             return Ok(ToleranceModel {
                 pairs,
                 nu,
