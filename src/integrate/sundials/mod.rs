@@ -218,6 +218,37 @@ mod tests {
         }
     }
 
+    /// The Rust vector operations (`fast_ops`) against the library's own serial ones, called
+    /// directly: the same bits.
+    #[test]
+    fn fast_vector_operations_match_the_librarys() {
+        let ctx = Context::new().unwrap();
+        for len in [1usize, 3, 4, 5, 154, 1918] {
+            let vals = |k: f64| -> Vec<f64> {
+                (0..len)
+                    .map(|i| ((i as f64 + k) * 0.7311).sin() * 10f64.powi((i % 7) as i32 - 3))
+                    .collect()
+            };
+            let x = SerialVector::from_slice(&ctx, &vals(0.0)).unwrap();
+            let y = SerialVector::from_slice(&ctx, &vals(1.0)).unwrap();
+            let w = SerialVector::from_slice(&ctx, &vals(2.0)).unwrap();
+            let z1 = SerialVector::zeros(&ctx, len).unwrap();
+            let z2 = SerialVector::zeros(&ctx, len).unwrap();
+            // SAFETY: all five are live serial vectors of length `len`; the operations read
+            // x, y, w and write z1 (through the patched ops table) and z2 (the library's).
+            let (fast, lib) = unsafe {
+                sundials_sys::N_VLinearSum(0.3, x.as_raw(), -1.7, y.as_raw(), z1.as_raw());
+                sundials_sys::N_VLinearSum_Serial(0.3, x.as_raw(), -1.7, y.as_raw(), z2.as_raw());
+                (
+                    sundials_sys::N_VWrmsNorm(x.as_raw(), w.as_raw()),
+                    sundials_sys::N_VWrmsNorm_Serial(x.as_raw(), w.as_raw()),
+                )
+            };
+            assert_eq!(z1.as_slice(), z2.as_slice(), "linear sum, length {len}");
+            assert_eq!(fast.to_bits(), lib.to_bits(), "WRMS norm, length {len}");
+        }
+    }
+
     #[test]
     fn vector_from_slice_outlives_its_context_handle() {
         let ctx = Context::new().unwrap();
