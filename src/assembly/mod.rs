@@ -69,13 +69,22 @@ pub fn assemble_structure(mesh: &Mesh) -> Result<Structure, Error> {
         .collect();
     let assembler = Assembler::new(&dof_map, element_nodes);
     let (ns, nb, nw) = (shells.len(), beams.len(), welds.len());
+    // The shells a weld's re-meshed neighbourhood replaces (its condensed matrices stand for them).
+    let replaced: std::collections::HashSet<usize> = mesh
+        .welds
+        .iter()
+        .filter_map(|w| w.patch.as_ref())
+        .flat_map(|p| p.replaced.iter().copied())
+        .collect();
     let stiffness = assembler.assemble(|e| match e {
+        e if replaced.contains(&e) => Mat::zeros(24, 24),
         e if e < ns => shells[e].stiffness(),
         e if e < ns + nb => beams[e - ns].stiffness(),
         e if e < ns + nb + nw => welds[e - ns - nb].stiffness(),
         _ => Mat::zeros(6, 6),
     });
     let mass = assembler.assemble(|e| match e {
+        e if replaced.contains(&e) => Mat::zeros(24, 24),
         e if e < ns => shells[e].mass(),
         e if e < ns + nb => beams[e - ns].mass(),
         e if e < ns + nb + nw => welds[e - ns - nb].mass(),

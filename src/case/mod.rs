@@ -189,6 +189,12 @@ pub struct WeldSpec {
     /// How the weld attaches to the sheets; `"area"` when omitted.
     #[serde(default)]
     pub model: WeldModel,
+    /// Shell size of the nugget's neighbourhood, mm (area welds; optional, > 0 and below the
+    /// sheets' element size): the sheets' shells around the nugget are re-meshed at this size
+    /// and condensed onto the sheets' own nodes (`crate::element::weld_patch`). Omitted: the
+    /// nugget acts on the sheets' own shells.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub local_mesh: Option<f64>,
 }
 
 /// How a spot weld attaches to its sheets.

@@ -64,7 +64,8 @@
 //! (+7 % on the first mode, +26 % on the tenth at the default mesh). The RBE3 + beam weld does
 //! not lock; what it leaves out is the fused disc's composite stiffness, which makes its
 //! converged limit 1–5 % softer than the solid in the modes where the sheets move against each
-//! other (README, *Spot welds*).
+//! other (README, *Spot welds*). With a re-meshed neighbourhood (a weld's `local_mesh`,
+//! [`super::weld_patch`]) the slab no longer locks, and that is the model used there.
 //!
 //! # Mass
 //!
@@ -88,12 +89,24 @@ pub struct Weld {
     maps: Vec<Mat<f64>>,
     /// Connector beams between consecutive reference points.
     beams: Vec<Beam2>,
+    /// With a re-meshed neighbourhood ([`super::weld_patch`]): the condensed stiffness and mass
+    /// on the DOF of `nodes` (and no maps or beams of its own).
+    condensed: Option<(Mat<f64>, Mat<f64>)>,
 }
 
 impl Weld {
     /// Builds the interpolation constraints and connector beams of `weld`. Errors ([`Error::Element`]) if a layer has too few points for a
     /// rigid fit (collinear or fewer than three) or a connector beam is invalid.
     pub fn new(weld: &WeldElem, material: Material) -> Result<Weld, Error> {
+        if let Some(patch) = &weld.patch {
+            let c = super::weld_patch::condense(weld, patch, material)?;
+            return Ok(Weld {
+                nodes: c.nodes,
+                maps: Vec::new(),
+                beams: Vec::new(),
+                condensed: Some((c.stiffness, c.mass)),
+            });
+        }
         let mut touched: Vec<usize> = weld
             .layers
             .iter()
@@ -122,6 +135,7 @@ impl Weld {
             nodes: touched,
             maps,
             beams,
+            condensed: None,
         })
     }
 
@@ -131,13 +145,17 @@ impl Weld {
     }
 
     /// `T_ℓ` of layer `layer` (lower to upper): the reference point's `[u_c, θ_c]` (mm, rad) as a
-    /// 6 × 6N map of the nodes' DOF.
-    pub fn reference_map(&self, layer: usize) -> &Mat<f64> {
-        &self.maps[layer]
+    /// 6 × 6N map of the nodes' DOF; `None` for a weld with a re-meshed neighbourhood (its
+    /// reference points live on the small shells) or past the last layer.
+    pub fn reference_map(&self, layer: usize) -> Option<&Mat<f64>> {
+        self.maps.get(layer)
     }
 
     /// Stiffness on the DOF of [`Weld::nodes`], N/mm, N, N·mm/rad.
     pub fn stiffness(&self) -> Mat<f64> {
+        if let Some((k, _)) = &self.condensed {
+            return k.clone();
+        }
         let dofs = 6 * self.nodes.len();
         let mut k = Mat::<f64>::zeros(dofs, dofs);
         for (l, beam) in self.beams.iter().enumerate() {
@@ -162,8 +180,12 @@ impl Weld {
         k
     }
 
-    /// Mass on the DOF of [`Weld::nodes`]: zero (the nugget's material belongs to the sheets).
+    /// Mass on the DOF of [`Weld::nodes`]: zero (the nugget's material belongs to the sheets),
+    /// or with a re-meshed neighbourhood the condensed mass of its small shells.
     pub fn mass(&self) -> Mat<f64> {
+        if let Some((_, m)) = &self.condensed {
+            return m.clone();
+        }
         let dofs = 6 * self.nodes.len();
         Mat::zeros(dofs, dofs)
     }

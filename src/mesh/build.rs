@@ -7,7 +7,9 @@ use std::collections::{HashMap, HashSet};
 
 use super::nugget;
 use super::Material;
-use super::{BeamElem, JointPair, Mesh, RigidTie, SheetGrid, ShellElem, WeldElem};
+use super::{
+    BeamElem, JointPair, Mesh, PatchLayer, RigidTie, SheetGrid, ShellElem, WeldElem, WeldPatch,
+};
 use crate::case::validate::{check_contact_and_load, check_material, check_sheets, Ctx};
 use crate::case::{Case, ClampSpec, JointSpec, RigidTieSpec, WeldModel, WeldSpec, NODE_TOLERANCE};
 use crate::error::Error;
@@ -41,6 +43,7 @@ pub(super) fn build(case: &Case) -> Result<Mesh, Error> {
         .collect();
     let (tied, tie) = sheets.rigid_tie(&case.rigid_tie, &clamp_of, &mut nodes)?;
     let welds = sheets.welds(&case.welds)?;
+    check_patches(&ctx, &welds.welds, &clamp_of, &tied)?;
     let supports = Supports {
         clamp_of,
         tied,
@@ -106,6 +109,91 @@ fn nodes_and_shells(grids: &[Grid]) -> (Vec<[f64; 3]>, Vec<ShellElem>) {
         }
     }
     (nodes, shells)
+}
+
+/// A weld's re-meshed neighbourhood (`local_mesh`) may neither hold a clamped or tied node
+/// (the small shells would not be held with it) nor overlap another weld's.
+fn check_patches(
+    ctx: &Ctx,
+    welds: &[WeldElem],
+    clamp_of: &[Option<usize>],
+    tied: &[bool],
+) -> Result<(), Error> {
+    let mut owner: HashMap<usize, usize> = HashMap::new();
+    for weld in welds {
+        let Some(patch) = &weld.patch else { continue };
+        let path = format!("welds[{}].local_mesh", weld.index);
+        for layer in &patch.layers {
+            if let Some(&n) = layer
+                .nodes
+                .iter()
+                .find(|&&n| clamp_of[n].is_some() || tied[n])
+            {
+                let what = if tied[n] { "rigid tie" } else { "clamp" };
+                return Err(ctx.err(
+                    path.as_str(),
+                    format!(
+                        "the re-meshed neighbourhood ({} ≤ x ≤ {}, {} ≤ z ≤ {} mm) reaches the \
+                         {what} (node at x = {} mm): move the weld or drop `local_mesh`",
+                        layer.xs[0],
+                        layer.xs[layer.xs.len() - 1],
+                        layer.zs[0],
+                        layer.zs[layer.zs.len() - 1],
+                        layer.xs[layer.nodes.iter().position(|&m| m == n).unwrap_or(0)
+                            / layer.zs.len()]
+                    ),
+                ));
+            }
+        }
+        for &shell in &patch.replaced {
+            if let Some(other) = owner.insert(shell, weld.index) {
+                return Err(ctx.err(
+                    path.as_str(),
+                    format!(
+                        "the re-meshed neighbourhood overlaps that of welds[{other}] (they share \
+                         shells): the welds are too close for separate neighbourhoods"
+                    ),
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Half-width of the square around a weld centre whose shells a `local_mesh` re-meshes, in
+/// nugget diameters (`crate::element::weld_patch`: measured on the friction bar, a half-width
+/// of one diameter leaves the patch's sides where the nugget's field is still strong).
+const PATCH_REACH: f64 = 2.0;
+
+/// Most nodes of a weld's re-meshed neighbourhood on one sheet (`local_mesh`).
+const MAX_PATCH_NODES: usize = 250_000;
+
+/// The small shell of a weld patch's grid (`xs` × `zs`, nodes numbered from `offset`, z
+/// fastest) containing `p` and the bilinear shape functions of its nodes there, in
+/// [`ShellElem`] node order.
+fn fine_interpolation(
+    xs: &[f64],
+    zs: &[f64],
+    offset: usize,
+    p: [f64; 2],
+) -> ([usize; 4], [f64; 4]) {
+    let cell = |lines: &[f64], v: f64| -> (usize, f64) {
+        let j = lines.partition_point(|&l| l <= v).clamp(1, lines.len() - 1) - 1;
+        let t = ((v - lines[j]) / (lines[j + 1] - lines[j])).clamp(0.0, 1.0);
+        (j, t)
+    };
+    let ((i, xi), (k, eta)) = (cell(xs, p[0]), cell(zs, p[1]));
+    let nz = zs.len();
+    let id = |i: usize, k: usize| offset + i * nz + k;
+    (
+        [id(i, k), id(i + 1, k), id(i + 1, k + 1), id(i, k + 1)],
+        [
+            (1.0 - xi) * (1.0 - eta),
+            xi * (1.0 - eta),
+            xi * eta,
+            (1.0 - xi) * eta,
+        ],
+    )
 }
 
 /// Which sheet nodes are held, for excluding them from joints and for messages.
@@ -483,10 +571,23 @@ impl Sheets<'_> {
                 }
             }
             self.check_nugget(welds, w, &stack)?;
+            if let Some(size) = weld.local_mesh {
+                ctx.positive(&format!("{p}.local_mesh"), size, " mm")?;
+                if weld.model == WeldModel::Point {
+                    return Err(ctx.err(
+                        format!("{p}.local_mesh"),
+                        "applies to area welds; a point weld (\"model\": \"point\") joins two \
+                         nodes and has no neighbourhood to re-mesh",
+                    ));
+                }
+            }
             match weld.model {
                 WeldModel::Point => out.beams.extend(self.point_weld(weld, &p, &stack)?),
                 WeldModel::Area => {
-                    let elem = self.area_weld(w, weld, &stack)?;
+                    let mut elem = self.area_weld(w, weld, &stack)?;
+                    if let Some(size) = weld.local_mesh {
+                        elem.patch = Some(self.weld_patch(w, weld, &stack, size)?);
+                    }
                     out.nuggets.push(Nugget {
                         index: w,
                         centre: elem.centre,
@@ -576,7 +677,115 @@ impl Sheets<'_> {
             centre,
             diameter: weld.diameter,
             layers,
+            patch: None,
         })
+    }
+
+    /// The re-meshed neighbourhood of area weld `welds[w]` (`local_mesh` = `size`, mm): on each
+    /// sheet of the stack the rectangle of its shells that meet the square of half-width
+    /// [`PATCH_REACH`] · d around the centre, every shell cut into shells of at most `size` along each side, and the
+    /// nugget sampled on those (`crate::element::weld_patch` condenses them).
+    fn weld_patch(
+        &self,
+        w: usize,
+        weld: &WeldSpec,
+        stack: &[usize],
+        size: f64,
+    ) -> Result<WeldPatch, Error> {
+        let (grids, ctx) = (self.grids, self.ctx);
+        let path = format!("welds[{w}].local_mesh");
+        let centre = [weld.x, weld.z];
+        let reach = PATCH_REACH * weld.diameter;
+        let mut layers = Vec::with_capacity(stack.len());
+        let mut replaced = Vec::new();
+        let mut nugget = Vec::with_capacity(stack.len());
+        let mut offset = 0usize;
+        let clip = Rect::common(stack.iter().map(|&s| &grids[s]));
+        let inside = |p: [f64; 2]| clip.contains(p);
+        for &s in stack {
+            let g = &grids[s];
+            let h = g.step[0].min(g.step[1]);
+            if size >= h {
+                return Err(ctx.err(
+                    path.as_str(),
+                    format!(
+                        "{size} mm is not smaller than the elements of sheet `{}` ({h} mm): \
+                         nothing to re-mesh",
+                        g.name
+                    ),
+                ));
+            }
+            let range = |a: usize| {
+                let lo = (centre[a] - reach - g.lo[a]) / g.step[a];
+                let hi = (centre[a] + reach - g.lo[a]) / g.step[a];
+                let i0 = (lo + 1e-9).floor().clamp(0.0, g.n[a] as f64 - 1.0) as usize;
+                let i1 = ((hi - 1e-9).ceil().clamp(1.0, g.n[a] as f64) as usize).max(i0 + 1);
+                (i0, i1)
+            };
+            let ((i0, i1), (k0, k1)) = (range(0), range(1));
+            let xs: Vec<f64> = (i0..=i1).map(|i| g.coord(0, i)).collect();
+            let zs: Vec<f64> = (k0..=k1).map(|k| g.coord(1, k)).collect();
+            let nodes = (i0..=i1)
+                .flat_map(|i| (k0..=k1).map(move |k| g.index(i, k)))
+                .collect();
+            let fine = |lines: &[f64]| -> Vec<f64> {
+                let mut out = vec![lines[0]];
+                for pair in lines.windows(2) {
+                    let m = ((pair[1] - pair[0]) / size - 1e-9).ceil().max(1.0) as usize;
+                    out.extend(
+                        (1..=m).map(|j| pair[0] + (pair[1] - pair[0]) * j as f64 / m as f64),
+                    );
+                }
+                out
+            };
+            let (fine_xs, fine_zs) = (fine(&xs), fine(&zs));
+            let count = fine_xs.len() * fine_zs.len();
+            if count > MAX_PATCH_NODES {
+                return Err(ctx.err(
+                    path.as_str(),
+                    format!(
+                        "{size} mm shells over the {} × {} mm around the nugget on sheet `{}` \
+                         would be {count} nodes (at most {MAX_PATCH_NODES} per sheet)",
+                        xs[xs.len() - 1] - xs[0],
+                        zs[zs.len() - 1] - zs[0],
+                        g.name
+                    ),
+                ));
+            }
+            let base = self.shell_base(s);
+            replaced.extend((i0..i1).flat_map(|i| (k0..k1).map(move |k| base + i * g.n[1] + k)));
+            let interpolation = |p: [f64; 2]| fine_interpolation(&fine_xs, &fine_zs, offset, p);
+            let view = nugget::SheetView {
+                sheet: s,
+                y: g.y,
+                h: size,
+                interpolation: &interpolation,
+            };
+            nugget.push(nugget::sample(centre, weld.diameter, &inside, &view));
+            offset += count;
+            layers.push(PatchLayer {
+                sheet: s,
+                y: g.y,
+                thickness: g.thickness,
+                xs,
+                zs,
+                nodes,
+                fine_xs,
+                fine_zs,
+                free_side: [i0 == 0, i1 == g.n[0], k0 == 0, k1 == g.n[1]],
+            });
+        }
+        Ok(WeldPatch {
+            size,
+            layers,
+            replaced,
+            nugget,
+        })
+    }
+
+    /// Index into the mesh's shells of sheet `s`'s first shell ([`nodes_and_shells`] order).
+    fn shell_base(&self, s: usize) -> usize {
+        self.grids[..s].iter().map(|g| g.n[0] * g.n[1]).sum()
     }
 
     /// The nugget of weld `w` (diameter d, on the sheets `stack`) fits each sheet (d no larger

@@ -844,6 +844,7 @@ fn welds(
             centre,
             diameter: d,
             layers,
+            patch: None,
         });
     }
     Ok((out, beams))

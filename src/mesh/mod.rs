@@ -47,6 +47,50 @@ pub struct WeldElem {
     pub diameter: f64,
     /// The welded sheets, lower to upper (strictly increasing y).
     pub layers: Vec<NuggetLayer>,
+    /// The re-meshed neighbourhood of the nugget (a weld's `local_mesh`), if any.
+    pub patch: Option<WeldPatch>,
+}
+
+/// The neighbourhood of an area weld's nugget re-meshed with small shells and condensed onto
+/// the sheets' own nodes (`crate::element::weld_patch`): the sheets' shells it replaces are
+/// left out of the assembly.
+#[derive(Clone, Debug, PartialEq)]
+pub struct WeldPatch {
+    /// Size of the small shells, mm.
+    pub size: f64,
+    /// Per welded sheet, lower to upper (as [`WeldElem::layers`]).
+    pub layers: Vec<PatchLayer>,
+    /// Indices into [`Mesh::shells`] of the shells the patch replaces.
+    pub replaced: Vec<usize>,
+    /// The nugget sampled on the small shells, per layer; its node indices number the small
+    /// shells' nodes layer by layer, `(layer, I, K)` → `Σ_{l < layer} (its node count) + I ·
+    /// fine_zs.len() + K`.
+    pub nugget: Vec<NuggetLayer>,
+}
+
+/// The replaced rectangle of shells on one welded sheet.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PatchLayer {
+    /// Index of the sheet (into [`Mesh::sheets`]).
+    pub sheet: usize,
+    /// Height of the sheet's mid-surface, mm.
+    pub y: f64,
+    /// Sheet thickness, mm.
+    pub thickness: f64,
+    /// The sheet's node lines bounding and crossing the rectangle, along x and z (mm, ascending).
+    pub xs: Vec<f64>,
+    /// As `xs`, along z.
+    pub zs: Vec<f64>,
+    /// The sheet's node at `(xs[i], zs[k])`: `nodes[i * zs.len() + k]`.
+    pub nodes: Vec<usize>,
+    /// The small shells' node lines along x and z (mm, ascending; every line of `xs`, `zs` is
+    /// one of them).
+    pub fine_xs: Vec<f64>,
+    /// As `fine_xs`, along z.
+    pub fine_zs: Vec<f64>,
+    /// Whether each side of the rectangle (x low, x high, z low, z high) is the sheet's free
+    /// edge (no shell beyond it).
+    pub free_side: [bool; 4],
 }
 
 /// The nugget on one welded sheet: its sampling points on the sheet's mid-surface.

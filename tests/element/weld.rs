@@ -79,7 +79,7 @@ fn nugget_reproduces_rigid_and_uniform_motions_wherever_it_lies() {
         let weld = Weld::new(&mesh.welds[0], Material::STEEL).unwrap();
         for (layer, y) in [(0, 0.0), (1, 0.5)] {
             let c = [xz[0], y, xz[1]];
-            let t = weld.reference_map(layer);
+            let t = weld.reference_map(layer).unwrap();
             // A rigid motion: the reference point follows it exactly.
             let (a, w) = ([0.3, -0.2, 0.1], [0.01, -0.02, 0.03]);
             let got = apply(t, &field(&mesh, &weld, rigid(a, w, [1.0, 2.0, 3.0])));
@@ -96,7 +96,7 @@ fn nugget_reproduces_rigid_and_uniform_motions_wherever_it_lies() {
         // A uniform membrane strain (ux = 1e-3 x, uz = −3e-4 z + 5e-4 x): the reference point
         // of a full nugget moves with the field at its centre; the fit does not depend on the
         // mesh under the nugget.
-        let t = weld.reference_map(0);
+        let t = weld.reference_map(0).unwrap();
         let strain = |x: [f64; 3]| [1e-3 * x[0], 0.0, -3e-4 * x[2] + 5e-4 * x[0], 0.0, 0.0, 0.0];
         let got = apply(t, &field(&mesh, &weld, strain));
         if xz[1] < 60.0 {
@@ -236,5 +236,135 @@ fn the_area_weld_converges_where_the_point_weld_drifts() {
     assert!(
         sp.windows(2).all(|w| w[1] > w[0]) && sp[2] > 0.05,
         "point {point:?}: {sp:?}"
+    );
+}
+
+/// [`plates`] with the weld's neighbourhood re-meshed at `size` mm (`local_mesh`).
+fn plates_local(n: usize, weld: [f64; 2], size: f64) -> Case {
+    let mut case = plates(n, weld, "area");
+    case.welds[0].local_mesh = Some(size);
+    case
+}
+
+#[test]
+fn resolved_neighbourhood_is_symmetric_keeps_rigid_modes_and_the_mass() {
+    let case = plates_local(6, [31.25, 28.75], 0.625);
+    let mesh = Mesh::from_case(&case).unwrap();
+    let patch = mesh.welds[0]
+        .patch
+        .as_ref()
+        .expect("a re-meshed neighbourhood");
+    let weld = Weld::new(&mesh.welds[0], Material::STEEL).unwrap();
+    assert!(weld.reference_map(0).is_none());
+    // It stands on the sheets' own nodes of its rectangles.
+    let own: Vec<usize> = patch.layers.iter().flat_map(|l| l.nodes.clone()).collect();
+    assert!(weld.nodes().iter().all(|n| own.contains(n)));
+    assert_eq!(weld.nodes().len(), own.len());
+    let (k, m) = (weld.stiffness(), weld.mass());
+    let scale = (0..k.nrows()).map(|i| k[(i, i)]).fold(0.0, f64::max);
+    for i in 0..k.nrows() {
+        for j in 0..i {
+            assert_eq!(k[(i, j)], k[(j, i)]);
+            assert_eq!(m[(i, j)], m[(j, i)]);
+        }
+    }
+    for (a, w) in [
+        ([1.0, 0.0, 0.0], [0.0; 3]),
+        ([0.0, 1.0, 0.0], [0.0; 3]),
+        ([0.0; 3], [0.02, 0.0, 0.0]),
+        ([0.0; 3], [0.0, 0.02, 0.0]),
+        ([0.0; 3], [0.0, 0.0, 0.02]),
+    ] {
+        let u = field(&mesh, &weld, rigid(a, w, [30.0, 0.25, 30.0]));
+        let ku = apply(&k, &u);
+        let worst = ku.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        assert!(worst < 1e-8 * scale, "{a:?} {w:?}: {worst} against {scale}");
+    }
+    // A rigid translation carries the mass of the replaced shells: ρ t × their area, per sheet.
+    let area: f64 = patch
+        .layers
+        .iter()
+        .map(|l| (l.xs[l.xs.len() - 1] - l.xs[0]) * (l.zs[l.zs.len() - 1] - l.zs[0]))
+        .sum();
+    let want = 7.85e-9 * 0.5 * area;
+    let u = field(&mesh, &weld, rigid([0.0, 1.0, 0.0], [0.0; 3], [0.0; 3]));
+    let got: f64 = u.iter().zip(apply(&m, &u)).map(|(a, b)| a * b).sum();
+    assert!((got / want - 1.0).abs() < 1e-10, "{got} vs {want}");
+    // The sheets' own shells of the rectangles are replaced: the structure's total mass stays.
+    let with = Model::from_case(case).unwrap();
+    let without = Model::from_case(plates(6, [31.25, 28.75], "area")).unwrap();
+    let total = |m: &Model| {
+        let n = m.dofs();
+        let mut e = vec![0.0; n];
+        for (i, v) in e.iter_mut().enumerate() {
+            if i % 6 == 1 {
+                *v = 1.0;
+            }
+        }
+        let mut me = vec![0.0; n];
+        m.mass.mul_vec(&e, &mut me);
+        e.iter().zip(&me).map(|(a, b)| a * b).sum::<f64>()
+    };
+    assert!((total(&with) / total(&without) - 1.0).abs() < 1e-10);
+}
+
+/// The re-meshed neighbourhood's answer moves little with its own shell size and sits above
+/// the RBE3 weld's limit (the fused disc's composite stiffness, which the RBE3 leaves out).
+/// Measured (uy, mm): 0.3125 mm −0.04238, 0.625 mm −0.04189 (1.2 %); the RBE3 weld on uniform
+/// 1.25 mm shells −0.04955. (Refining these 10 mm sheets themselves moves uy by 9 %: a plate
+/// loaded through one 5 mm weld is a concentrated-load problem far from the patch too; the
+/// friction bar's convergence is in the README.)
+#[test]
+fn resolved_neighbourhood_converges_with_its_shells() {
+    let uy = |case: Case| {
+        let m = Model::from_case(case).unwrap();
+        m.static_linear(&[m.master_load()]).unwrap()[0].master_displacement[1]
+    };
+    let fine = uy(plates_local(6, [30.0, 30.0], 0.3125));
+    let coarse = uy(plates_local(6, [30.0, 30.0], 0.625));
+    let uniform = deflection(48, "area");
+    assert!((coarse / fine - 1.0).abs() < 0.02, "{coarse} vs {fine}");
+    assert!(fine.abs() < 0.9 * uniform.abs(), "{fine} vs {uniform}");
+}
+
+#[test]
+fn resolved_neighbourhood_refuses_what_it_cannot_model() {
+    let err = |case: Result<Case, jointrom::Error>| -> String {
+        match case.and_then(|c| Mesh::from_case(&c).map(|_| ())) {
+            Ok(()) => panic!("accepted"),
+            Err(e) => e.to_string(),
+        }
+    };
+    let with = |n: usize, xz: [f64; 2], size: f64| Ok(plates_local(n, xz, size));
+    let e = err(with(6, [30.0, 30.0], -1.0));
+    assert!(
+        e.contains("welds[0].local_mesh") && e.contains("positive"),
+        "{e}"
+    );
+    let e = err(with(6, [30.0, 30.0], 10.0));
+    assert!(
+        e.contains("welds[0].local_mesh") && e.contains("not smaller"),
+        "{e}"
+    );
+    let e = err(with(6, [8.0, 30.0], 0.625));
+    assert!(
+        e.contains("welds[0].local_mesh") && e.contains("clamp"),
+        "{e}"
+    );
+    let mut point = plates(6, [30.0, 30.0], "point");
+    point.welds[0].local_mesh = Some(0.5);
+    let e = err(Ok(point));
+    assert!(
+        e.contains("welds[0].local_mesh") && e.contains("area welds"),
+        "{e}"
+    );
+    let mut two = plates_local(6, [25.0, 30.0], 0.625);
+    let mut second = two.welds[0].clone();
+    second.x = 40.0;
+    two.welds.push(second);
+    let e = err(Ok(two));
+    assert!(
+        e.contains("welds[1].local_mesh") && e.contains("overlaps"),
+        "{e}"
     );
 }
