@@ -166,7 +166,10 @@ fn check_patches(
 const PATCH_REACH: f64 = 2.0;
 
 /// Most nodes of a weld's re-meshed neighbourhood on one sheet (`local_mesh`).
-const MAX_PATCH_NODES: usize = 250_000;
+const MAX_PATCH_NODES: usize = 100_000;
+
+/// Most memory of a weld's condensation (`local_mesh`), bytes.
+const MAX_PATCH_BYTES: f64 = 4e9;
 
 /// The small shell of a weld patch's grid (`xs` × `zs`, nodes numbered from `offset`, z
 /// fastest) containing `p` and the bilinear shape functions of its nodes there, in
@@ -774,6 +777,22 @@ impl Sheets<'_> {
                 fine_zs,
                 free_side: [i0 == 0, i1 == g.n[0], k0 == 0, k1 == g.n[1]],
             });
+        }
+        // The condensation keeps two dense (internal DOF × retained DOF) matrices.
+        let internal = 6 * offset;
+        let retained = 6 * layers.iter().map(|l| l.nodes.len()).sum::<usize>();
+        let bytes = 2.0 * 8.0 * internal as f64 * retained as f64;
+        if bytes > MAX_PATCH_BYTES {
+            return Err(ctx.err(
+                path.as_str(),
+                format!(
+                    "condensing {internal} DOF of {size} mm shells onto the {retained} DOF of the \
+                     sheets' nodes around the nugget would take {:.1} GB (at most {:.0} GB): \
+                     use larger `local_mesh` shells or a coarser sheet mesh",
+                    bytes / 1e9,
+                    MAX_PATCH_BYTES / 1e9
+                ),
+            ));
         }
         Ok(WeldPatch {
             size,

@@ -341,6 +341,13 @@ fn resolved_neighbourhood_refuses_what_it_cannot_model() {
         e.contains("welds[0].local_mesh") && e.contains("positive"),
         "{e}"
     );
+    let e = err(with(6, [30.0, 30.0], 1e-3));
+    assert!(
+        e.contains("welds[0].local_mesh") && e.contains("nodes"),
+        "{e}"
+    );
+    let e = err(with(48, [30.0, 30.0], 0.1));
+    assert!(e.contains("welds[0].local_mesh") && e.contains("GB"), "{e}");
     let e = err(with(6, [30.0, 30.0], 10.0));
     assert!(
         e.contains("welds[0].local_mesh") && e.contains("not smaller"),
