@@ -67,7 +67,7 @@ use faer::Mat;
 use super::{Material, Shell4};
 use crate::error::Error;
 use crate::linalg::{SparseCholesky, SymCsc};
-use crate::mesh::{NuggetLayer, PatchLayer, WeldElem, WeldPatch};
+use crate::mesh::{line_cell, NuggetLayer, PatchLayer, WeldElem, WeldPatch};
 
 /// What a small shell node is ([`condense`]'s module docs).
 #[derive(Clone, Copy, Debug)]
@@ -86,15 +86,6 @@ fn coarse_index(fine: &[f64], coarse: &[f64]) -> Vec<Option<usize>> {
     fine.iter()
         .map(|&v| coarse.iter().position(|&c| (c - v).abs() <= 1e-9 * scale))
         .collect()
-}
-
-/// The coarse interval `[j, j + 1]` of `coarse` containing `v` and the position `t` in it.
-fn coarse_interval(coarse: &[f64], v: f64) -> (usize, f64) {
-    let j = coarse
-        .partition_point(|&c| c <= v)
-        .clamp(1, coarse.len() - 1)
-        - 1;
-    (j, (v - coarse[j]) / (coarse[j + 1] - coarse[j]))
 }
 
 /// The roles of one layer's small-shell nodes (z fastest), numbering new retained nodes in
@@ -119,11 +110,11 @@ fn layer_roles(layer: &PatchLayer, retained: &[usize], internal: &mut usize) -> 
             let role = match (cx[ii], cz[kk]) {
                 (Some(i), Some(k)) => Role::Retained(coarse(i, k)),
                 (Some(i), None) if x_side => {
-                    let (k, t) = coarse_interval(&layer.zs, layer.fine_zs[kk]);
+                    let (k, t) = line_cell(&layer.zs, layer.fine_zs[kk]);
                     Role::Edge(coarse(i, k), coarse(i, k + 1), t)
                 }
                 (None, Some(k)) if z_side => {
-                    let (i, t) = coarse_interval(&layer.xs, layer.fine_xs[ii]);
+                    let (i, t) = line_cell(&layer.xs, layer.fine_xs[ii]);
                     Role::Edge(coarse(i, k), coarse(i + 1, k), t)
                 }
                 _ => {
@@ -220,9 +211,8 @@ impl Blocks {
 /// `layer` containing `p`, in [`ShellElem`](crate::mesh::ShellElem) node order.
 fn shape_derivatives(layer: &PatchLayer, p: [f64; 2]) -> ([f64; 4], [f64; 4]) {
     let cell = |lines: &[f64], v: f64| {
-        let j = lines.partition_point(|&c| c <= v).clamp(1, lines.len() - 1) - 1;
-        let h = lines[j + 1] - lines[j];
-        (((v - lines[j]) / h).clamp(0.0, 1.0), h)
+        let (j, t) = line_cell(lines, v);
+        (t, lines[j + 1] - lines[j])
     };
     let ((xi, hx), (eta, hz)) = (cell(&layer.fine_xs, p[0]), cell(&layer.fine_zs, p[1]));
     (

@@ -180,12 +180,7 @@ fn fine_interpolation(
     offset: usize,
     p: [f64; 2],
 ) -> ([usize; 4], [f64; 4]) {
-    let cell = |lines: &[f64], v: f64| -> (usize, f64) {
-        let j = lines.partition_point(|&l| l <= v).clamp(1, lines.len() - 1) - 1;
-        let t = ((v - lines[j]) / (lines[j + 1] - lines[j])).clamp(0.0, 1.0);
-        (j, t)
-    };
-    let ((i, xi), (k, eta)) = (cell(xs, p[0]), cell(zs, p[1]));
+    let ((i, xi), (k, eta)) = (super::line_cell(xs, p[0]), super::line_cell(zs, p[1]));
     let nz = zs.len();
     let id = |i: usize, k: usize| offset + i * nz + k;
     (
@@ -686,8 +681,9 @@ impl Sheets<'_> {
 
     /// The re-meshed neighbourhood of area weld `welds[w]` (`local_mesh` = `size`, mm): on each
     /// sheet of the stack the rectangle of its shells that meet the square of half-width
-    /// [`PATCH_REACH`] · d around the centre, every shell cut into shells of at most `size` along each side, and the
-    /// nugget sampled on those (`crate::element::weld_patch` condenses them).
+    /// [`PATCH_REACH`] · d around the centre, every shell cut into shells of at most `size`
+    /// along each side, and the nugget sampled on those (`crate::element::weld_patch`
+    /// condenses them).
     fn weld_patch(
         &self,
         w: usize,
