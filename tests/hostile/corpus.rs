@@ -433,6 +433,37 @@ fn geometry(fx: &Fixture) -> Vec<Hostile> {
             Fails("welds[1]"),
         ),
         info_case(
+            "geom-weld-local-mesh-negative",
+            "negative re-meshing size of a weld's neighbourhood",
+            edit(c, |v| v["welds"][0]["local_mesh"] = json!(-0.5)),
+            Fails("welds[0].local_mesh"),
+        ),
+        info_case(
+            "geom-weld-local-mesh-too-fine",
+            "a weld's neighbourhood re-meshed at 0.1 µm",
+            edit(c, |v| v["welds"][0]["local_mesh"] = json!(1e-4)),
+            Fails("welds[0].local_mesh"),
+        ),
+        info_case(
+            "geom-weld-local-mesh-point",
+            "a re-meshed neighbourhood on a point weld",
+            edit(c, |v| {
+                v["welds"][0]["model"] = json!("point");
+                v["welds"][0]["local_mesh"] = json!(0.5);
+            }),
+            Fails("welds[0].local_mesh"),
+        ),
+        info_case(
+            "geom-weld-local-mesh-overlap",
+            "two welds' re-meshed neighbourhoods overlapping",
+            edit(c, |v| {
+                v["welds"][1]["x"] = json!(75.0);
+                v["welds"][0]["local_mesh"] = json!(0.5);
+                v["welds"][1]["local_mesh"] = json!(0.5);
+            }),
+            Fails("welds[1].local_mesh"),
+        ),
+        info_case(
             "geom-joint-unknown-sheet",
             "joint naming an unknown sheet",
             set(c, "/joints/0/upper", json!("Z")),
