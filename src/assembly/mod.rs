@@ -53,11 +53,7 @@ pub fn assemble_structure(mesh: &Mesh) -> Result<Structure, Error> {
             )
         })
         .collect::<Result<Vec<_>, _>>()?;
-    let welds = mesh
-        .welds
-        .iter()
-        .map(|w| Weld::new(w, material))
-        .collect::<Result<Vec<_>, _>>()?;
+    let welds = Weld::build_all(&mesh.welds, &mesh.nodes, material)?;
     let dof_map = DofMap::new(mesh);
     let element_nodes: Vec<&[usize]> = mesh
         .shells

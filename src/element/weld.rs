@@ -77,7 +77,7 @@ use faer::{Mat, Side};
 
 use super::{Beam2, Material};
 use crate::error::Error;
-use crate::mesh::{NuggetLayer, WeldElem};
+use crate::mesh::{NuggetLayer, WeldElem, WeldPatch};
 
 /// An area spot weld through a stack of sheets (see the module docs). Its matrices are on the
 /// DOF of [`Weld::nodes`], 6 per node `[ux, uy, uz, rx, ry, rz]`.
@@ -137,6 +137,39 @@ impl Weld {
             beams,
             condensed: None,
         })
+    }
+
+    /// The area welds of a mesh (node coordinates `nodes`, mm), each as [`Weld::new`], except
+    /// that a re-meshed neighbourhood equal to an earlier weld's up to a translation (the same
+    /// geometry relative to the weld centre, to 1e-9 mm) reuses that weld's condensed matrices:
+    /// the friction bar's two welds are one condensation.
+    pub fn build_all(
+        welds: &[WeldElem],
+        nodes: &[[f64; 3]],
+        material: Material,
+    ) -> Result<Vec<Weld>, Error> {
+        let mut seen: Vec<(Vec<i64>, usize)> = Vec::new();
+        let mut out: Vec<Weld> = Vec::with_capacity(welds.len());
+        for w in welds {
+            let key = w.patch.as_ref().map(|p| relative_key(w, p, nodes));
+            let earlier = key
+                .as_ref()
+                .and_then(|k| seen.iter().find(|(s, _)| s == k).map(|&(_, i)| i));
+            let weld = match earlier {
+                Some(i) => Weld {
+                    nodes: retained_nodes(w.patch.as_ref().expect("keyed")),
+                    maps: Vec::new(),
+                    beams: Vec::new(),
+                    condensed: out[i].condensed.clone(),
+                },
+                None => Weld::new(w, material)?,
+            };
+            if let (Some(k), None) = (key, earlier) {
+                seen.push((k, out.len()));
+            }
+            out.push(weld);
+        }
+        Ok(out)
     }
 
     /// The shell nodes the weld couples, in the order of its matrices' DOF.
@@ -251,6 +284,46 @@ fn reference_map(
         }
     }
     Ok(llt.solve(&rhs))
+}
+
+/// The sheet nodes a re-meshed neighbourhood stands on, sorted (as its condensed matrices).
+fn retained_nodes(patch: &WeldPatch) -> Vec<usize> {
+    let mut nodes: Vec<usize> = patch
+        .layers
+        .iter()
+        .flat_map(|l| l.nodes.iter().copied())
+        .collect();
+    nodes.sort_unstable();
+    nodes.dedup();
+    nodes
+}
+
+/// Everything a re-meshed neighbourhood's condensation depends on, relative to the weld centre
+/// and rounded to 1e-9 mm, with its retained nodes' positions in matrix order.
+fn relative_key(weld: &WeldElem, patch: &WeldPatch, nodes: &[[f64; 3]]) -> Vec<i64> {
+    let q = |v: f64| (v * 1e9).round() as i64;
+    let [cx, cz] = weld.centre;
+    let mut key = vec![q(patch.size), q(weld.diameter)];
+    for l in &patch.layers {
+        key.extend([q(l.y), q(l.thickness), l.nodes.len() as i64]);
+        key.extend(l.free_side.map(i64::from));
+        for (lines, c) in [(&l.xs, cx), (&l.zs, cz), (&l.fine_xs, cx), (&l.fine_zs, cz)] {
+            key.push(lines.len() as i64);
+            key.extend(lines.iter().map(|&v| q(v - c)));
+        }
+    }
+    for n in retained_nodes(patch) {
+        let [x, y, z] = nodes[n];
+        key.extend([q(x - cx), q(y), q(z - cz)]);
+    }
+    for layer in &patch.nugget {
+        key.push(layer.points.len() as i64);
+        for p in &layer.points {
+            key.extend([q(p.xz[0] - cx), q(p.xz[1] - cz), q(p.weight)]);
+            key.extend(p.nodes.map(|n| n as i64));
+        }
+    }
+    key
 }
 
 /// The rotations about the sheets' in-plane axes x and z (the sheets lie in x–z planes).

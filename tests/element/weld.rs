@@ -375,3 +375,28 @@ fn resolved_neighbourhood_refuses_what_it_cannot_model() {
         "{e}"
     );
 }
+
+#[test]
+fn equal_neighbourhoods_share_one_condensation() {
+    // Two welds 20 mm apart on 10 mm shells: the same patch geometry up to a translation.
+    let mut case = plates_local(6, [20.0, 30.0], 0.625);
+    let mut second = case.welds[0].clone();
+    second.x = 40.0;
+    case.welds.push(second);
+    let mesh = Mesh::from_case(&case).unwrap();
+    let all = Weld::build_all(&mesh.welds, &mesh.nodes, Material::STEEL).unwrap();
+    let own = Weld::new(&mesh.welds[1], Material::STEEL).unwrap();
+    assert_eq!(all[1].nodes(), own.nodes());
+    assert_ne!(all[0].nodes(), all[1].nodes());
+    for (a, b) in [
+        (all[1].stiffness(), own.stiffness()),
+        (all[1].mass(), own.mass()),
+    ] {
+        let scale = (0..b.nrows()).map(|i| b[(i, i)].abs()).fold(0.0, f64::max);
+        for i in 0..b.nrows() {
+            for j in 0..b.ncols() {
+                assert!((a[(i, j)] - b[(i, j)]).abs() <= 1e-9 * scale, "({i}, {j})");
+            }
+        }
+    }
+}
