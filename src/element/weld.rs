@@ -157,7 +157,7 @@ impl Weld {
                 .and_then(|k| seen.iter().find(|(s, _)| s == k).map(|&(_, i)| i));
             let weld = match earlier {
                 Some(i) => Weld {
-                    nodes: retained_nodes(w.patch.as_ref().expect("keyed")),
+                    nodes: super::weld_patch::retained_nodes(w.patch.as_ref().expect("keyed")),
                     maps: Vec::new(),
                     beams: Vec::new(),
                     condensed: out[i].condensed.clone(),
@@ -286,18 +286,6 @@ fn reference_map(
     Ok(llt.solve(&rhs))
 }
 
-/// The sheet nodes a re-meshed neighbourhood stands on, sorted (as its condensed matrices).
-fn retained_nodes(patch: &WeldPatch) -> Vec<usize> {
-    let mut nodes: Vec<usize> = patch
-        .layers
-        .iter()
-        .flat_map(|l| l.nodes.iter().copied())
-        .collect();
-    nodes.sort_unstable();
-    nodes.dedup();
-    nodes
-}
-
 /// Everything a re-meshed neighbourhood's condensation depends on, relative to the weld centre
 /// and rounded to 1e-9 mm, with its retained nodes' positions in matrix order.
 fn relative_key(weld: &WeldElem, patch: &WeldPatch, nodes: &[[f64; 3]]) -> Vec<i64> {
@@ -312,7 +300,7 @@ fn relative_key(weld: &WeldElem, patch: &WeldPatch, nodes: &[[f64; 3]]) -> Vec<i
             key.extend(lines.iter().map(|&v| q(v - c)));
         }
     }
-    for n in retained_nodes(patch) {
+    for n in super::weld_patch::retained_nodes(patch) {
         let [x, y, z] = nodes[n];
         key.extend([q(x - cx), q(y), q(z - cz)]);
     }

@@ -298,19 +298,26 @@ pub(super) struct Condensed {
     pub(super) mass: Mat<f64>,
 }
 
+/// The sheet nodes a re-meshed neighbourhood stands on, sorted (the order of its condensed
+/// matrices' DOF).
+pub(super) fn retained_nodes(patch: &WeldPatch) -> Vec<usize> {
+    let mut nodes: Vec<usize> = patch
+        .layers
+        .iter()
+        .flat_map(|l| l.nodes.iter().copied())
+        .collect();
+    nodes.sort_unstable();
+    nodes.dedup();
+    nodes
+}
+
 /// The condensed patch of `weld` (module docs).
 pub(super) fn condense(
     weld: &WeldElem,
     patch: &WeldPatch,
     material: Material,
 ) -> Result<Condensed, Error> {
-    let mut retained: Vec<usize> = patch
-        .layers
-        .iter()
-        .flat_map(|l| l.nodes.iter().copied())
-        .collect();
-    retained.sort_unstable();
-    retained.dedup();
+    let retained = retained_nodes(patch);
     let mut internal = 0usize;
     let roles: Vec<Role> = patch
         .layers
