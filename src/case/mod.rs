@@ -189,12 +189,83 @@ pub struct WeldSpec {
     /// How the weld attaches to the sheets; `"area"` when omitted.
     #[serde(default)]
     pub model: WeldModel,
-    /// Shell size of the nugget's neighbourhood, mm (area welds; optional, > 0 and below the
-    /// sheets' element size): the sheets' shells around the nugget are re-meshed at this size
-    /// and condensed onto the sheets' own nodes (`crate::element::weld_patch`). Omitted: the
-    /// nugget acts on the sheets' own shells.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub local_mesh: Option<f64>,
+    /// The nugget's neighbourhood (area welds): `"auto"` when omitted, `"off"`, or a shell size
+    /// in mm (see [`LocalMesh`]).
+    #[serde(default, skip_serializing_if = "LocalMesh::is_auto")]
+    pub local_mesh: LocalMesh,
+}
+
+/// Whether an area weld's neighbourhood is re-meshed with small shells around the nugget and
+/// condensed onto the sheets' own nodes (`crate::element::weld_patch`). JSON: `"auto"`,
+/// `"off"` or a number (mm).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub enum LocalMesh {
+    /// The default: re-meshed with shells of d/16 ([`LocalMesh::AUTO_SIZE_PER_DIAMETER`]) where
+    /// the sheets' own shells do not resolve the nugget (a side longer than d/2 on a welded
+    /// sheet) and the neighbourhood is admissible (no clamp or tie in it, no overlap with
+    /// another weld's, within the size limits); otherwise the nugget acts on the sheets' own
+    /// shells. Point welds: nothing to re-mesh.
+    #[default]
+    Auto,
+    /// The nugget acts on the sheets' own shells (the RBE3 area weld of `crate::element::weld`).
+    Off,
+    /// Re-meshed with shells of at most this size, mm (> 0, below the sheets' element size);
+    /// an inadmissible neighbourhood is an error.
+    Size(f64),
+}
+
+impl LocalMesh {
+    /// The automatic shell size as a fraction of the nugget diameter: 1/16 (0.3125 mm for a
+    /// 5 mm nugget; README, *Spot welds as area connections*).
+    pub const AUTO_SIZE_PER_DIAMETER: f64 = 1.0 / 16.0;
+
+    /// A sheet side longer than this fraction of d leaves the nugget unresolved, so `"auto"`
+    /// re-meshes it.
+    pub const AUTO_UNRESOLVED_PER_DIAMETER: f64 = 0.5;
+
+    /// `true` for [`LocalMesh::Auto`] (omitted when written).
+    pub fn is_auto(&self) -> bool {
+        *self == LocalMesh::Auto
+    }
+}
+
+impl Serialize for LocalMesh {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        match self {
+            LocalMesh::Auto => s.serialize_str("auto"),
+            LocalMesh::Off => s.serialize_str("off"),
+            LocalMesh::Size(v) => s.serialize_f64(*v),
+        }
+    }
+}
+
+impl<'de> Deserialize<'de> for LocalMesh {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct Visitor;
+        impl serde::de::Visitor<'_> for Visitor {
+            type Value = LocalMesh;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("\"auto\", \"off\" or a shell size in mm")
+            }
+            fn visit_f64<E: serde::de::Error>(self, v: f64) -> Result<LocalMesh, E> {
+                Ok(LocalMesh::Size(v))
+            }
+            fn visit_i64<E: serde::de::Error>(self, v: i64) -> Result<LocalMesh, E> {
+                Ok(LocalMesh::Size(v as f64))
+            }
+            fn visit_u64<E: serde::de::Error>(self, v: u64) -> Result<LocalMesh, E> {
+                Ok(LocalMesh::Size(v as f64))
+            }
+            fn visit_str<E: serde::de::Error>(self, v: &str) -> Result<LocalMesh, E> {
+                match v {
+                    "auto" => Ok(LocalMesh::Auto),
+                    "off" => Ok(LocalMesh::Off),
+                    other => Err(E::invalid_value(serde::de::Unexpected::Str(other), &self)),
+                }
+            }
+        }
+        d.deserialize_any(Visitor)
+    }
 }
 
 /// How a spot weld attaches to its sheets.

@@ -72,6 +72,8 @@
 //! None of its own: the nugget's material is the sheets' material, whose shells already cover
 //! the disc (the point weld's beam mass counted that volume twice).
 
+use std::sync::{Arc, Mutex};
+
 use faer::linalg::solvers::Solve;
 use faer::{Mat, Side};
 
@@ -91,7 +93,7 @@ pub struct Weld {
     beams: Vec<Beam2>,
     /// With a re-meshed neighbourhood ([`super::weld_patch`]): the condensed stiffness and mass
     /// on the DOF of `nodes` (and no maps or beams of its own).
-    condensed: Option<(Mat<f64>, Mat<f64>)>,
+    condensed: Option<Arc<(Mat<f64>, Mat<f64>)>>,
 }
 
 impl Weld {
@@ -104,7 +106,7 @@ impl Weld {
                 nodes: c.nodes,
                 maps: Vec::new(),
                 beams: Vec::new(),
-                condensed: Some((c.stiffness, c.mass)),
+                condensed: Some(Arc::new((c.stiffness, c.mass))),
             });
         }
         let mut touched: Vec<usize> = weld
@@ -141,33 +143,37 @@ impl Weld {
 
     /// The area welds of a mesh (node coordinates `nodes`, mm), each as [`Weld::new`], except
     /// that a re-meshed neighbourhood equal to an earlier weld's up to a translation (the same
-    /// geometry relative to the weld centre, to 1e-9 mm) reuses that weld's condensed matrices:
-    /// the friction bar's two welds are one condensation.
+    /// geometry relative to the weld centre, to 1e-9 mm, and the same material) reuses that
+    /// weld's condensed matrices — within the scene (the friction bar's two welds are one
+    /// condensation) and across scenes built by this process ([`CondensationCache`]).
     pub fn build_all(
         welds: &[WeldElem],
         nodes: &[[f64; 3]],
         material: Material,
     ) -> Result<Vec<Weld>, Error> {
-        let mut seen: Vec<(Vec<i64>, usize)> = Vec::new();
         let mut out: Vec<Weld> = Vec::with_capacity(welds.len());
         for w in welds {
-            let key = w.patch.as_ref().map(|p| relative_key(w, p, nodes));
-            let earlier = key
-                .as_ref()
-                .and_then(|k| seen.iter().find(|(s, _)| s == k).map(|&(_, i)| i));
-            let weld = match earlier {
-                Some(i) => Weld {
-                    nodes: super::weld_patch::retained_nodes(w.patch.as_ref().expect("keyed")),
-                    maps: Vec::new(),
-                    beams: Vec::new(),
-                    condensed: out[i].condensed.clone(),
-                },
-                None => Weld::new(w, material)?,
+            let Some(patch) = &w.patch else {
+                out.push(Weld::new(w, material)?);
+                continue;
             };
-            if let (Some(k), None) = (key, earlier) {
-                seen.push((k, out.len()));
-            }
-            out.push(weld);
+            let key = condensation_key(w, patch, nodes, material);
+            let condensed = match CONDENSED.get(&key) {
+                Some(c) => c,
+                None => {
+                    let c = Weld::new(w, material)?
+                        .condensed
+                        .expect("a weld with a neighbourhood is condensed");
+                    CONDENSED.insert(key, c.clone());
+                    c
+                }
+            };
+            out.push(Weld {
+                nodes: super::weld_patch::retained_nodes(patch),
+                maps: Vec::new(),
+                beams: Vec::new(),
+                condensed: Some(condensed),
+            });
         }
         Ok(out)
     }
@@ -186,8 +192,8 @@ impl Weld {
 
     /// Stiffness on the DOF of [`Weld::nodes`], N/mm, N, N·mm/rad.
     pub fn stiffness(&self) -> Mat<f64> {
-        if let Some((k, _)) = &self.condensed {
-            return k.clone();
+        if let Some(c) = &self.condensed {
+            return c.0.clone();
         }
         let dofs = 6 * self.nodes.len();
         let mut k = Mat::<f64>::zeros(dofs, dofs);
@@ -216,8 +222,8 @@ impl Weld {
     /// Mass on the DOF of [`Weld::nodes`]: zero (the nugget's material belongs to the sheets),
     /// or with a re-meshed neighbourhood the condensed mass of its small shells.
     pub fn mass(&self) -> Mat<f64> {
-        if let Some((_, m)) = &self.condensed {
-            return m.clone();
+        if let Some(c) = &self.condensed {
+            return c.1.clone();
         }
         let dofs = 6 * self.nodes.len();
         Mat::zeros(dofs, dofs)
@@ -286,12 +292,70 @@ fn reference_map(
     Ok(llt.solve(&rhs))
 }
 
+/// Condensed neighbourhoods (stiffness, mass) by [`condensation_key`].
+type CondensedMatrices = Arc<(Mat<f64>, Mat<f64>)>;
+
+/// The condensations of this process, by [`condensation_key`]: a neighbourhood equal to an
+/// earlier one up to a translation — the other weld of the same scene, or the same scene built
+/// again (a sweep, a study, the test suite) — is condensed once. Bounded by
+/// [`CondensationCache::MAX_BYTES`], oldest first out.
+struct CondensationCache {
+    entries: Mutex<Vec<(Vec<i64>, CondensedMatrices)>>,
+}
+
+impl CondensationCache {
+    /// The cache's bound on its matrices, bytes.
+    const MAX_BYTES: usize = 512 << 20;
+
+    fn lock(&self) -> std::sync::MutexGuard<'_, Vec<(Vec<i64>, CondensedMatrices)>> {
+        // A panic elsewhere cannot leave an entry half-written (entries are pushed whole).
+        self.entries.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    fn get(&self, key: &[i64]) -> Option<CondensedMatrices> {
+        let entries = self.lock();
+        entries
+            .iter()
+            .find(|(k, _)| k == key)
+            .map(|(_, c)| c.clone())
+    }
+
+    fn insert(&self, key: Vec<i64>, c: CondensedMatrices) {
+        let bytes =
+            |c: &CondensedMatrices| 8 * (c.0.nrows() * c.0.ncols() + c.1.nrows() * c.1.ncols());
+        let mut entries = self.lock();
+        let mut total: usize = bytes(&c) + entries.iter().map(|(_, e)| bytes(e)).sum::<usize>();
+        while total > Self::MAX_BYTES && !entries.is_empty() {
+            total -= bytes(&entries.remove(0).1);
+        }
+        if total <= Self::MAX_BYTES {
+            entries.push((key, c));
+        }
+    }
+}
+
+static CONDENSED: CondensationCache = CondensationCache {
+    entries: Mutex::new(Vec::new()),
+};
+
 /// Everything a re-meshed neighbourhood's condensation depends on, relative to the weld centre
 /// and rounded to 1e-9 mm, with its retained nodes' positions in matrix order.
-fn relative_key(weld: &WeldElem, patch: &WeldPatch, nodes: &[[f64; 3]]) -> Vec<i64> {
+fn condensation_key(
+    weld: &WeldElem,
+    patch: &WeldPatch,
+    nodes: &[[f64; 3]],
+    material: Material,
+) -> Vec<i64> {
     let q = |v: f64| (v * 1e9).round() as i64;
     let [cx, cz] = weld.centre;
-    let mut key = vec![q(patch.size), q(weld.diameter)];
+    let bits = |v: f64| v.to_bits() as i64;
+    let mut key = vec![
+        q(patch.size),
+        q(weld.diameter),
+        bits(material.youngs_modulus),
+        bits(material.poisson_ratio),
+        bits(material.density),
+    ];
     for l in &patch.layers {
         key.extend([q(l.y), q(l.thickness), l.nodes.len() as i64]);
         key.extend(l.free_side.map(i64::from));

@@ -11,7 +11,9 @@ use super::{
     BeamElem, JointPair, Mesh, PatchLayer, RigidTie, SheetGrid, ShellElem, WeldElem, WeldPatch,
 };
 use crate::case::validate::{check_contact_and_load, check_material, check_sheets, Ctx};
-use crate::case::{Case, ClampSpec, JointSpec, RigidTieSpec, WeldModel, WeldSpec, NODE_TOLERANCE};
+use crate::case::{
+    Case, ClampSpec, JointSpec, LocalMesh, RigidTieSpec, WeldModel, WeldSpec, NODE_TOLERANCE,
+};
 use crate::error::Error;
 
 /// Relative tolerance of the zero-clearance test of a joint.
@@ -42,8 +44,8 @@ pub(super) fn build(case: &Case) -> Result<Mesh, Error> {
         .filter(|&n| clamp_of[n].is_some())
         .collect();
     let (tied, tie) = sheets.rigid_tie(&case.rigid_tie, &clamp_of, &mut nodes)?;
-    let welds = sheets.welds(&case.welds)?;
-    check_patches(&ctx, &welds.welds, &clamp_of, &tied)?;
+    let mut welds = sheets.welds(&case.welds)?;
+    check_patches(&ctx, &mut welds.welds, &clamp_of, &tied)?;
     let supports = Supports {
         clamp_of,
         tied,
@@ -112,52 +114,68 @@ fn nodes_and_shells(grids: &[Grid]) -> (Vec<[f64; 3]>, Vec<ShellElem>) {
 }
 
 /// A weld's re-meshed neighbourhood (`local_mesh`) may neither hold a clamped or tied node
-/// (the small shells would not be held with it) nor overlap another weld's.
+/// (the small shells would not be held with it) nor overlap another weld's. An explicit size
+/// that breaks this is an error; an automatic neighbourhood is left out (checked after every
+/// explicit one, in file order).
 fn check_patches(
     ctx: &Ctx,
-    welds: &[WeldElem],
+    welds: &mut [WeldElem],
     clamp_of: &[Option<usize>],
     tied: &[bool],
 ) -> Result<(), Error> {
     let mut owner: HashMap<usize, usize> = HashMap::new();
-    for weld in welds {
-        let Some(patch) = &weld.patch else { continue };
-        let path = format!("welds[{}].local_mesh", weld.index);
-        for layer in &patch.layers {
-            if let Some(&n) = layer
-                .nodes
-                .iter()
-                .find(|&&n| clamp_of[n].is_some() || tied[n])
-            {
-                let what = if tied[n] { "rigid tie" } else { "clamp" };
-                return Err(ctx.err(
-                    path.as_str(),
-                    format!(
-                        "the re-meshed neighbourhood ({} ≤ x ≤ {}, {} ≤ z ≤ {} mm) reaches the \
-                         {what} (node at x = {} mm): move the weld or drop `local_mesh`",
-                        layer.xs[0],
-                        layer.xs[layer.xs.len() - 1],
-                        layer.zs[0],
-                        layer.zs[layer.zs.len() - 1],
-                        layer.xs[layer.nodes.iter().position(|&m| m == n).unwrap_or(0)
-                            / layer.zs.len()]
-                    ),
-                ));
+    for automatic in [false, true] {
+        for weld in welds.iter_mut() {
+            let Some(patch) = &weld.patch else { continue };
+            if patch.automatic != automatic {
+                continue;
             }
-        }
-        for &shell in &patch.replaced {
-            if let Some(other) = owner.insert(shell, weld.index) {
-                return Err(ctx.err(
-                    path.as_str(),
-                    format!(
-                        "the re-meshed neighbourhood overlaps that of welds[{other}] (they share \
-                         shells): the welds are too close for separate neighbourhoods"
-                    ),
-                ));
+            let conflict = patch_conflict(patch, weld.index, &owner, clamp_of, tied);
+            match conflict {
+                None => owner.extend(patch.replaced.iter().map(|&shell| (shell, weld.index))),
+                Some(_) if automatic => weld.patch = None,
+                Some(reason) => {
+                    return Err(ctx.err(format!("welds[{}].local_mesh", weld.index), reason))
+                }
             }
         }
     }
     Ok(())
+}
+
+/// Why `patch` (of `welds[index]`) is inadmissible given the shells `owner` already gives to
+/// other welds' neighbourhoods, if it is.
+fn patch_conflict(
+    patch: &WeldPatch,
+    index: usize,
+    owner: &HashMap<usize, usize>,
+    clamp_of: &[Option<usize>],
+    tied: &[bool],
+) -> Option<String> {
+    for layer in &patch.layers {
+        if let Some(&n) = layer
+            .nodes
+            .iter()
+            .find(|&&n| clamp_of[n].is_some() || tied[n])
+        {
+            let what = if tied[n] { "rigid tie" } else { "clamp" };
+            return Some(format!(
+                "the re-meshed neighbourhood ({} ≤ x ≤ {}, {} ≤ z ≤ {} mm) reaches the {what} \
+                 (node at x = {} mm): move the weld or set `\"local_mesh\": \"off\"`",
+                layer.xs[0],
+                layer.xs[layer.xs.len() - 1],
+                layer.zs[0],
+                layer.zs[layer.zs.len() - 1],
+                layer.xs[layer.nodes.iter().position(|&m| m == n).unwrap_or(0) / layer.zs.len()]
+            ));
+        }
+    }
+    let other = patch.replaced.iter().find_map(|s| owner.get(s))?;
+    debug_assert_ne!(*other, index);
+    Some(format!(
+        "the re-meshed neighbourhood overlaps that of welds[{other}] (they share shells): the \
+         welds are too close for separate neighbourhoods"
+    ))
 }
 
 /// Half-width of the square around a weld centre whose shells a `local_mesh` re-meshes, in
@@ -569,7 +587,7 @@ impl Sheets<'_> {
                 }
             }
             self.check_nugget(welds, w, &stack)?;
-            if let Some(size) = weld.local_mesh {
+            if let LocalMesh::Size(size) = weld.local_mesh {
                 ctx.positive(&format!("{p}.local_mesh"), size, " mm")?;
                 if weld.model == WeldModel::Point {
                     return Err(ctx.err(
@@ -583,9 +601,11 @@ impl Sheets<'_> {
                 WeldModel::Point => out.beams.extend(self.point_weld(weld, &p, &stack)?),
                 WeldModel::Area => {
                     let mut elem = self.area_weld(w, weld, &stack)?;
-                    if let Some(size) = weld.local_mesh {
-                        elem.patch = Some(self.weld_patch(w, weld, &stack, size)?);
-                    }
+                    elem.patch = match weld.local_mesh {
+                        LocalMesh::Off => None,
+                        LocalMesh::Size(size) => Some(self.weld_patch(w, weld, &stack, size)?),
+                        LocalMesh::Auto => self.auto_patch(w, weld, &stack),
+                    };
                     out.nuggets.push(Nugget {
                         index: w,
                         centre: elem.centre,
@@ -677,6 +697,25 @@ impl Sheets<'_> {
             layers,
             patch: None,
         })
+    }
+
+    /// The neighbourhood `"local_mesh": "auto"` gives area weld `welds[w]`: re-meshed at
+    /// d · [`LocalMesh::AUTO_SIZE_PER_DIAMETER`] when a welded sheet's shells have a side longer
+    /// than d · [`LocalMesh::AUTO_UNRESOLVED_PER_DIAMETER`] and the neighbourhood is within the
+    /// size limits; `None` otherwise (the nugget acts on the sheets' own shells).
+    fn auto_patch(&self, w: usize, weld: &WeldSpec, stack: &[usize]) -> Option<WeldPatch> {
+        let d = weld.diameter;
+        let unresolved = stack.iter().any(|&s| {
+            let step = self.grids[s].step;
+            step[0].max(step[1]) > LocalMesh::AUTO_UNRESOLVED_PER_DIAMETER * d
+        });
+        if !unresolved {
+            return None;
+        }
+        let size = LocalMesh::AUTO_SIZE_PER_DIAMETER * d;
+        let mut patch = self.weld_patch(w, weld, stack, size).ok()?;
+        patch.automatic = true;
+        Some(patch)
     }
 
     /// The re-meshed neighbourhood of area weld `welds[w]` (`local_mesh` = `size`, mm): on each
@@ -795,6 +834,7 @@ impl Sheets<'_> {
             layers,
             replaced,
             nugget,
+            automatic: false,
         })
     }
 

@@ -74,6 +74,10 @@ pub struct WeldPatch {
     /// shells' nodes layer by layer, `(layer, I, K)` → `Σ_{l < layer} (its node count) + I ·
     /// fine_zs.len() + K`.
     pub nugget: Vec<NuggetLayer>,
+    /// Chosen by `"local_mesh": "auto"`: left out (the nugget then acts on the sheets' own
+    /// shells) where it would reach a clamp or tie or overlap another weld's, instead of an
+    /// error.
+    pub automatic: bool,
 }
 
 /// The replaced rectangle of shells on one welded sheet.

@@ -97,6 +97,25 @@ pub fn point_weld_model(name: &str) -> Model {
     Model::from_case(case).unwrap()
 }
 
+/// The built-in case `name` with the welds' neighbourhoods not re-meshed (`"local_mesh":
+/// "off"`: the RBE3 area weld on the sheets' own shells, the default before the re-meshed
+/// neighbourhood) — what a NASTRAN deck's CWELD gives, and the model some tests' measured
+/// premises were taken on.
+#[allow(dead_code)]
+pub fn rbe3_case(name: &str) -> Case {
+    let mut case = builtin_case(name);
+    for w in &mut case.welds {
+        w.local_mesh = jointrom::case::LocalMesh::Off;
+    }
+    case
+}
+
+/// [`rbe3_case`]'s model.
+#[allow(dead_code)]
+pub fn rbe3_model(name: &str) -> Model {
+    Model::from_case(rbe3_case(name)).unwrap()
+}
+
 /// The built-in case `name` with point welds written to a temporary file; its path.
 #[allow(dead_code)]
 pub fn point_weld_case_file(name: &str) -> String {

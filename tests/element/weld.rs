@@ -5,7 +5,7 @@
 
 use faer::Mat;
 use jointrom::assembly::assemble_structure;
-use jointrom::case::Case;
+use jointrom::case::{Case, LocalMesh};
 use jointrom::element::{Material, Weld};
 use jointrom::mesh::Mesh;
 use jointrom::{Interface, Model};
@@ -14,6 +14,13 @@ use serde_json::json;
 /// Two coincident 60 × 60 × 0.5 mm plates (`n × n` shells each): A clamped at x = 0, B tied at
 /// x = 60 to the master at (60, 0.5, 30), joined only by one 5 mm weld at (x, z).
 fn plates(n: usize, weld: [f64; 2], model: &str) -> Case {
+    plates_with(n, weld, model, json!("off"))
+}
+
+/// [`plates`] with the weld's `local_mesh` set to `local_mesh` (`"off"` in [`plates`]: the
+/// nugget on the sheets' own shells, the RBE3 area weld these tests are about unless they say
+/// otherwise).
+fn plates_with(n: usize, weld: [f64; 2], model: &str, local_mesh: serde_json::Value) -> Case {
     let text = json!({
         "name": "plates",
         "material": {"youngs_modulus": 210000.0, "poisson_ratio": 0.3, "density": 7.85e-9},
@@ -23,7 +30,8 @@ fn plates(n: usize, weld: [f64; 2], model: &str) -> Case {
         ],
         "clamps": [{"x": 0.0, "sheets": ["A"]}],
         "rigid_tie": {"x": 60.0, "sheets": ["B"], "master": [60.0, 0.5, 30.0]},
-        "welds": [{"x": weld[0], "z": weld[1], "sheets": ["A", "B"], "diameter": 5.0, "model": model}],
+        "welds": [{"x": weld[0], "z": weld[1], "sheets": ["A", "B"], "diameter": 5.0, "model": model,
+                   "local_mesh": local_mesh}],
         "joints": [],
         "contact": {"normal_stiffness": 1.0e4, "friction_coefficient": 0.25, "stick_stiffness": 1.0e4},
         "load": {"master": {"fx": 1.0, "fy": -0.1, "fz": 0.5, "mx": -2.0, "my": 1.0, "mz": 1.0},
@@ -191,7 +199,15 @@ fn one_weld_between_coincident_plates_carries_every_load() {
     // Membrane shear (Fx, Fz), bending (Fy, Mz), torsion (Mx) and in-plane twist (My) all pass
     // from B through the single nugget to A: K is positive definite and each load does work
     // equal to twice the strain energy.
-    let model = Model::from_case(plates(12, [30.0, 30.0], "area")).unwrap();
+    for local_mesh in ["off", "auto"] {
+        let case = plates_with(12, [30.0, 30.0], "area", json!(local_mesh));
+        let mesh = Mesh::from_case(&case).unwrap();
+        assert_eq!(mesh.welds[0].patch.is_some(), local_mesh == "auto");
+        carries_every_load(&Model::from_case(case).unwrap());
+    }
+}
+
+fn carries_every_load(model: &Model) {
     let loads: Vec<[f64; 6]> = (0..6)
         .map(|k| {
             let mut l = [0.0; 6];
@@ -242,7 +258,7 @@ fn the_area_weld_converges_where_the_point_weld_drifts() {
 /// [`plates`] with the weld's neighbourhood re-meshed at `size` mm (`local_mesh`).
 fn plates_local(n: usize, weld: [f64; 2], size: f64) -> Case {
     let mut case = plates(n, weld, "area");
-    case.welds[0].local_mesh = Some(size);
+    case.welds[0].local_mesh = LocalMesh::Size(size);
     case
 }
 
@@ -359,7 +375,7 @@ fn resolved_neighbourhood_refuses_what_it_cannot_model() {
         "{e}"
     );
     let mut point = plates(6, [30.0, 30.0], "point");
-    point.welds[0].local_mesh = Some(0.5);
+    point.welds[0].local_mesh = LocalMesh::Size(0.5);
     let e = err(Ok(point));
     assert!(
         e.contains("welds[0].local_mesh") && e.contains("area welds"),
@@ -399,4 +415,43 @@ fn equal_neighbourhoods_share_one_condensation() {
             }
         }
     }
+}
+
+#[test]
+fn auto_resolves_unresolved_nuggets_and_steps_back_where_it_cannot() {
+    let patched = |case: &Case| -> Vec<bool> {
+        let mesh = Mesh::from_case(case).unwrap();
+        mesh.welds.iter().map(|w| w.patch.is_some()).collect()
+    };
+    // 5 mm shells (a side above d/2): re-meshed at d/16; 2.5 mm shells (= d/2): resolved by
+    // the sheets' own shells, the nugget acts on them.
+    let coarse = plates_with(12, [30.0, 30.0], "area", json!("auto"));
+    let mesh = Mesh::from_case(&coarse).unwrap();
+    assert_eq!(
+        mesh.welds[0].patch.as_ref().map(|p| p.size),
+        Some(5.0 / 16.0)
+    );
+    assert_eq!(
+        patched(&plates_with(24, [30.0, 30.0], "area", json!("auto"))),
+        [false]
+    );
+    // Near the clamp an explicit size is an error, "auto" keeps the nugget on the own shells.
+    assert_eq!(
+        patched(&plates_with(12, [8.0, 30.0], "area", json!("auto"))),
+        [false]
+    );
+    // Two welds too close for separate neighbourhoods: the first keeps its own.
+    let mut two = plates_with(12, [25.0, 30.0], "area", json!("auto"));
+    let mut second = two.welds[0].clone();
+    second.x = 40.0;
+    two.welds.push(second);
+    assert_eq!(patched(&two), [true, false]);
+    // An explicit size wins over an automatic neighbourhood it overlaps.
+    two.welds[1].local_mesh = LocalMesh::Size(0.625);
+    assert_eq!(patched(&two), [false, true]);
+    // Point welds have nothing to re-mesh.
+    assert_eq!(
+        patched(&plates_with(12, [30.0, 30.0], "point", json!("auto"))),
+        [] as [bool; 0]
+    );
 }

@@ -9,7 +9,7 @@ use jointrom::reduction::{
     build_basis, craig_bampton, pod_tvd, trial_vector_derivatives, BasisKind, BasisOptions, Pod,
     Tvd, TvdOptions, DEFAULT_THRESHOLD,
 };
-use jointrom::studies::convergence::reduced_contact_static;
+use jointrom::studies::convergence::reduced_contact_static_restarting;
 use jointrom::system::ReducedSystem;
 use jointrom::Model;
 
@@ -106,8 +106,11 @@ fn reduced_fc(model: &Model, g: usize) -> f64 {
     };
     let basis = build_basis(model, BasisKind::Tvd, &opts).unwrap();
     let rm = ReducedSystem::new(model, basis.phi).unwrap();
-    reduced_contact_static(model, &rm, 1.0, &ContactOptions::default())
+    // The product's path (the study's): the active-set Newton method, damped Newton where it
+    // cycles on a coarse basis.
+    reduced_contact_static_restarting(model, &rm, 1.0, &ContactOptions::default())
         .unwrap()
+        .0
         .state
         .contact_force_norm
 }

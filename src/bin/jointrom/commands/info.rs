@@ -31,11 +31,12 @@ pub fn run(a: InfoArgs) -> Result<(), Error> {
         println!("joint DOF       {}", model.joint_dofs());
         println!("nodes           {}", model.geometry.nodes.len());
         println!(
-            "elements        {} ({} Shell4, {} Beam2, {} Weld)",
+            "elements        {} ({} Shell4, {} Beam2, {} Weld; {} with a re-meshed neighbourhood)",
             v["elements"],
             cell_count(&model, true),
             cell_count(&model, false),
-            area_welds(&model)
+            area_welds(&model),
+            v["resolved_welds"]
         );
     }
     Ok(())
@@ -63,6 +64,10 @@ pub fn info_json(model: &Model) -> Value {
         "shells": cell_count(model, true),
         "beams": cell_count(model, false),
         "area_welds": area_welds(model),
+        // Area welds whose neighbourhood is re-meshed and condensed (`local_mesh`).
+        "resolved_welds": model
+            .mesh()
+            .map_or(0, |m| m.welds.iter().filter(|w| w.patch.is_some()).count()),
         "clamped_nodes": model
             .dof_map
             .nodes
