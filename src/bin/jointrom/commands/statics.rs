@@ -122,15 +122,36 @@ fn contact_json(model: &Model, scale: f64) -> Result<Value, Error> {
     let load = model.master_load().map(|v| v * scale);
     let sol =
         jointrom::model::contact_static_full(model, load, &contact::ContactOptions::default())?;
-    Ok(json!({
+    let mut v = json!({
         "case": model.name,
         "linear": false,
         "load": load,
         "master_displacement": sol.master_displacement,
-        "contact_force_norm": sol.state.contact_force_norm,
-        "pairs_in_contact": sol.state.pairs_in_contact,
         "iterations": sol.state.iterations,
-    }))
+    });
+    add_pair_forces(&mut v, model, &sol.state);
+    Ok(v)
+}
+
+/// Adds the contact state's `contact_force_norm`, `contact_force_total` (the resultant Σ|p|, N:
+/// unlike the norm, comparable between meshes of one scene), `pairs_in_contact` and
+/// `pair_forces` (`[x, y, z (mm) of the pair's lower node, p (N, compressive negative)]` per
+/// pair in contact) to the JSON object `v`.
+fn add_pair_forces(v: &mut Value, model: &Model, st: &contact::ContactState) {
+    let pair_forces: Vec<[f64; 4]> = st
+        .forces
+        .iter()
+        .zip(&model.pairs)
+        .filter(|(p, _)| **p != 0.0)
+        .map(|(p, pair)| {
+            let [x, y, z] = model.geometry.nodes[pair.lower];
+            [x, y, z, *p]
+        })
+        .collect();
+    v["contact_force_norm"] = json!(st.contact_force_norm);
+    v["contact_force_total"] = json!(st.forces.iter().map(|p| p.abs()).sum::<f64>());
+    v["pairs_in_contact"] = json!(st.pairs_in_contact);
+    v["pair_forces"] = json!(pair_forces);
 }
 
 fn tolerance_static(
@@ -142,13 +163,12 @@ fn tolerance_static(
 ) -> Result<(), Error> {
     let t = static_tolerance_model(model, tol, nu, scale)?;
     let st = &t.solution.state;
-    let v = json!({
+    let mut v = json!({
         "case": model.name,
         "linear": false,
         "load": study::scaled_load(model, scale)?,
         "master_displacement": t.solution.master_displacement,
-        "contact_force_norm": st.contact_force_norm,
-        "pairs_in_contact": st.pairs_in_contact,
+        "iterations": st.iterations,
         "basis": "adaptive",
         "g": t.pairs.len(),
         "basis_size": t.basis_size,
@@ -159,6 +179,7 @@ fn tolerance_static(
         "offline_s": t.wall_s,
         "wall_s": t.wall_s,
     });
+    add_pair_forces(&mut v, model, st);
     if json {
         print_json(&v);
         return Ok(());
@@ -208,13 +229,11 @@ fn reduced_static(
     } else {
         st.contact_force_norm
     };
-    let v = json!({
+    let mut v = json!({
         "case": model.name,
         "linear": false,
         "load": load,
         "master_displacement": r.solution.master_displacement,
-        "contact_force_norm": st.contact_force_norm,
-        "pairs_in_contact": st.pairs_in_contact,
         "iterations": st.iterations,
         "basis": r.basis,
         "g": r.g,
@@ -226,6 +245,7 @@ fn reduced_static(
         "error_estimate": { "contact_force": error, "exact": true },
         "full_contact_force_norm": exact,
     });
+    add_pair_forces(&mut v, model, st);
     if json {
         print_json(&v);
         return Ok(());
