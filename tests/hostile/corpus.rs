@@ -464,6 +464,18 @@ fn geometry(fx: &Fixture) -> Vec<Hostile> {
             Fails("welds[1].local_mesh"),
         ),
         info_case(
+            "geom-weld-local-mesh-word",
+            "a weld's neighbourhood given as an unknown word",
+            edit(c, |v| v["welds"][0]["local_mesh"] = json!("fine")),
+            Fails("welds[0].local_mesh"),
+        ),
+        info_case(
+            "geom-weld-local-mesh-null",
+            "a weld's neighbourhood given as null",
+            edit(c, |v| v["welds"][0]["local_mesh"] = json!(null)),
+            Fails("welds[0].local_mesh"),
+        ),
+        info_case(
             "geom-joint-unknown-sheet",
             "joint naming an unknown sheet",
             set(c, "/joints/0/upper", json!("Z")),
