@@ -150,11 +150,11 @@ impl Blocks {
         let ri: sprs::CsMat<f64> = self.ri.to_csr();
         let nr = x.ncols();
         let mut out = Mat::<f64>::zeros(ri.rows(), nr);
-        for (r, row) in ri.outer_iterator().enumerate() {
-            for (i, &v) in row.iter() {
-                for j in 0..nr {
-                    out[(r, j)] += v * x[(i, j)];
-                }
+        // Column by column: X's columns are contiguous.
+        for j in 0..nr {
+            let xj = x.col(j);
+            for (r, row) in ri.outer_iterator().enumerate() {
+                out[(r, j)] = row.iter().map(|(i, &v)| v * xj[i]).sum::<f64>();
             }
         }
         out
@@ -377,12 +377,17 @@ pub(super) fn condense(
     chol.solve_in_place(&mut x);
     let mut kc = k.rr.clone() + k.ri_times(&x);
     let mii = m.ii_matrix();
+    // M̂_ii X column by column (X and the product are column-major: contiguous columns).
     let mut mx = Mat::<f64>::zeros(ni, nr);
-    for col in 0..ni {
-        for p in mii.col_ptr[col]..mii.col_ptr[col + 1] {
-            let (row, v) = (mii.row_idx[p], mii.values[p]);
-            for j in 0..nr {
-                mx[(row, j)] += v * x[(col, j)];
+    for j in 0..nr {
+        let (xj, mut out) = (x.col(j), mx.col_mut(j));
+        for col in 0..ni {
+            let xv = xj[col];
+            if xv == 0.0 {
+                continue;
+            }
+            for p in mii.col_ptr[col]..mii.col_ptr[col + 1] {
+                out[mii.row_idx[p]] += mii.values[p] * xv;
             }
         }
     }
