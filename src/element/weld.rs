@@ -145,7 +145,7 @@ impl Weld {
     /// that a re-meshed neighbourhood equal to an earlier weld's up to a translation (the same
     /// geometry relative to the weld centre, to 1e-9 mm, and the same material) reuses that
     /// weld's condensed matrices — within the scene (the friction bar's two welds are one
-    /// condensation) and across scenes built by this process ([`CondensationCache`]).
+    /// condensation) and across scenes built by this process (a cache bounded at 512 MB).
     pub fn build_all(
         welds: &[WeldElem],
         nodes: &[[f64; 3]],
