@@ -65,7 +65,9 @@
 //! not lock; what it leaves out is the fused disc's composite stiffness, which makes its
 //! converged limit 1–5 % softer than the solid in the modes where the sheets move against each
 //! other (README, *Spot welds*). With a re-meshed neighbourhood (a weld's `local_mesh`,
-//! [`super::weld_patch`]) the slab no longer locks, and that is the model used there.
+//! [`super::weld_patch`]) the slab no longer locks, and that is the model used there — by
+//! default (`"auto"`) wherever the sheets' shells do not resolve the nugget; this module's RBE3
+//! + beam weld is what `"off"`, a NASTRAN CWELD and sheets fine enough for the nugget get.
 //!
 //! # Mass
 //!

@@ -1,4 +1,5 @@
-//! The re-meshed neighbourhood of an area spot weld (a weld's `local_mesh`): small shells
+//! The re-meshed neighbourhood of an area spot weld (a weld's `local_mesh`; by default,
+//! `"auto"`, at d/16 wherever a welded sheet's shells have a side longer than d/2): small shells
 //! around the nugget, condensed onto the sheets' own nodes.
 //!
 //! # Why
