@@ -159,7 +159,8 @@ impl Weld {
                 out.push(Weld::new(w, material)?);
                 continue;
             };
-            let key = condensation_key(w, patch, nodes, material);
+            let retained = super::weld_patch::retained_nodes(patch);
+            let key = condensation_key(w, patch, &retained, nodes, material);
             let condensed = match CONDENSED.get(&key) {
                 Some(c) => c,
                 None => {
@@ -171,7 +172,7 @@ impl Weld {
                 }
             };
             out.push(Weld {
-                nodes: super::weld_patch::retained_nodes(patch),
+                nodes: retained,
                 maps: Vec::new(),
                 beams: Vec::new(),
                 condensed: Some(condensed),
@@ -341,10 +342,11 @@ static CONDENSED: CondensationCache = CondensationCache {
 };
 
 /// Everything a re-meshed neighbourhood's condensation depends on, relative to the weld centre
-/// and rounded to 1e-9 mm, with its retained nodes' positions in matrix order.
+/// and rounded to 1e-9 mm, with the positions of its `retained` nodes (sorted: matrix order).
 fn condensation_key(
     weld: &WeldElem,
     patch: &WeldPatch,
+    retained: &[usize],
     nodes: &[[f64; 3]],
     material: Material,
 ) -> Vec<i64> {
@@ -366,7 +368,7 @@ fn condensation_key(
             key.extend(lines.iter().map(|&v| q(v - c)));
         }
     }
-    for n in super::weld_patch::retained_nodes(patch) {
+    for &n in retained {
         let [x, y, z] = nodes[n];
         key.extend([q(x - cx), q(y), q(z - cz)]);
     }
