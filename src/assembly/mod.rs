@@ -369,7 +369,9 @@ impl Assembler {
             let len = sc.dofs.len();
             for i in 0..len {
                 for j in 0..len {
-                    values[sc.positions[i * len + j]] += a[(i, j)];
+                    // Both triangles from the same bits: `Tᵀ A T` (and a rotated element's
+                    // `Tᵀ A T`) is symmetric only up to round-off.
+                    values[sc.positions[i * len + j]] += 0.5 * (a[(i, j)] + a[(j, i)]);
                 }
             }
         }
