@@ -132,26 +132,26 @@ fn full_model_short_window_reproduces_the_stored_reference() {
     }
 }
 
-/// Friction off (the paper's Section 4.1.3 comparison): g = 0 fails, the w(g)-chosen g is ~20 %
+/// Friction off (the paper's Section 4.1.3 comparison): g = 0 fails, the w(g)-chosen g is ~40 %
 /// off in ‖f_c‖ (the 2 % is not met), all 51 POD modes meet it.
 #[test]
 fn rom_against_full_reference_friction_off() {
     let r = reference("friction_bar_full_friction_off");
     let (_, fc0, uy0, _) = rom_errors(false, Some(0), &r);
-    // Measured 42.0 / 0.095 (re-meshed weld neighbourhoods; RBE3 area welds 21.4 / 0.152,
-    // point welds 32.7 / 0.385).
+    // Measured 22.1 / 0.125 (DKMQ sheets, 2026-11-26; MITC4 with re-meshed weld
+    // neighbourhoods 42.0 / 0.095, RBE3 area welds 21.4 / 0.152, point welds 32.7 / 0.385).
     assert!(fc0 > 5.0 && uy0 > 0.05, "g = 0: {fc0} {uy0}");
     let (g, fc, uy, _) = rom_errors(false, None, &r);
     eprintln!("friction off: g = 0 {fc0} {uy0}; chosen g = {g}: {fc} {uy}");
     assert!(g > 0 && g < 48);
-    // Measured 0.302 / 1.5e-4 at the chosen g = 19 (re-meshed weld neighbourhoods; the RBE3
-    // area welds chose g = 18 and were 0.044 / 3.1e-4 off, the point welds g = 12, 0.233 /
-    // 3.7e-3).
-    assert!(fc < 0.4 && uy < 0.01, "chosen g = {g}: {fc} {uy}");
+    // Measured 0.389 / 3.6e-4 at the chosen g = 14 (DKMQ sheets, 2026-11-26; MITC4 with
+    // re-meshed weld neighbourhoods g = 19, 0.302 / 1.5e-4; the RBE3 area welds chose g = 18
+    // and were 0.044 / 3.1e-4 off, the point welds g = 12, 0.233 / 3.7e-3).
+    assert!(fc < 0.5 && uy < 0.01, "chosen g = {g}: {fc} {uy}");
     let (_, fc48, uy48, _) = rom_errors(false, Some(51), &r);
     eprintln!("g = 51: {fc48} {uy48}");
-    // Measured 0.0013 / 2.6e-5 with all 51 POD modes (re-meshed weld neighbourhoods; g = 48 is
-    // 0.058 off on this model; the RBE3 area welds' g = 48 was 0.0011 / 4.4e-6, the point
+    // Measured 0.0013 / 1.8e-5 with all 51 POD modes (DKMQ sheets; MITC4 with re-meshed weld
+    // neighbourhoods 0.0013 / 2.6e-5, its g = 48 0.058 off; the RBE3 area welds' g = 48 was 0.0011 / 4.4e-6, the point
     // welds' 0.0133 / 1e-5).
     assert!(fc48 < 0.02 && uy48 < 1e-3, "g = 51: {fc48} {uy48}");
 }
@@ -166,10 +166,11 @@ fn rom_against_full_reference_friction_on() {
         "g = 0: {fc0} {uy0} {fr0}"
     );
     let (g, fc, uy, fr) = rom_errors(true, None, &r);
-    // Measured 0.304 / 3.8e-3 / 0.307 at the chosen g = 19 (re-meshed weld neighbourhoods; the
-    // RBE3 area welds 0.220 / 4.4e-3 / 0.219): the a-priori rule gets the tip, not the forces.
+    // Measured 0.384 / 4.4e-3 / 0.384 at the chosen g = 14 (DKMQ sheets, 2026-11-26; MITC4
+    // with re-meshed weld neighbourhoods g = 19, 0.304 / 3.8e-3 / 0.307; the RBE3 area welds
+    // 0.220 / 4.4e-3 / 0.219): the a-priori rule gets the tip, not the forces.
     assert!(
-        fc < 0.4 && uy < 0.01 && fr < 0.4,
+        fc < 0.5 && uy < 0.01 && fr < 0.5,
         "chosen g = {g}: {fc} {uy} {fr}"
     );
 }
