@@ -418,8 +418,11 @@ fn thin_limit_is_free_of_shear_locking() {
         let ei = m.youngs_modulus * b * t.powi(3) / 12.0;
         let ratio = tip / (p * l.powi(3) / (3.0 * ei));
         eprintln!("t = {t}: deflection / Euler–Bernoulli = {ratio}");
+        // Measured (DKMQ, 2026-11-26): 1 + 6.0e-5 (t = 1: the shear deformation), 1 + 6e-7,
+        // 1 + 6e-9, 1 + 7e-11 — each edge's deflection is the beam's exact cubic; MITC4's
+        // bilinear rotations gave 0.9975 on these 10 elements.
         assert!(
-            (ratio - 1.0).abs() < 0.01,
+            (ratio - 1.0).abs() < 2e-4,
             "t = {t}: ratio {ratio} (locking if ≪ 1)"
         );
     }
