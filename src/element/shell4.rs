@@ -126,6 +126,34 @@ fn edge_bubble_derivatives(r: f64, s: f64) -> [(f64, f64); 4] {
     ]
 }
 
+/// The curvature rows `κ = [β_x,x, β_y,y, β_x,y + β_y,x]` over the 24 local DOF at `(r, s)`:
+/// the bilinear rotations plus DKMQ's mid-side increments of the four edges (module docs).
+fn curvature_rows(sh: &ShapeAt, r: f64, s: f64, edges: &[EdgeTerms; 4]) -> [[f64; 24]; 3] {
+    let mut bb = [[0.0; 24]; 3];
+    for i in 0..4 {
+        // β_x = θ2, β_y = −θ1.
+        bb[0][6 * i + T2] = sh.dx[i];
+        bb[1][6 * i + T1] = -sh.dy[i];
+        bb[2][6 * i + T2] = sh.dy[i];
+        bb[2][6 * i + T1] = -sh.dx[i];
+    }
+    // Mid-side tangential rotation increments: β += Σ_k P_k t_k Δβ_k.
+    for (edge, (p_r, p_s)) in edges.iter().zip(edge_bubble_derivatives(r, s)) {
+        let px = sh.inv_j[0][0] * p_r + sh.inv_j[0][1] * p_s;
+        let py = sh.inv_j[1][0] * p_r + sh.inv_j[1][1] * p_s;
+        let [c, sn] = edge.tangent;
+        for d in 0..24 {
+            let v = edge.increment[d];
+            if v != 0.0 {
+                bb[0][d] += px * c * v;
+                bb[1][d] += py * sn * v;
+                bb[2][d] += (py * c + px * sn) * v;
+            }
+        }
+    }
+    bb
+}
+
 /// Shape functions and their derivatives at one point.
 struct ShapeAt {
     n: [f64; 4],
@@ -436,28 +464,7 @@ impl Shell4 {
             }
 
             // Bending: κ rows over 24 DOF.
-            let mut bb = [[0.0; 24]; 3];
-            for i in 0..4 {
-                // β_x = θ2, β_y = −θ1.
-                bb[0][6 * i + T2] = sh.dx[i];
-                bb[1][6 * i + T1] = -sh.dy[i];
-                bb[2][6 * i + T2] = sh.dy[i];
-                bb[2][6 * i + T1] = -sh.dx[i];
-            }
-            // Mid-side tangential rotation increments: β += Σ_k P_k t_k Δβ_k.
-            for (edge, (p_r, p_s)) in edges.iter().zip(edge_bubble_derivatives(r, s)) {
-                let px = sh.inv_j[0][0] * p_r + sh.inv_j[0][1] * p_s;
-                let py = sh.inv_j[1][0] * p_r + sh.inv_j[1][1] * p_s;
-                let [c, sn] = edge.tangent;
-                for d in 0..24 {
-                    let v = edge.increment[d];
-                    if v != 0.0 {
-                        bb[0][d] += px * c * v;
-                        bb[1][d] += py * sn * v;
-                        bb[2][d] += (py * c + px * sn) * v;
-                    }
-                }
-            }
+            let bb = curvature_rows(&sh, r, s, &edges);
             let dbb = mat3_times(&db, &bb);
             add_btdb(&mut k, &bb, &dbb, w);
 
