@@ -9,3 +9,4 @@ mod deck;
 mod matrices;
 mod model;
 mod petsc;
+mod weld_targets;
