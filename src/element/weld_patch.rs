@@ -263,14 +263,16 @@ impl Blocks {
     /// Adds element matrix `k` over nodes with `roles`.
     fn add(&mut self, roles: &[Role], k: &Mat<f64>) {
         let dofs = 6 * roles.len();
-        for a in 0..dofs {
-            let (ta, na) = Blocks::terms(roles[a / 6], a % 6);
-            for b in 0..dofs {
+        // Each DOF's terms once (a side's are polynomials in t), not once per matrix entry.
+        let terms: Vec<_> = (0..dofs)
+            .map(|a| Blocks::terms(roles[a / 6], a % 6))
+            .collect();
+        for (a, &(ta, na)) in terms.iter().enumerate() {
+            for (b, &(tb, nb)) in terms.iter().enumerate() {
                 let v = k[(a, b)];
                 if v == 0.0 {
                     continue;
                 }
-                let (tb, nb) = Blocks::terms(roles[b / 6], b % 6);
                 for &(ra, ia, ca) in &ta[..na] {
                     for &(rb, ib, cb) in &tb[..nb] {
                         let w = v * ca * cb;

@@ -29,6 +29,13 @@ fn relative(a: &[f64], b: &[f64]) -> Vec<f64> {
     a.iter().zip(b).map(|(x, y)| x / y - 1.0).collect()
 }
 
+/// The relative changes ×2 → ×4 of `scene`'s first `count` frequencies and of its [uy, rx].
+fn refinement_changes(scene: &str, count: usize) -> (Vec<f64>, Vec<f64>) {
+    let (f2, u2) = modes_and_statics(&format!("cases/scale/{scene}_x2.json"), count);
+    let (f4, u4) = modes_and_statics(&format!("cases/scale/{scene}_x4.json"), count);
+    (relative(&f4, &f2), relative(&u4, &u2))
+}
+
 /// Measured (2026-11-26): f1–f9 −0.68 … +0.17 %, f10 −2.10 % (1308.1 Hz; the paper's 1337 Hz
 /// −2.2 %), uy +0.36 %, rx −0.18 % (MITC4 sheets with linear neighbourhood sides: f10 +4.7 %).
 #[test]
@@ -48,10 +55,7 @@ fn friction_bar_on_the_papers_mesh_is_within_three_percent_of_the_converged_soli
 /// sheets with linear neighbourhood sides: up to 1.56 %, f10). Building ×4 takes ~40 s.
 #[test]
 fn friction_bar_refined_x2_to_x4_moves_less_than_one_percent() {
-    let (f2, u2) = modes_and_statics("cases/scale/friction_bar_x2.json", 10);
-    let (f4, u4) = modes_and_statics("cases/scale/friction_bar_x4.json", 10);
-    let ef = relative(&f4, &f2);
-    let eu = relative(&u4, &u2);
+    let (ef, eu) = refinement_changes("friction_bar", 10);
     eprintln!("x2 -> x4: frequencies {ef:?}, uy, rx {eu:?}");
     assert!(
         ef.iter().chain(&eu).all(|e| e.abs() < 0.01),
@@ -63,9 +67,7 @@ fn friction_bar_refined_x2_to_x4_moves_less_than_one_percent() {
 /// sheets with linear neighbourhood sides: 0.91, 1.81, 0.63, 2.62, 1.82 %).
 #[test]
 fn multilayer_refined_x2_to_x4_moves_its_first_five_modes_less_than_one_percent() {
-    let (f2, _) = modes_and_statics("cases/scale/multilayer_sheet_x2.json", 5);
-    let (f4, _) = modes_and_statics("cases/scale/multilayer_sheet_x4.json", 5);
-    let ef = relative(&f4, &f2);
+    let (ef, _) = refinement_changes("multilayer_sheet", 5);
     eprintln!("x2 -> x4: frequencies {ef:?}");
     assert!(ef.iter().all(|e| e.abs() < 0.01), "{ef:?}");
 }
