@@ -18,7 +18,7 @@ use std::time::Duration;
 use criterion::{criterion_group, criterion_main, Criterion};
 use jointrom::integrate::{run, Run, TransientOptions};
 use jointrom::reduction::{build_basis, BasisKind, BasisOptions};
-use jointrom::studies::tolerance::{tolerance_model, ToleranceOptions};
+use jointrom::rom::tolerance::{tolerance_model, ToleranceOptions};
 use jointrom::system::{FullSystem, ReducedSystem, Scene};
 use jointrom::Model;
 

@@ -1,5 +1,5 @@
 //! Error-controlled reduction benchmarks (issue 14): the tolerance-chosen model
-//! (`jointrom::studies::tolerance`, TOL = 1e-2) against the full FE run, with friction, at the
+//! (`jointrom::rom::tolerance`, TOL = 1e-2) against the full FE run, with friction, at the
 //! paper's tolerances, on both built-in scenes.
 //!
 //! Each scene is first run five times over its whole window (0.2 s friction bar, 0.05 s
@@ -15,7 +15,7 @@ use std::time::Duration;
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use jointrom::integrate::{run, TransientOptions};
-use jointrom::studies::tolerance::{tolerance_model, ToleranceOptions};
+use jointrom::rom::tolerance::{tolerance_model, ToleranceOptions};
 use jointrom::system::{FullSystem, Scene};
 use jointrom::Model;
 

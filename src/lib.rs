@@ -19,14 +19,23 @@
 //! 8. [`system`]: the second-order-system boundary, full and reduced;
 //! 9. [`reduction`]: Craig–Bampton, trial vector derivatives, POD, the basis Φ and competitors;
 //! 10. [`integrate`]: the mechanical ODE and the one CVODE driver loop;
-//! 11. [`studies`]: convergence study, stability map, sweeps;
-//! 12. [`report`]: charts, heat maps, VTU, the main job's report.
+//! 11. [`rom`]: the reduced model's home — the model choice ([`rom::ModelSpec`]), the
+//!     tolerance-chosen model, every reduced run with its error estimate, the reduced-model file;
+//! 12. [`studies`]: convergence study, stability map, sweeps, the main job;
+//! 13. [`report`]: charts, heat maps, VTU, the main job's report.
 //!
 //! ```no_run
 //! let model = jointrom::Model::from_case_name("friction_bar")?;
 //! assert_eq!(model.dofs(), 906);
 //! let modes = model.modes(10, jointrom::Interface::Fixed)?;
 //! println!("10th fixed-interface mode: {:.1} Hz", modes.frequencies_hz[9]);
+//!
+//! // A 1 % reduced model, its run and its error estimate.
+//! use jointrom::rom::{run_model, ModelSpec, RunSettings};
+//! let spec = ModelSpec::Tolerance { tolerance: 1e-2, nu: 10 };
+//! let opts = jointrom::integrate::TransientOptions::default();
+//! let out = run_model(&model, &spec, &opts, &RunSettings::default())?;
+//! println!("r = {}, estimate {:?}", out.basis_size, out.estimate);
 //! # Ok::<(), jointrom::Error>(())
 //! ```
 
@@ -55,6 +64,8 @@ pub mod system;
 pub mod reduction;
 
 pub mod integrate;
+
+pub mod rom;
 
 pub mod studies;
 

@@ -38,8 +38,8 @@ use std::path::Path;
 
 use jointrom::case::ContactSpec;
 use jointrom::integrate::{EnergySample, Stepper, TransientOptions};
-use jointrom::reduction::rom_file::RomFile;
 use jointrom::report::fmu::{guid, variable, vr, Causality, Variability, ROM_RESOURCE, VARIABLES};
+use jointrom::rom::file::RomFile;
 use jointrom::system::ReducedSystem;
 
 /// A state of the FMI 2.0 co-simulation state machine.

@@ -6,7 +6,7 @@ use std::io::Write;
 fuzz_target!(|data: &[u8]| {
     let mut f = tempfile::NamedTempFile::new().unwrap();
     f.write_all(data).unwrap();
-    if let Ok(rom) = jointrom::reduction::rom_file::RomFile::read(f.path()) {
+    if let Ok(rom) = jointrom::rom::file::RomFile::read(f.path()) {
         let _ = rom.system();
     }
 });

@@ -463,3 +463,137 @@ impl ContactPattern {
         }
     }
 }
+
+/// Frictionless contact statics of a dense reduced system (as [`contact_static_reduced`]) by
+/// semismooth Newton with a backtracking
+/// (Armijo) line search on the contact energy
+///
+/// ```text
+/// E(η) = ½ ηᵀ K̃ η − f̃ᵀ η + ½ k_n Σ_i min(b_i η, 0)²     (b_i: row i of B_n Φ)
+/// ```
+///
+/// which is convex and continuously differentiable with `∇E = H_A η − f̃`,
+/// `H_A = K̃ + k_n Σ_{i∈A(η)} b_iᵀ b_i`, `A(η) = {i : b_i η < 0}`. The Newton direction
+/// `d = H_A⁻¹ f̃ − η` is the undamped active-set step of [`contact_static_reduced`]; it is a descent
+/// direction (`∇E·d = −dᵀ H_A d < 0`), and backtracking until
+/// `E(η + t d) ≤ E(η) + 10⁻⁴ t ∇E·d` makes the iteration converge from any start, where the
+/// undamped one can cycle. It stops exactly as the undamped one: when the full step's active set
+/// equals the set it was computed with, the step solves the piecewise linear equilibrium
+/// exactly. Starts from η = 0 (all pairs open); at most `20 · opts.max_iterations` steps.
+pub fn contact_static_reduced_damped(
+    k_red: MatRef<'_, f64>,
+    b_n_phi: MatRef<'_, f64>,
+    f: &[f64],
+    k_n: f64,
+    opts: &ContactOptions,
+) -> Result<(Vec<f64>, ContactState), Error> {
+    let (w, r) = (b_n_phi.nrows(), k_red.nrows());
+    if k_red.ncols() != r || b_n_phi.ncols() != r || f.len() != r {
+        return Err(Error::Invalid(format!(
+            "damped reduced contact statics: K_r is {}×{}, B_n Φ is {}×{}, f_r has {} entries",
+            k_red.nrows(),
+            k_red.ncols(),
+            b_n_phi.nrows(),
+            b_n_phi.ncols(),
+            f.len()
+        )));
+    }
+    let b = b_n_phi;
+    let gaps_of = |eta: &[f64]| -> Vec<f64> {
+        (0..w)
+            .map(|i| (0..r).map(|j| b[(i, j)] * eta[j]).sum())
+            .collect()
+    };
+    let energy = |eta: &[f64]| -> f64 {
+        let mut e = 0.0;
+        for i in 0..r {
+            let ki: f64 = (0..r).map(|j| k_red[(i, j)] * eta[j]).sum();
+            e += eta[i] * (0.5 * ki - f[i]);
+        }
+        e + 0.5 * k_n * gaps_of(eta).iter().map(|g| g.min(0.0).powi(2)).sum::<f64>()
+    };
+    let max_steps = 20 * opts.max_iterations.max(1);
+    let mut eta = vec![0.0; r];
+    let mut active_counts = Vec::new();
+    for it in 1..=max_steps {
+        let active: Vec<bool> = gaps_of(&eta).iter().map(|&g| g < 0.0).collect();
+        active_counts.push(active.iter().filter(|&&a| a).count());
+        let mut h = k_red.to_owned();
+        for i in (0..w).filter(|&i| active[i]) {
+            for c in 0..r {
+                let bc = k_n * b[(i, c)];
+                if bc != 0.0 {
+                    for rr in 0..r {
+                        h[(rr, c)] += b[(i, rr)] * bc;
+                    }
+                }
+            }
+        }
+        let llt = h.llt(Side::Lower).map_err(|e| {
+            Error::LinearAlgebra(LinalgError::caused_by(
+                format!(
+                    "damped reduced contact, step {it}: K̃ + K_c is not positive definite: {e:?}"
+                ),
+                e,
+            ))
+        })?;
+        let rhs = Mat::from_fn(r, 1, |i, _| f[i]);
+        let x = faer::linalg::solvers::Solve::solve(&llt, &rhs);
+        let full: Vec<f64> = (0..r).map(|i| x[(i, 0)]).collect();
+        if full.iter().any(|v| !v.is_finite()) {
+            return Err(Error::LinearAlgebra(
+                format!("damped reduced contact, step {it}: solution is not finite").into(),
+            ));
+        }
+        let gaps = gaps_of(&full);
+        let next: Vec<bool> = gaps.iter().map(|&g| g < 0.0).collect();
+        if next == active {
+            let forces: Vec<f64> = gaps
+                .iter()
+                .zip(&active)
+                .map(|(&g, &a)| if a { k_n * g } else { 0.0 })
+                .collect();
+            let state = ContactState {
+                contact_force_norm: forces.iter().map(|p| p * p).sum::<f64>().sqrt(),
+                pairs_in_contact: active.iter().filter(|&&a| a).count(),
+                gaps,
+                forces,
+                active,
+                iterations: it,
+                active_counts,
+            };
+            return Ok((full, state));
+        }
+        // Armijo backtracking along d = full − η; ∇E·d = −dᵀ H_A d.
+        let d: Vec<f64> = full.iter().zip(&eta).map(|(a, b)| a - b).collect();
+        let mut hd = vec![0.0; r];
+        for c in 0..r {
+            for rr in 0..r {
+                hd[rr] += h[(rr, c)] * d[c];
+            }
+        }
+        let slope = -d.iter().zip(&hd).map(|(a, b)| a * b).sum::<f64>();
+        let e0 = energy(&eta);
+        let mut t = 1.0;
+        loop {
+            let trial: Vec<f64> = eta.iter().zip(&d).map(|(e, dd)| e + t * dd).collect();
+            if energy(&trial) <= e0 + 1e-4 * t * slope {
+                eta = trial;
+                break;
+            }
+            t *= 0.5;
+            if t < 1e-12 {
+                return Err(Error::LinearAlgebra(
+                    format!(
+                    "damped reduced contact, step {it}: line search failed (no decrease of the \
+                     contact energy along the Newton direction)"
+                )
+                    .into(),
+                ));
+            }
+        }
+    }
+    Err(Error::LinearAlgebra(
+        format!("damped reduced contact did not converge in {max_steps} steps").into(),
+    ))
+}

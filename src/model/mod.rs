@@ -42,12 +42,14 @@ struct Parts {
     warnings: Vec<String>,
 }
 
-/// Which boundary the master node has in an eigenproblem.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// Which boundary the master node has in an eigenproblem (the CLI's `--interface` values).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum Interface {
     /// Master node free: the cantilever's own modes.
+    #[value(name = "free")]
     Free,
     /// Master node clamped: Craig–Bampton fixed-interface normal modes.
+    #[value(name = "fixed")]
     Fixed,
 }
 

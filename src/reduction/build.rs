@@ -12,23 +12,30 @@ use super::tvd::trial_vector_derivatives;
 use crate::error::Error;
 use crate::model::Model;
 
-/// Which enrichment of the Craig–Bampton basis [`build_basis`] uses.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// Which enrichment of the Craig–Bampton basis [`build_basis`] uses. The one table of the basis
+/// names: [`BasisKind::NAMES`], the CLI's `--basis`/`--model` values (a clap value enum) and the
+/// names in every output.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum BasisKind {
     /// TVD joint modes from the K-weighted POD (eqs. 24–25; the paper's choice).
+    #[value(name = "tvd")]
     Tvd,
     /// TVD joint modes from the plain (Euclidean) POD (eqs. 20–22).
+    #[value(name = "tvd-plain")]
     TvdPlain,
     /// No joint modes: Craig–Bampton with ν + g fixed-interface modes instead (the paper's
     /// comparison, Figure 7).
+    #[value(name = "modes")]
     Modes,
     /// Craig–Bampton plus the g lowest Joint Interface Modes (Witteveen & Irschik 2009; the
     /// paper's Section 5.3 and Figure 19), of the set [`BasisOptions::jim_set`]; see
     /// [`super::competitors::jim`].
+    #[value(name = "jim")]
     Jim,
     /// Craig–Bampton plus the static constraint modes of every joint pair's relative normal DOF
     /// (all joint DOF kept, the paper's Section 5.1); g is ignored and reported as the number of
     /// pairs; see [`super::competitors::alldof`].
+    #[value(name = "alldof")]
     AllDof,
 }
 

@@ -105,7 +105,7 @@
 //! the slip memory from the reduced run — so ‖f_R‖ and the master u_y are estimated less well
 //! than ‖f_c‖ (measured effectivities in the README). The per-pair differences
 //! `Σ_t (p_{n,k} − p_{n,k}*)²` say which pairs' attachment modes `K⁻¹ b_kᵀ` the basis needs
-//! ([`Estimate::pair_error`]); `crate::studies::tolerance` enriches the basis with them (and ν)
+//! ([`Estimate::pair_error`]); `crate::rom::tolerance` enriches the basis with them (and ν)
 //! until the estimate meets a tolerance, and adds the integration error of the run.
 
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -393,11 +393,11 @@ impl JointFlexibility {
     /// The [`TRUNCATION_MODES`] lowest fixed-interface modes (n × m, zero at the master DOF),
     /// computed on first use: only the transient estimate needs them (not the pair-space
     /// statics), and its first use is on the second core beside a reduced run
-    /// ([`crate::studies::tolerance::run_estimated`]).
+    /// ([`crate::rom::estimate::run_estimated`]).
     fn truncation_modes(&self, model: &Model) -> Result<Arc<Mat<f64>>, Error> {
         // Not held while computing: the modes' solves may run on rayon's pool, and a worker
         // waiting there can take another estimator's job that wants this lock (the deadlock
-        // class of `studies::tolerance::beside`). Two estimators may both compute them: the
+        // class of `rom::estimate::beside`). Two estimators may both compute them: the
         // same bits, the first one kept.
         let slot = || {
             self.modes

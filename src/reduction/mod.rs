@@ -54,7 +54,6 @@ pub mod craig_bampton;
 pub mod distributed;
 pub mod estimate;
 pub mod pod;
-pub mod rom_file;
 pub mod tvd;
 
 pub use basis::{final_basis, modal_rotation, Basis, BasisOptions, JimSet, DEFAULT_DROP_TOL};

@@ -42,297 +42,45 @@
 //!
 //! ## Reduced contact solves
 //!
-//! The active-set Newton method of [`crate::joint::statics`] can cycle on a coarse basis (measured on
-//! the friction bar: CB + 2 … 14 extra modes, TVD with 4 … 6 joint modes). The contact energy is
-//! convex, so [`reduced_contact_static_damped`] (the same Newton step with an Armijo line search)
-//! takes over when it fails; every such g is listed in `restarts`, and a g where both fail is
-//! NaN and listed in `failures` (none measured).
+//! The active-set Newton method of [`crate::joint::statics`] can cycle on a coarse basis. The
+//! contact energy is convex, so the damped Newton method
+//! ([`crate::joint::statics::contact_static_reduced_damped`], the same Newton step with an Armijo
+//! line search) takes over when it fails
+//! ([`crate::rom::statics::reduced_contact_static_restarting`]); every such g is listed in
+//! `restarts`, and a g where both fail is NaN and listed in `failures`.
 //!
-//! ## Measured (ν = 10, load × 1; this crate's meshes; `results/study/`)
-//!
-//! | case | full ‖f_c‖ | g = 0 error | tvd (K-weighted) | tvd-plain | tvd-inertia (eq. 15) | tvd-kt | modes | jim |
-//! |---|---|---|---|---|---|---|---|---|
-//! | friction_bar (54 pairs) | 2.0630588 N | 33 | 1 % from g = 49, 1e-4 from 52, 4.8e-10 at 54 | same g, 4.7e-10 | 2.1e-2 at 60 | 0.17 at 60 | 3.2e-2 at 60 | 3.0e-2 at 60 |
-//! | multilayer_sheet (92 pairs) | 0.04133989 N | 34 | 1 % from 53, 1e-4 from 73, 2.9e-7 at 80 | same g | 2.5e-4 at 80 | 0.36 at 80 | 3.5e-2 at 80 | 0.15 at 80 |
+//! ## Why the TVD series converge late
 //!
 //! The weighted POD of the TVD is computed without forming `YᵀKY` ([`crate::reduction::pod_tvd`]):
 //! the POMs that carry the last per cent of the contact force have POD eigenvalues of
 //! 1e-12 … 1e-16 λ_max, below the round-off floor of the Gram route. The TVD series converge to
-//! the full value, but late: w(g) ≥ 0.999 already at g = 12 (friction bar) and 21 (multilayer),
-//! far before the contact force converges, so the paper's "25 joint modes converge the friction
-//! bar (w = 0.9994)" is not reproduced for the static contact force on this mesh. k_n + k_t TVD
-//! span a three times larger space and converge more slowly per added vector; without POD they
-//! stop at 4.7e-4 / 2.9e-3 (the combined normal-tangential pseudoforces do not contain the pure
-//! normal flexibility directions).
-//!
-//! Timings (2 shared cores, loaded): a whole study ≈ 2.5–6 s per scene (each sweep ≈ 0.3–1.5 s;
-//! the all-TVD references ≈ 0.3–0.6 s each), charts ≈ 0.05 s.
-//!
-//! ## Basis names
-//!
-//! [`BASIS_KINDS`] is the one list of the names `--basis` accepts; [`parse_basis`] maps a name to
-//! its [`BasisKind`] or fails listing the valid ones.
+//! the full value, but late: w(g) reaches 0.999 long before the contact force converges, because
+//! the POD ranks by global strain energy and the pairs that carry the load are small in energy.
+//! k_n + k_t TVD span a three times larger space and converge more slowly per added vector;
+//! without POD they stop short of the full value (the combined normal-tangential pseudoforces do
+//! not contain the pure normal flexibility directions). The measured series are in
+//! docs/validation (the static convergence study; `jointrom study CASE`).
 
 use std::time::Instant;
 
-use faer::{Mat, MatRef, Side};
+use faer::{Mat, MatRef};
 use serde::Serialize;
 
 use crate::error::Error;
-use crate::joint::statics::{contact_static_reduced, ContactOptions, ContactState};
-use crate::joint::NORMAL;
-use crate::linalg::LinalgError;
+use crate::joint::statics::{ContactOptions, ContactState};
 use crate::model::{contact_static_full, Interface, Model};
 use crate::reduction::{
     alldof_vectors, build_basis, build_tvd_basis_both_pods, craig_bampton, final_basis,
     jim_vectors, trial_vector_derivatives, BasisKind, BasisOptions, JimSet, JointFlexibility,
     TvdOptions, DEFAULT_DROP_TOL, DEFAULT_THRESHOLD,
 };
+use crate::rom::statics::{reduced_contact_static_restarting, scaled_load, ReducedStatic};
 use crate::system::ReducedSystem;
-
-/// The basis kinds of `jointrom static --basis`, by name (the one list; see [`parse_basis`]).
-pub const BASIS_KINDS: &[(&str, BasisKind)] = &[
-    ("tvd", BasisKind::Tvd),
-    ("tvd-plain", BasisKind::TvdPlain),
-    ("modes", BasisKind::Modes),
-    ("jim", BasisKind::Jim),
-    ("alldof", BasisKind::AllDof),
-];
-
-/// The [`BasisKind`] called `name` (one of [`BASIS_KINDS`]); the error lists the valid names.
-pub fn parse_basis(name: &str) -> Result<BasisKind, Error> {
-    BASIS_KINDS
-        .iter()
-        .find(|(n, _)| *n == name)
-        .map(|&(_, k)| k)
-        .ok_or_else(|| {
-            Error::Invalid(format!(
-                "--basis {name:?}: unknown basis kind; valid: {}",
-                basis_names().join(", ")
-            ))
-        })
-}
-
-/// The name of a kind in [`BASIS_KINDS`] (`"?"` for a kind not listed there).
-pub fn basis_name(kind: BasisKind) -> &'static str {
-    BASIS_KINDS
-        .iter()
-        .find(|(_, k)| *k == kind)
-        .map(|&(n, _)| n)
-        .unwrap_or("?")
-}
-
-/// All names of [`BASIS_KINDS`], in order.
-pub fn basis_names() -> Vec<&'static str> {
-    BASIS_KINDS.iter().map(|&(n, _)| n).collect()
-}
-
-/// The case's master load `[Fx, Fy, Fz (N), Mx, My, Mz (N·mm)]` times `scale`.
-pub fn scaled_load(model: &Model, scale: f64) -> Result<[f64; 6], Error> {
-    if !scale.is_finite() {
-        return Err(Error::Invalid(format!(
-            "--scale must be finite, got {scale}"
-        )));
-    }
-    Ok(model.master_load().map(|v| v * scale))
-}
-
-/// A reduced contact static solution.
-#[derive(Clone, Debug)]
-pub struct ReducedStatic {
-    /// Reduced coordinates η (r); the displacement is `Φ η`.
-    pub eta: Vec<f64>,
-    /// The master node `[ux, uy, uz (mm), rx, ry, rz (rad)]` of `Φ η`.
-    pub master_displacement: [f64; 6],
-    /// Gaps (mm), pair forces (N), active set, `‖f_c‖` (N).
-    pub state: ContactState,
-}
-
-/// Frictionless contact statics of a reduced model under its load `Φᵀ f` times `scale`
-/// ([`contact_static_reduced`] on `K̃` and the normal rows of `B Φ`).
-pub fn reduced_contact_static(
-    model: &Model,
-    rm: &ReducedSystem,
-    scale: f64,
-    opts: &ContactOptions,
-) -> Result<ReducedStatic, Error> {
-    let w = model.joint.pairs();
-    let r = rm.dim();
-    let b_n = Mat::from_fn(w, r, |i, j| rm.b_phi()[(3 * i + NORMAL, j)]);
-    let f: Vec<f64> = rm.reduced_load().iter().map(|v| v * scale).collect();
-    let (eta, state) = contact_static_reduced(
-        rm.k().as_ref(),
-        b_n.as_ref(),
-        &f,
-        model.contact.normal_stiffness,
-        opts,
-    )?;
-    let master_displacement: [f64; 6] =
-        std::array::from_fn(|k| (0..r).map(|c| rm.phi_master[(k, c)] * eta[c]).sum::<f64>());
-    Ok(ReducedStatic {
-        eta,
-        master_displacement,
-        state,
-    })
-}
-
-/// [`reduced_contact_static`] (the active-set Newton method of [`crate::joint::statics`]) from
-/// `opts.start`; if that fails — it can cycle on a coarse basis, whose contact problem is still
-/// convex but poorly resolved — [`reduced_contact_static_damped`], which converges for any
-/// basis. Returns the solution and the first attempt's error if the fallback was needed.
-pub fn reduced_contact_static_restarting(
-    model: &Model,
-    rm: &ReducedSystem,
-    scale: f64,
-    opts: &ContactOptions,
-) -> Result<(ReducedStatic, Option<Error>), Error> {
-    match reduced_contact_static(model, rm, scale, opts) {
-        Ok(sol) => Ok((sol, None)),
-        Err(first) => match reduced_contact_static_damped(model, rm, scale, opts) {
-            Ok(sol) => Ok((sol, Some(first))),
-            Err(second) => Err(Error::LinearAlgebra(
-                format!("reduced contact statics failed: {first}; then, damped: {second}").into(),
-            )),
-        },
-    }
-}
-
-/// Frictionless contact statics of a reduced model by semismooth Newton with a backtracking
-/// (Armijo) line search on the contact energy
-///
-/// ```text
-/// E(η) = ½ ηᵀ K̃ η − f̃ᵀ η + ½ k_n Σ_i min(b_i η, 0)²     (b_i: row i of B_n Φ)
-/// ```
-///
-/// which is convex and continuously differentiable with `∇E = H_A η − f̃`,
-/// `H_A = K̃ + k_n Σ_{i∈A(η)} b_iᵀ b_i`, `A(η) = {i : b_i η < 0}`. The Newton direction
-/// `d = H_A⁻¹ f̃ − η` is the undamped active-set step of [`crate::joint::statics`]; it is a descent
-/// direction (`∇E·d = −dᵀ H_A d < 0`), and backtracking until
-/// `E(η + t d) ≤ E(η) + 10⁻⁴ t ∇E·d` makes the iteration converge from any start, where the
-/// undamped one can cycle. It stops exactly as the undamped one: when the full step's active set
-/// equals the set it was computed with, the step solves the piecewise linear equilibrium
-/// exactly. Starts from η = 0 (all pairs open); at most `20 · opts.max_iterations` steps.
-pub fn reduced_contact_static_damped(
-    model: &Model,
-    rm: &ReducedSystem,
-    scale: f64,
-    opts: &ContactOptions,
-) -> Result<ReducedStatic, Error> {
-    let w = model.joint.pairs();
-    let r = rm.dim();
-    let k_n = model.contact.normal_stiffness;
-    let b = Mat::from_fn(w, r, |i, j| rm.b_phi()[(3 * i + NORMAL, j)]);
-    let f: Vec<f64> = rm.reduced_load().iter().map(|v| v * scale).collect();
-    let gaps_of = |eta: &[f64]| -> Vec<f64> {
-        (0..w)
-            .map(|i| (0..r).map(|j| b[(i, j)] * eta[j]).sum())
-            .collect()
-    };
-    let energy = |eta: &[f64]| -> f64 {
-        let mut e = 0.0;
-        for i in 0..r {
-            let ki: f64 = (0..r).map(|j| rm.k()[(i, j)] * eta[j]).sum();
-            e += eta[i] * (0.5 * ki - f[i]);
-        }
-        e + 0.5 * k_n * gaps_of(eta).iter().map(|g| g.min(0.0).powi(2)).sum::<f64>()
-    };
-    let max_steps = 20 * opts.max_iterations.max(1);
-    let mut eta = vec![0.0; r];
-    let mut active_counts = Vec::new();
-    for it in 1..=max_steps {
-        let active: Vec<bool> = gaps_of(&eta).iter().map(|&g| g < 0.0).collect();
-        active_counts.push(active.iter().filter(|&&a| a).count());
-        let mut h = rm.k().to_owned();
-        for i in (0..w).filter(|&i| active[i]) {
-            for c in 0..r {
-                let bc = k_n * b[(i, c)];
-                if bc != 0.0 {
-                    for rr in 0..r {
-                        h[(rr, c)] += b[(i, rr)] * bc;
-                    }
-                }
-            }
-        }
-        let llt = h.llt(Side::Lower).map_err(|e| {
-            Error::LinearAlgebra(LinalgError::caused_by(
-                format!(
-                    "damped reduced contact, step {it}: K̃ + K_c is not positive definite: {e:?}"
-                ),
-                e,
-            ))
-        })?;
-        let rhs = Mat::from_fn(r, 1, |i, _| f[i]);
-        let x = faer::linalg::solvers::Solve::solve(&llt, &rhs);
-        let full: Vec<f64> = (0..r).map(|i| x[(i, 0)]).collect();
-        if full.iter().any(|v| !v.is_finite()) {
-            return Err(Error::LinearAlgebra(
-                format!("damped reduced contact, step {it}: solution is not finite").into(),
-            ));
-        }
-        let gaps = gaps_of(&full);
-        let next: Vec<bool> = gaps.iter().map(|&g| g < 0.0).collect();
-        if next == active {
-            let forces: Vec<f64> = gaps
-                .iter()
-                .zip(&active)
-                .map(|(&g, &a)| if a { k_n * g } else { 0.0 })
-                .collect();
-            let master_displacement = std::array::from_fn(|k| {
-                (0..r).map(|c| rm.phi_master[(k, c)] * full[c]).sum::<f64>()
-            });
-            let state = ContactState {
-                contact_force_norm: forces.iter().map(|p| p * p).sum::<f64>().sqrt(),
-                pairs_in_contact: active.iter().filter(|&&a| a).count(),
-                gaps,
-                forces,
-                active,
-                iterations: it,
-                active_counts,
-            };
-            return Ok(ReducedStatic {
-                eta: full,
-                master_displacement,
-                state,
-            });
-        }
-        // Armijo backtracking along d = full − η; ∇E·d = −dᵀ H_A d.
-        let d: Vec<f64> = full.iter().zip(&eta).map(|(a, b)| a - b).collect();
-        let mut hd = vec![0.0; r];
-        for c in 0..r {
-            for rr in 0..r {
-                hd[rr] += h[(rr, c)] * d[c];
-            }
-        }
-        let slope = -d.iter().zip(&hd).map(|(a, b)| a * b).sum::<f64>();
-        let e0 = energy(&eta);
-        let mut t = 1.0;
-        loop {
-            let trial: Vec<f64> = eta.iter().zip(&d).map(|(e, dd)| e + t * dd).collect();
-            if energy(&trial) <= e0 + 1e-4 * t * slope {
-                eta = trial;
-                break;
-            }
-            t *= 0.5;
-            if t < 1e-12 {
-                return Err(Error::LinearAlgebra(
-                    format!(
-                    "damped reduced contact, step {it}: line search failed (no decrease of the \
-                     contact energy along the Newton direction)"
-                )
-                    .into(),
-                ));
-            }
-        }
-    }
-    Err(Error::LinearAlgebra(
-        format!("damped reduced contact did not converge in {max_steps} steps").into(),
-    ))
-}
 
 /// What `jointrom static --basis` reports.
 #[derive(Clone, Debug)]
 pub struct BasisStatic {
-    /// The kind's name ([`BASIS_KINDS`]).
+    /// The kind's name ([`BasisKind::name`]).
     pub basis: &'static str,
     /// Enrichment vectors used (joint modes; extra modes for `modes`).
     pub g: usize,
@@ -366,7 +114,7 @@ pub fn basis_static(
         if basis.g < g {
             return Err(Error::Invalid(format!(
                 "--g {g}: basis `{}` has only {} enrichment vectors on {}",
-                basis_name(kind),
+                kind.name(),
                 basis.g,
                 model.name
             )));
@@ -379,7 +127,7 @@ pub fn basis_static(
         reduced_contact_static_restarting(model, &rm, scale, &ContactOptions::default())?;
     Ok(BasisStatic {
         restarted: first.is_some(),
-        basis: basis_name(kind),
+        basis: kind.name(),
         g: basis.g,
         basis_size,
         solution,
@@ -426,7 +174,7 @@ pub fn basis_summary(
     if !matches!(kind, BasisKind::Tvd | BasisKind::TvdPlain) {
         return Err(Error::Invalid(format!(
             "--kind {}: must be tvd or tvd-plain",
-            basis_name(kind)
+            kind.name()
         )));
     }
     if !(opts.threshold > 0.0 && opts.threshold <= 1.0) {
@@ -454,7 +202,7 @@ pub fn basis_summary(
     };
     Ok(BasisSummary {
         case: model.name.clone(),
-        kind: basis_name(kind),
+        kind: kind.name(),
         nu: opts.nu,
         w,
         w_plain,
@@ -603,7 +351,7 @@ pub struct SpanReference {
     pub solve_s: f64,
 }
 
-/// The tolerance rule's basis ([`crate::studies::tolerance`]) as a convergence series: the
+/// The tolerance rule's basis ([`crate::rom::tolerance`]) as a convergence series: the
 /// attachment modes of the pairs ranked by their force in the pair-space solution (exact),
 /// largest first.
 fn adaptive_series(

@@ -15,8 +15,8 @@
 //!    200 displacement snapshots of the job's own full run, paper Section 5.2) and functional
 //!    (fixed-point) iteration next to Newton; every run under a wall-clock budget, so a method
 //!    that does not finish is a measured failure, not a hang; every reduced run carries its own
-//!    error estimate ([`crate::studies::tolerance::run_estimated`]) beside its true error; and
-//!    the tolerance-chosen models ([`crate::studies::tolerance`], TOL = 1e-1, 1e-2, 1e-3), the
+//!    error estimate ([`crate::rom::estimate::run_estimated`]) beside its true error; and
+//!    the tolerance-chosen models ([`crate::rom::tolerance`], TOL = 1e-1, 1e-2, 1e-3), the
 //!    one for 1e-2 being the headline reduced model;
 //! 4. charts: ‖f_c‖(t), ‖f_R‖(t), master u_y(t) (Figs. 9, 11, 12, 17, 18), and speed against
 //!    accuracy — integration CPU time (log) against the relative L2 error of ‖f_c‖(t)
@@ -45,9 +45,11 @@ use crate::integrate::problem::{Iteration, OdeOptions, OdeStats};
 use crate::integrate::{integrate, ProblemOptions, Run, RunStatus, Scene, TransientOptions};
 use crate::model::Model;
 use crate::reduction::{build_basis, snapshot_basis, BasisKind, BasisOptions, JointFlexibility};
+use crate::rom::compare::relative_l2;
+use crate::rom::estimate::{run_estimated, RunEstimate};
+use crate::rom::tolerance::{tolerance_model, ToleranceOptions};
 use crate::studies::convergence::{self as study, StudyOptions};
-use crate::studies::stability::{relative_l2, Outcome};
-use crate::studies::tolerance::{run_estimated, tolerance_model, RunEstimate, ToleranceOptions};
+use crate::studies::stability::Outcome;
 use crate::system::{FullSystem, ReducedSystem, SecondOrderSystem};
 
 /// Options of the main job ([`run_main_job`], [`crate::report::main_job::run_report`]). Defaults: the full job (case end time, study g ≤ 60, functional
@@ -69,7 +71,7 @@ pub struct ReportOptions {
     pub progress: bool,
     /// Folder holding stored stability maps (`<dir>/<case>/stability_status.png`).
     pub stability_dir: PathBuf,
-    /// Tolerances of the tolerance-chosen models run ([`crate::studies::tolerance`]; `quick`:
+    /// Tolerances of the tolerance-chosen models run ([`crate::rom::tolerance`]; `quick`:
     /// the headline one only).
     pub tolerances: Vec<f64>,
     /// The tolerance of the headline reduced model (run whether or not in `tolerances`).
@@ -122,7 +124,7 @@ pub struct RunRecord {
     pub error_uy: Option<f64>,
     /// Relative L2 error of ‖f_R‖(t).
     pub error_fr: Option<f64>,
-    /// The run's own error estimate (reduced runs; [`crate::studies::tolerance::RunEstimate`]),
+    /// The run's own error estimate (reduced runs; [`crate::rom::estimate::RunEstimate`]),
     /// to set beside the true errors above.
     pub estimate: Option<RunEstimate>,
     /// Why a reduced run has no estimate.
@@ -743,7 +745,7 @@ fn run_tolerances(opts: &ReportOptions) -> Vec<f64> {
     tols
 }
 
-/// The tolerance-chosen models (step 3, [`crate::studies::tolerance`]): one run each, its
+/// The tolerance-chosen models (step 3, [`crate::rom::tolerance`]): one run each, its
 /// offline time as the build time; returns the index of the headline model's run. A model
 /// that cannot be built or run is recorded with its status.
 fn tolerance_runs(

@@ -79,19 +79,23 @@ use crate::integrate::problem::{Iteration, NewtonLinear, OdeOptions, OdeStats};
 use crate::integrate::{integrate, ProblemOptions, Run, RunStatus, Scene, TransientOptions};
 use crate::model::Model;
 use crate::reduction::{build_basis, BasisKind, BasisOptions};
+use crate::rom::compare::relative_l2;
 use crate::system::{FullSystem, ReducedSystem};
 
-/// The model of a cell.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+/// The model of a cell (the CLI's `--models` values).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, clap::ValueEnum)]
 pub enum ModelKind {
     /// The full FE model.
     #[serde(rename = "full")]
+    #[value(name = "full")]
     Full,
     /// ROM, TVD basis with g = 0 (Craig–Bampton).
     #[serde(rename = "rom-g0")]
+    #[value(name = "rom-g0")]
     RomG0,
     /// ROM, TVD basis with g chosen by w(g).
     #[serde(rename = "rom")]
+    #[value(name = "rom")]
     Rom,
 }
 
@@ -121,13 +125,15 @@ impl ModelKind {
     }
 }
 
-/// The nonlinear iteration of a cell.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+/// The nonlinear iteration of a cell or a run (the CLI's `--iteration`/`--iterations` values).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, clap::ValueEnum)]
 #[serde(rename_all = "lowercase")]
 pub enum IterKind {
     /// Fixed point, no acceleration.
+    #[value(name = "functional")]
     Functional,
     /// Modified Newton with the structured solve.
+    #[value(name = "newton")]
     Newton,
 }
 
@@ -151,7 +157,9 @@ impl IterKind {
         }
     }
 
-    fn iteration(self) -> Iteration {
+    /// The integrator's iteration of this kind (no Anderson acceleration; Newton with the
+    /// problem's structured solve).
+    pub fn iteration(self) -> Iteration {
         match self {
             IterKind::Functional => Iteration::Functional { anderson: 0 },
             IterKind::Newton => Iteration::Newton {
@@ -380,37 +388,6 @@ pub struct Sweep {
     pub cells: Vec<Cell>,
     /// Total wall time, s.
     pub wall_s: f64,
-}
-
-/// Relative L2 difference of `a` against `reference` over the times of `a` that the reference
-/// has too (matched to 1e-6 of the smaller spacing); `None` with fewer than 2 matched nonzero
-/// points or a zero reference.
-pub fn relative_l2(t_a: &[f64], a: &[f64], t_ref: &[f64], reference: &[f64]) -> Option<f64> {
-    let spacing = |t: &[f64]| {
-        t.windows(2)
-            .map(|w| w[1] - w[0])
-            .filter(|d| *d > 0.0)
-            .fold(f64::INFINITY, f64::min)
-    };
-    let tol = 1e-6 * spacing(t_a).min(spacing(t_ref));
-    if !tol.is_finite() {
-        return None;
-    }
-    let (mut num, mut den, mut matched) = (0.0, 0.0, 0usize);
-    let mut j = 0;
-    for (i, &t) in t_a.iter().enumerate() {
-        while j < t_ref.len() && t_ref[j] < t - tol {
-            j += 1;
-        }
-        if j < t_ref.len() && (t_ref[j] - t).abs() <= tol {
-            num += (a[i] - reference[j]).powi(2);
-            den += reference[j].powi(2);
-            if reference[j] != 0.0 {
-                matched += 1;
-            }
-        }
-    }
-    (matched >= 2 && den > 0.0).then(|| (num / den).sqrt())
 }
 
 /// A model of one k_n, ready to build systems.

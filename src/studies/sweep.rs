@@ -24,7 +24,7 @@ use crate::integrate::problem::OdeStats;
 use crate::integrate::{Curves, TransientOptions};
 use crate::model::Model;
 use crate::reduction::JointFlexibility;
-use crate::studies::tolerance::{run_estimated, RunEstimate};
+use crate::rom::estimate::{run_estimated, RunEstimate};
 use crate::system::{ReducedSystem, Scene};
 
 /// One variant of a sweep.
@@ -165,7 +165,7 @@ fn variant_system(base: &ReducedSystem, scene: &Scene, v: &Variant) -> (ReducedS
 
 /// Runs every variant on the shared reduction `rom` of `model`, `parallel` across rayon's
 /// threads or one after the other, each with its own error estimate
-/// ([`crate::studies::tolerance::run_estimated`]: a shared basis chosen for one variant need not
+/// ([`crate::rom::estimate::run_estimated`]: a shared basis chosen for one variant need not
 /// suit another, and the estimate says so). A variant that fails is recorded with its error;
 /// `wall_s` is the run's own integration, the estimate's cost is not in it.
 pub fn run_sweep(

@@ -137,7 +137,7 @@ impl ReducedSystem {
     }
 
     /// Builds the system from its matrices (e.g. read back from an exported reduced model,
-    /// [`crate::reduction::rom_file`]), with the basis if known; checks the dimensions,
+    /// [`crate::rom::file`]), with the basis if known; checks the dimensions,
     /// finiteness and the coordinate sizes, factors M̃ unless it is the identity.
     ///
     /// `k` = K̃ (r × r, N/mm per unit coordinate²), `m` = M̃ (r × r, t per unit coordinate²),

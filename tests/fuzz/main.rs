@@ -172,7 +172,7 @@ fn reduced_model_files() {
     let target = dir.join("mutant.json");
     fuzz("rom", &[seed], 3, |bytes| {
         std::fs::write(&target, bytes).unwrap();
-        match jointrom::reduction::rom_file::RomFile::read(&target) {
+        match jointrom::rom::file::RomFile::read(&target) {
             Ok(f) => f.system().is_ok(),
             Err(_) => false,
         }

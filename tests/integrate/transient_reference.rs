@@ -12,7 +12,7 @@
 
 use jointrom::integrate::{run, Curves, TransientOptions};
 use jointrom::reduction::{build_basis, BasisKind, BasisOptions};
-use jointrom::studies::reference::ReferenceCurves;
+use jointrom::rom::compare::ReferenceCurves;
 use jointrom::system::{FullSystem, ReducedSystem, Scene};
 use jointrom::Model;
 

@@ -11,7 +11,7 @@ use jointrom::joint::statics::{
 };
 use jointrom::joint::NORMAL;
 use jointrom::model::contact_static_full;
-use jointrom::studies::convergence::reduced_contact_static_damped;
+use jointrom::rom::statics::reduced_contact_static_damped;
 use jointrom::system::ReducedSystem;
 use jointrom::{Error, Model};
 

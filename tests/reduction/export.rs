@@ -5,8 +5,8 @@
 use std::path::PathBuf;
 
 use jointrom::integrate as transient;
-use jointrom::reduction::rom_file::{BasisInfo, RomFile};
 use jointrom::reduction::{build_basis, BasisKind, BasisOptions};
+use jointrom::rom::file::{BasisInfo, RomFile};
 use jointrom::system::{ReducedSystem, Scene};
 
 use crate::common::{self, jointrom_json, jointrom_ok};

@@ -9,7 +9,7 @@ use jointrom::reduction::{
     build_basis, craig_bampton, pod_tvd, trial_vector_derivatives, BasisKind, BasisOptions, Pod,
     Tvd, TvdOptions, DEFAULT_THRESHOLD,
 };
-use jointrom::studies::convergence::reduced_contact_static_restarting;
+use jointrom::rom::statics::reduced_contact_static_restarting;
 use jointrom::system::ReducedSystem;
 use jointrom::Model;
 

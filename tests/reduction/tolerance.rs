@@ -1,4 +1,4 @@
-//! Error-controlled reduction (`jointrom::studies::tolerance`) and the a-posteriori estimate
+//! Error-controlled reduction (`jointrom::rom::tolerance`) and the a-posteriori estimate
 //! (`jointrom::reduction::estimate`): the pair-space statics against the full model, the
 //! tolerance contract against the stored full references, the estimator's effectivity, and the
 //! `--tolerance` flag's bad input.
@@ -9,10 +9,8 @@ use jointrom::integrate::{integrate, TransientOptions};
 use jointrom::joint::statics::ContactOptions;
 use jointrom::model::contact_static_full;
 use jointrom::reduction::{build_basis, BasisKind, BasisOptions, JointFlexibility, RunStates};
-use jointrom::studies::tolerance::{
-    integration_errors, pair_law, run_estimated, static_tolerance_model, tolerance_model,
-    ToleranceOptions,
-};
+use jointrom::rom::estimate::{integration_errors, pair_law, run_estimated};
+use jointrom::rom::tolerance::{static_tolerance_model, tolerance_model, ToleranceOptions};
 use jointrom::system::{ReducedSystem, Scene};
 
 use crate::common::{jointrom_err, jointrom_json, model, reference_json};

@@ -5,7 +5,7 @@
 use faer::Mat;
 use jointrom::integrate::{self as transient, Run};
 use jointrom::reduction::{build_basis, snapshot_basis, BasisKind, BasisOptions};
-use jointrom::studies::stability::relative_l2;
+use jointrom::rom::compare::relative_l2;
 use jointrom::system::{FullSystem, ReducedSystem, Scene};
 use jointrom::Model;
 

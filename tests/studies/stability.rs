@@ -3,7 +3,8 @@
 
 use jointrom::case::Case;
 use jointrom::report::stability::write_outputs;
-use jointrom::studies::stability::{relative_l2, run_sweep, IterKind, ModelKind, SweepOptions};
+use jointrom::rom::compare::relative_l2;
+use jointrom::studies::stability::{run_sweep, IterKind, ModelKind, SweepOptions};
 
 use crate::common;
 

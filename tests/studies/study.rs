@@ -12,10 +12,10 @@ use jointrom::model::contact_static_full;
 use jointrom::reduction::{build_basis, craig_bampton, final_basis, BasisKind, BasisOptions};
 use jointrom::report::chart::{LineChart, Reference, Series};
 use jointrom::report::convergence::write_charts;
-use jointrom::studies::convergence::{
-    basis_static, reduced_contact_static, reduced_contact_static_damped,
-    reduced_contact_static_restarting, run_study, within, StudyOptions,
+use jointrom::rom::statics::{
+    reduced_contact_static, reduced_contact_static_damped, reduced_contact_static_restarting,
 };
+use jointrom::studies::convergence::{basis_static, run_study, within, StudyOptions};
 use jointrom::system::ReducedSystem;
 use jointrom::{Interface, Model};
 

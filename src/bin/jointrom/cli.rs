@@ -2,12 +2,11 @@
 //! values of those flags.
 
 use clap::error::{ContextKind, ContextValue, ErrorKind};
-use clap::{Parser, Subcommand, ValueEnum};
+use clap::{Parser, Subcommand};
 
 use jointrom::reduction::BasisKind;
-use jointrom::studies::convergence as study;
 use jointrom::studies::stability::{IterKind, ModelKind};
-use jointrom::{Error, Interface};
+use jointrom::Error;
 
 use crate::commands::{
     basis, distributed, export, export_matrices, info, modes, run, shapes, stability, statics,
@@ -53,7 +52,7 @@ pub enum Command {
     /// sharing the basis → a table (or JSON with every run's curves).
     Sweep(sweep::SweepArgs),
     /// Writes a reduced model as a versioned JSON file (schema `jointrom-rom` v1: M̃, K̃, BΦ,
-    /// master rows, reduced loads, contact law, load ramp; see `jointrom::reduction::rom_file`).
+    /// master rows, reduced loads, contact law, load ramp; see `jointrom::rom::file`).
     Export(export::ExportArgs),
     /// Writes a model's K and M as MatrixMarket files plus the JSON map (`K.mtx`, `M.mtx`,
     /// `model.json`; see `jointrom::model::matrices`): the format a user's own model comes in. Any
@@ -68,125 +67,23 @@ pub enum Command {
     Distributed(distributed::DistributedArgs),
 }
 
-#[derive(Clone, Copy, ValueEnum)]
-pub enum InterfaceArg {
-    /// Master node clamped (Craig–Bampton fixed-interface normal modes).
-    Fixed,
-    /// Master node free (the cantilever's own modes).
-    Free,
-}
-
-impl From<InterfaceArg> for Interface {
-    fn from(a: InterfaceArg) -> Interface {
-        match a {
-            InterfaceArg::Fixed => Interface::Fixed,
-            InterfaceArg::Free => Interface::Free,
-        }
-    }
-}
-
-// A reduced basis kind (`--basis`), spelled as `BasisKind::NAMES`.
-#[derive(Clone, Copy, ValueEnum)]
-pub enum BasisArg {
-    #[value(name = "tvd")]
-    Tvd,
-    #[value(name = "tvd-plain")]
-    TvdPlain,
-    #[value(name = "modes")]
-    Modes,
-    #[value(name = "jim")]
-    Jim,
-    #[value(name = "alldof")]
-    AllDof,
-}
-
-impl From<BasisArg> for BasisKind {
-    fn from(a: BasisArg) -> BasisKind {
-        match a {
-            BasisArg::Tvd => BasisKind::Tvd,
-            BasisArg::TvdPlain => BasisKind::TvdPlain,
-            BasisArg::Modes => BasisKind::Modes,
-            BasisArg::Jim => BasisKind::Jim,
-            BasisArg::AllDof => BasisKind::AllDof,
-        }
-    }
-}
-
-// The TVD bases `jointrom basis --kind` describes.
-#[derive(Clone, Copy, ValueEnum)]
-pub enum TvdKindArg {
-    #[value(name = "tvd")]
-    Tvd,
-    #[value(name = "tvd-plain")]
-    TvdPlain,
-}
-
-impl From<TvdKindArg> for BasisKind {
-    fn from(a: TvdKindArg) -> BasisKind {
-        match a {
-            TvdKindArg::Tvd => BasisKind::Tvd,
-            TvdKindArg::TvdPlain => BasisKind::TvdPlain,
-        }
-    }
-}
-
-// The nonlinear iteration (`--iteration`, `--iterations`).
-#[derive(Clone, Copy, ValueEnum)]
-pub enum IterationArg {
-    #[value(name = "newton")]
-    Newton,
-    #[value(name = "functional")]
-    Functional,
-}
-
-impl From<IterationArg> for IterKind {
-    fn from(a: IterationArg) -> IterKind {
-        match a {
-            IterationArg::Newton => IterKind::Newton,
-            IterationArg::Functional => IterKind::Functional,
-        }
-    }
-}
-
-// A switch: `on` or `off`.
-#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum OnOff {
-    #[value(name = "on")]
-    On,
-    #[value(name = "off")]
-    Off,
-}
-
-impl OnOff {
-    pub fn is_on(self) -> bool {
-        self == OnOff::On
-    }
-
-    pub fn name(self) -> &'static str {
+impl Command {
+    /// Runs the subcommand.
+    pub fn run(self) -> Result<(), Error> {
         match self {
-            OnOff::On => "on",
-            OnOff::Off => "off",
-        }
-    }
-}
-
-// The models of the stability map (`--models`).
-#[derive(Clone, Copy, ValueEnum)]
-pub enum MapModelArg {
-    #[value(name = "full")]
-    Full,
-    #[value(name = "rom-g0")]
-    RomG0,
-    #[value(name = "rom")]
-    Rom,
-}
-
-impl From<MapModelArg> for ModelKind {
-    fn from(a: MapModelArg) -> ModelKind {
-        match a {
-            MapModelArg::Full => ModelKind::Full,
-            MapModelArg::RomG0 => ModelKind::RomG0,
-            MapModelArg::Rom => ModelKind::Rom,
+            Command::Info(a) => info::run(a),
+            Command::Modes(a) => modes::run(a),
+            Command::Static(a) => statics::run(a),
+            Command::Basis(a) => basis::run(a),
+            Command::Study(a) => study_cmd::run(a),
+            Command::Stability(a) => stability::run(a),
+            Command::Transient(a) => transient::run(a),
+            Command::Shapes(a) => shapes::run(a),
+            Command::Sweep(a) => sweep::run(a),
+            Command::Export(a) => export::run(a),
+            Command::ExportMatrices(a) => export_matrices::run(a),
+            Command::Run(a) => run::run(a),
+            Command::Distributed(a) => distributed::run(a),
         }
     }
 }
@@ -225,14 +122,14 @@ fn has_value(args: &[String], flag: &str) -> bool {
 fn value_error(subcommand: &str, flag: &str, v: &str) -> Option<Error> {
     let invalid = |s: String| Some(Error::Invalid(s));
     match (subcommand, flag) {
-        ("static", "--basis") => study::parse_basis(v).err(),
-        ("sweep" | "export", "--basis") => BasisKind::from_name(v)
+        ("static", "--basis") => invalid(format!(
+            "--basis {v:?}: unknown basis kind; valid: {}",
+            BasisKind::NAMES.join(", ")
+        )),
+        ("sweep" | "export" | "transient", "--basis") => BasisKind::from_name(v)
             .err()
             .and_then(|e| invalid(format!("--basis: {e}"))),
-        ("basis", "--kind") => match study::parse_basis(v) {
-            Ok(_) => invalid(format!("--kind {v}: must be tvd or tvd-plain")),
-            Err(_) => invalid(format!("--kind {v:?}: valid: tvd, tvd-plain")),
-        },
+        ("basis", "--kind") => invalid(format!("--kind {v:?}: valid: tvd, tvd-plain")),
         ("transient", "--iteration") => invalid(format!(
             "--iteration must be `newton` or `functional`, got `{v}`"
         )),

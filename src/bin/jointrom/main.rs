@@ -1,9 +1,11 @@
 //! `jointrom` command line: a thin layer over the library. The subcommands are defined in
 //! [`cli`], each one runs in its own module of [`commands`].
 
+mod args;
 mod cli;
 mod commands;
 mod common;
+mod summary;
 
 use std::process::ExitCode;
 
@@ -33,7 +35,7 @@ fn main() -> ExitCode {
     // Every output a failing command created is removed again: a failed export or report
     // leaves no partial files.
     jointrom::files::journal_start();
-    match commands::run(cli.command) {
+    match cli.command.run() {
         Ok(()) => {
             jointrom::files::journal_commit();
             ExitCode::SUCCESS

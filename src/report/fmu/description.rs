@@ -21,7 +21,7 @@ use std::fmt::Write;
 
 use super::{guid, model_identifier, Causality, Variability, UNITS, VARIABLES};
 use crate::integrate::TransientOptions;
-use crate::reduction::rom_file::RomFile;
+use crate::rom::file::RomFile;
 
 /// Text with the five XML special characters escaped (for attribute values), control
 /// characters other than tab and newline dropped (XML 1.0 cannot carry them).

@@ -54,7 +54,7 @@ pub mod package;
 
 use sha2::{Digest, Sha256};
 
-use crate::reduction::rom_file::RomFile;
+use crate::rom::file::RomFile;
 
 pub use description::model_description;
 pub use package::{write_fmu, FmuPackage};

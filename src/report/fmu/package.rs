@@ -12,7 +12,7 @@ use zip::{CompressionMethod, ZipWriter};
 
 use super::{guid, model_description, model_identifier, PLATFORM, ROM_RESOURCE};
 use crate::error::Error;
-use crate::reduction::rom_file::RomFile;
+use crate::rom::file::RomFile;
 
 /// What [`write_fmu`] wrote.
 #[derive(Clone, Debug, PartialEq, Eq)]

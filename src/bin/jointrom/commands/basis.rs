@@ -2,11 +2,10 @@
 
 use clap::Args;
 
-use jointrom::reduction::BasisOptions;
+use jointrom::reduction::{BasisKind, BasisOptions};
 use jointrom::studies::convergence as study;
 use jointrom::Error;
 
-use crate::cli::TvdKindArg;
 use crate::common::print_json;
 
 #[derive(Args)]
@@ -14,8 +13,8 @@ pub struct BasisArgs {
     /// Case file, matrix map (`jointrom-matrices` JSON) or built-in name.
     case: String,
     /// tvd (K-weighted POD) or tvd-plain (plain POD).
-    #[arg(long, value_enum, default_value_t = TvdKindArg::Tvd)]
-    kind: TvdKindArg,
+    #[arg(long, value_enum, default_value_t = BasisKind::Tvd)]
+    kind: BasisKind,
     /// Number of joint modes; default: the smallest g with w(g) >= --threshold.
     #[arg(long)]
     g: Option<usize>,
@@ -31,6 +30,12 @@ pub struct BasisArgs {
 }
 
 pub fn run(a: BasisArgs) -> Result<(), Error> {
+    if !matches!(a.kind, BasisKind::Tvd | BasisKind::TvdPlain) {
+        return Err(Error::Invalid(format!(
+            "--kind {}: must be tvd or tvd-plain",
+            a.kind.name()
+        )));
+    }
     let model = crate::common::load_model(&a.case)?;
     let opts = BasisOptions {
         nu: a.nu,
@@ -38,7 +43,7 @@ pub fn run(a: BasisArgs) -> Result<(), Error> {
         threshold: a.threshold,
         ..BasisOptions::default()
     };
-    let b = study::basis_summary(&model, a.kind.into(), &opts)?;
+    let b = study::basis_summary(&model, a.kind, &opts)?;
     if a.json {
         print_json(&serde_json::to_value(&b).expect("JSON values serialise"));
         return Ok(());

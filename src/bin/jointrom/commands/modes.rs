@@ -7,7 +7,6 @@ use serde_json::json;
 
 use jointrom::{Error, Interface};
 
-use crate::cli::InterfaceArg;
 use crate::common::print_json;
 
 #[derive(Args)]
@@ -18,8 +17,8 @@ pub struct ModesArgs {
     #[arg(long, default_value_t = 10)]
     count: usize,
     /// Boundary condition of the master node.
-    #[arg(long, value_enum, default_value_t = InterfaceArg::Fixed)]
-    interface: InterfaceArg,
+    #[arg(long, value_enum, default_value_t = Interface::Fixed)]
+    interface: Interface,
     /// One JSON document on stdout.
     #[arg(long)]
     json: bool,
@@ -27,7 +26,7 @@ pub struct ModesArgs {
 
 pub fn run(a: ModesArgs) -> Result<(), Error> {
     let model = crate::common::load_model(&a.case)?;
-    let iface = Interface::from(a.interface);
+    let iface = a.interface;
     let t0 = Instant::now();
     let modes = model.modes(a.count, iface)?;
     let secs = t0.elapsed().as_secs_f64();

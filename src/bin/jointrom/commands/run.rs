@@ -9,13 +9,12 @@ use indicatif::{ProgressBar, ProgressStyle};
 use serde_json::json;
 
 use jointrom::report::main_job as report;
+use jointrom::rom::tolerance::check_tolerance;
 use jointrom::studies::main_job::{Progress, Report, ReportOptions};
-use jointrom::studies::tolerance::check_tolerance;
 use jointrom::{Error, Interface};
 
-use super::info::info_json;
-use super::statics::static_json;
 use crate::common::print_json;
+use crate::summary::{info_json, static_json};
 
 #[derive(Args)]
 pub struct RunArgs {

@@ -10,7 +10,9 @@ use jointrom::report::stability::stability_study;
 use jointrom::studies::stability::SweepOptions;
 use jointrom::Error;
 
-use crate::cli::{IterationArg, MapModelArg, OnOff};
+use jointrom::studies::stability::{IterKind, ModelKind};
+
+use crate::args::OnOff;
 
 #[derive(Args)]
 pub struct StabilityArgs {
@@ -26,7 +28,7 @@ pub struct StabilityArgs {
         value_delimiter = ',',
         default_value = "full,rom-g0,rom"
     )]
-    pub models: Vec<MapModelArg>,
+    pub models: Vec<ModelKind>,
     /// Iterations: functional, newton.
     #[arg(
         long,
@@ -34,7 +36,7 @@ pub struct StabilityArgs {
         value_delimiter = ',',
         default_value = "functional,newton"
     )]
-    pub iterations: Vec<IterationArg>,
+    pub iterations: Vec<IterKind>,
     /// Penalty stiffnesses k_n, N/mm.
     #[arg(long, value_delimiter = ',', default_value = "1e2,1e4,1e6")]
     pub kn: Vec<f64>,
@@ -94,8 +96,8 @@ impl StabilityArgs {
     pub fn options(&self) -> SweepOptions {
         let on = |v: &[OnOff]| v.iter().map(|s| s.is_on()).collect();
         SweepOptions {
-            models: self.models.iter().map(|&m| m.into()).collect(),
-            iterations: self.iterations.iter().map(|&i| i.into()).collect(),
+            models: self.models.clone(),
+            iterations: self.iterations.clone(),
             normal_stiffness: self.kn.clone(),
             friction: on(&self.friction),
             events: on(&self.events),

@@ -5,12 +5,15 @@ use serde_json::{json, Value};
 
 use jointrom::joint::statics as contact;
 use jointrom::reduction::{BasisKind, BasisOptions, JointFlexibility};
+use jointrom::rom::spec::unsupported;
+use jointrom::rom::statics::scaled_load;
+use jointrom::rom::tolerance::static_tolerance_model;
+use jointrom::rom::{ModelFlags, ModelSpec};
 use jointrom::studies::convergence as study;
-use jointrom::studies::tolerance::static_tolerance_model;
 use jointrom::{Error, Model};
 
-use crate::cli::BasisArg;
 use crate::common::{print_json, print_master_displacement};
+use crate::summary::static_json;
 
 #[derive(Args)]
 pub struct StaticArgs {
@@ -23,22 +26,12 @@ pub struct StaticArgs {
     /// Factor on the case's load (e.g. -1 reverses it).
     #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
     scale: f64,
-    /// Solve the reduced model on this basis instead of the full FE model: tvd, tvd-plain,
-    /// modes, ... (see `jointrom::studies::convergence::BASIS_KINDS`).
-    #[arg(long, value_enum)]
-    basis: Option<BasisArg>,
-    /// Enrichment vectors of the basis (joint modes; extra modes for `modes`); default: the
-    /// smallest g with w(g) >= 0.999. Larger than available is an error.
-    #[arg(long)]
-    g: Option<usize>,
-    /// Fixed-interface modes ν of the basis.
-    #[arg(long, default_value_t = 10)]
-    nu: usize,
-    /// Solve the smallest reduced model (Craig–Bampton plus the attachment modes of the pairs
-    /// in contact, largest force first) whose ‖f_c‖ is within TOL (relative, in (0, 1)) of the
-    /// full model's; the full model's ‖f_c‖ comes from the exact pair-space solution.
-    #[arg(long, allow_negative_numbers = true)]
-    tolerance: Option<f64>,
+    /// The model (default: full). A reduced basis solves the reduced contact statics exactly;
+    /// --tolerance TOL solves the smallest Craig–Bampton + pair-attachment-mode model (the pairs
+    /// in contact, largest force first) whose ‖f_c‖ is within TOL of the full model's (the full
+    /// model's ‖f_c‖ from the exact pair-space solution).
+    #[command(flatten)]
+    model: ModelFlags,
     /// One JSON document on stdout.
     #[arg(long)]
     json: bool,
@@ -51,29 +44,31 @@ pub fn run(a: StaticArgs) -> Result<(), Error> {
             "--scale must be finite, got {scale}"
         )));
     }
-    if let Some(tol) = a.tolerance {
-        if a.basis.is_some() || a.g.is_some() || a.linear {
-            return Err(Error::Invalid(
-                "--tolerance chooses its own reduced model: drop --basis, --g and --linear".into(),
-            ));
-        }
-        let model = crate::common::load_model(&a.case)?;
-        return tolerance_static(&model, tol, a.nu, scale, a.json);
-    }
-    if a.basis.is_none() && a.g.is_some() {
-        return Err(Error::Invalid("--g needs --basis".into()));
-    }
-    if let Some(kind) = a.basis {
-        if a.linear {
-            return Err(Error::Invalid(
-                "--linear and --basis do not combine: --basis solves the reduced contact statics"
-                    .into(),
-            ));
-        }
-        let model = crate::common::load_model(&a.case)?;
-        return reduced_static(&model, kind.into(), a.g, a.nu, scale, a.json);
+    let spec = a.model.spec(ModelSpec::Full)?;
+    if a.linear && spec.is_reduced() {
+        return Err(Error::Invalid(
+            "--linear and a reduced model do not combine: a reduced model solves the contact \
+             statics (drop --linear, or --basis/--model/--tolerance)"
+                .into(),
+        ));
     }
     let model = crate::common::load_model(&a.case)?;
+    match spec {
+        ModelSpec::Full => {}
+        ModelSpec::Tolerance { tolerance, nu } => {
+            return tolerance_static(&model, tolerance, nu, scale, a.json)
+        }
+        ModelSpec::Basis { kind, g, nu } => {
+            return reduced_static(&model, kind, g, nu, scale, a.json)
+        }
+        other => {
+            return Err(unsupported(
+                "static",
+                &other,
+                "full, a reduced basis or --tolerance TOL",
+            ))
+        }
+    }
     let v = if a.linear {
         static_json(&model, scale)?
     } else {
@@ -103,19 +98,6 @@ pub fn run(a: StaticArgs) -> Result<(), Error> {
         );
     }
     Ok(())
-}
-
-/// The linear static solution under `scale` × the master load (also part of `run`'s
-/// results.json).
-pub fn static_json(model: &Model, scale: f64) -> Result<Value, Error> {
-    let load = model.master_load().map(|v| v * scale);
-    let sol = model.static_linear(&[load])?.remove(0);
-    Ok(json!({
-        "case": model.name,
-        "linear": true,
-        "load": load,
-        "master_displacement": sol.master_displacement,
-    }))
 }
 
 fn contact_json(model: &Model, scale: f64) -> Result<Value, Error> {
@@ -166,7 +148,7 @@ fn tolerance_static(
     let mut v = json!({
         "case": model.name,
         "linear": false,
-        "load": study::scaled_load(model, scale)?,
+        "load": scaled_load(model, scale)?,
         "master_displacement": t.solution.master_displacement,
         "iterations": st.iterations,
         "basis": "adaptive",
@@ -209,7 +191,7 @@ fn reduced_static(
     scale: f64,
     json: bool,
 ) -> Result<(), Error> {
-    let load = study::scaled_load(model, scale)?;
+    let load = scaled_load(model, scale)?;
     let opts = BasisOptions {
         nu,
         g,

@@ -6,15 +6,12 @@ use std::time::Instant;
 use clap::Args;
 use serde_json::json;
 
-use jointrom::integrate::TransientOptions;
-use jointrom::reduction::{build_basis, BasisKind, BasisOptions};
-use jointrom::studies::sweep::{self, SweepResult};
-use jointrom::studies::tolerance::{tolerance_model, ToleranceOptions};
-use jointrom::system::ReducedSystem;
-use jointrom::Error;
-
-use crate::cli::BasisArg;
 use crate::common::{positive, print_json};
+use jointrom::integrate::TransientOptions;
+use jointrom::reduction::BasisKind;
+use jointrom::rom::{build_rom, ModelFlags, ModelSpec};
+use jointrom::studies::sweep::{self, SweepResult};
+use jointrom::Error;
 
 #[derive(Args)]
 pub struct SweepArgs {
@@ -24,16 +21,11 @@ pub struct SweepArgs {
     /// "normal_stiffness", "stick_stiffness"}, ...]}`).
     #[arg(long)]
     variants: PathBuf,
-    /// Basis kind: tvd, tvd-plain, modes, jim, alldof (default tvd).
-    #[arg(long, value_enum)]
-    basis: Option<BasisArg>,
-    /// Share the tolerance-chosen model instead (see `transient --tolerance`), chosen on the
-    /// case itself; each variant's own error estimate says whether it suits the variant.
-    #[arg(long, allow_negative_numbers = true)]
-    tolerance: Option<f64>,
-    /// Enrichment vectors g; default: the smallest g with w(g) >= 0.999.
-    #[arg(long)]
-    g: Option<usize>,
+    /// The shared reduced model (default: tvd); --tolerance TOL shares the tolerance-chosen
+    /// model (see `transient --tolerance`), chosen on the case itself: each variant's own error
+    /// estimate says whether it suits the variant.
+    #[command(flatten)]
+    model: ModelFlags,
     /// End time, s (default: the case's).
     #[arg(long)]
     end_time: Option<f64>,
@@ -58,31 +50,13 @@ pub fn run(a: SweepArgs) -> Result<(), Error> {
     }
     opts.budget_s = Some(positive("max-wall", a.max_wall)?);
     let t0 = Instant::now();
-    let (kind, g_used, rom) = match a.tolerance {
-        Some(tol) => {
-            if a.basis.is_some() || a.g.is_some() {
-                return Err(Error::Invalid(
-                    "--tolerance chooses its own basis: drop --basis and --g".into(),
-                ));
-            }
-            let mut t_opts = ToleranceOptions::new(tol);
-            t_opts.transient = opts.clone();
-            let t = tolerance_model(&model, &t_opts)?;
-            ("adaptive", t.pairs.len(), t.rom)
-        }
-        None => {
-            let kind = BasisKind::from(a.basis.unwrap_or(BasisArg::Tvd));
-            let b = build_basis(
-                &model,
-                kind,
-                &BasisOptions {
-                    g: a.g,
-                    ..BasisOptions::default()
-                },
-            )?;
-            (kind.name(), b.g, ReducedSystem::new(&model, b.phi)?)
-        }
-    };
+    let spec = a.model.spec(ModelSpec::Basis {
+        kind: BasisKind::Tvd,
+        g: None,
+        nu: a.model.nu,
+    })?;
+    let built = build_rom(&model, &spec, &opts, "sweep")?;
+    let (kind, g_used, rom) = (built.info.kind, built.info.g, built.rom);
     let build_s = t0.elapsed().as_secs_f64();
     let res = sweep::run_sweep(&model, &rom, &list, &opts, !a.sequential)?;
     if a.json {

@@ -7,37 +7,25 @@ use std::time::Instant;
 use clap::Args;
 use serde_json::{json, Value};
 
-use jointrom::integrate::problem::{Iteration, NewtonLinear};
-use jointrom::integrate::{self as driver, integrate, Curves, Run, TransientOptions};
-use jointrom::reduction::rom_file as export;
-use jointrom::reduction::{build_basis, BasisKind, BasisOptions, JointFlexibility};
-use jointrom::studies::reference::{ReferenceCurves, ReferenceErrors};
-use jointrom::studies::tolerance::{run_estimated, tolerance_model, RunEstimate, ToleranceOptions};
-use jointrom::studies::training::train_snapshot_basis;
-use jointrom::system::{FullSystem, ReducedSystem, Scene, SecondOrderSystem};
+use jointrom::integrate::{Curves, TransientOptions};
+use jointrom::reduction::BasisKind;
+use jointrom::rom::compare::{ReferenceCurves, ReferenceErrors};
+use jointrom::rom::spec::DEFAULT_SNAPSHOTS;
+use jointrom::rom::{run_model, ModelFlags, ModelRun, ModelSpec, RunEstimate, RunSettings};
 use jointrom::{Error, Model};
 
-use crate::cli::{IterationArg, OnOff};
+use jointrom::studies::stability::IterKind;
+
+use crate::args::OnOff;
 use crate::common::{create_dir, positive, print_json, write_file};
 
 #[derive(Args)]
 pub struct TransientArgs {
     /// Case file, matrix map (`jointrom-matrices` JSON) or built-in name.
     case: String,
-    /// full (FE model) or a reduced basis: tvd, tvd-plain, modes, jim, alldof, pod (POD of
-    /// the displacement snapshots of a full-FE training run, paper Section 5.2), or
-    /// file:PATH (a reduced model written by `jointrom export`; CASE is still loaded), or
-    /// adaptive (Craig–Bampton plus the attachment modes of the pairs the error estimate
-    /// selects, see --tolerance). Default: tvd, or adaptive with --tolerance.
-    #[arg(long)]
-    model: Option<String>,
-    /// Enrichment vectors of the basis; default: the smallest g with w(g) >= 0.999.
-    #[arg(long)]
-    g: Option<usize>,
-    /// Build the smallest reduced model whose estimated relative L2 error of |f_c|(t) is at most
-    /// TOL (in (0, 1); e.g. 1e-2), with --model adaptive (the default with this flag).
-    #[arg(long, allow_negative_numbers = true)]
-    tolerance: Option<f64>,
+    /// The model (default: tvd, or adaptive with --tolerance).
+    #[command(flatten)]
+    model: ModelFlags,
     /// With --tolerance: exit non-zero (after printing the best model's run) when the estimate
     /// does not meet the tolerance. Without it a miss is a warning.
     #[arg(long, requires = "tolerance")]
@@ -47,14 +35,11 @@ pub struct TransientArgs {
     train_end: Option<f64>,
     /// `--model pod`: about this many snapshots kept from the training run (every k-th output,
     /// k = outputs / N).
-    #[arg(long, default_value_t = 200)]
+    #[arg(long, default_value_t = DEFAULT_SNAPSHOTS)]
     snapshots: usize,
-    /// Fixed-interface modes ν of the basis.
-    #[arg(long, default_value_t = 10)]
-    nu: usize,
     /// Nonlinear iteration: newton (structured solve) or functional (fixed point).
-    #[arg(long, value_enum, default_value_t = IterationArg::Newton)]
-    iteration: IterationArg,
+    #[arg(long, value_enum, default_value_t = IterKind::Newton)]
+    iteration: IterKind,
     /// Friction on or off.
     #[arg(long, value_enum, default_value_t = OnOff::On)]
     friction: OnOff,
@@ -125,56 +110,6 @@ pub struct TransientArgs {
     vtu_frames: usize,
 }
 
-/// What `--model` names: the full FE model, the POD of a full-FE training run, a reduced model
-/// exported by `jointrom export`, or a basis kind.
-enum ModelChoice {
-    Full,
-    Pod,
-    File(PathBuf),
-    Basis(BasisKind),
-}
-
-impl ModelChoice {
-    fn parse(name: &str) -> Result<ModelChoice, Error> {
-        Ok(match name {
-            "full" => ModelChoice::Full,
-            "adaptive" => {
-                return Err(Error::Invalid(
-                    "--model adaptive is chosen by --tolerance TOL: give the tolerance".into(),
-                ))
-            }
-            "pod" => ModelChoice::Pod,
-            _ if name.starts_with("file:") => {
-                ModelChoice::File(PathBuf::from(&name["file:".len()..]))
-            }
-            _ => ModelChoice::Basis(
-                BasisKind::from_name(name)
-                    .map_err(|e| Error::Invalid(format!("--model: {e} (or full, pod)")))?,
-            ),
-        })
-    }
-}
-
-/// Kept states: (time in s, state).
-type Frames = Vec<(f64, Vec<f64>)>;
-
-/// A finished run: the result, its size, g, the POD training run (`--model pod`) and the kept
-/// states in physical DOF (reduced states are expanded with Φ).
-struct Outcome {
-    res: Run,
-    basis_size: usize,
-    g: Option<usize>,
-    training: Option<Value>,
-    frames: Frames,
-    /// Wall time of building the reduced model (basis, enrichment, earlier rounds), s.
-    offline_s: Option<f64>,
-    /// `--tolerance`: the tolerance, whether it was met, the rounds and the chosen pairs.
-    tolerance: Option<Value>,
-    /// The a-posteriori error estimate of a reduced run (`None` for the full model), or why
-    /// there is none.
-    estimate: Option<Result<RunEstimate, String>>,
-}
-
 pub fn run(a: TransientArgs) -> Result<(), Error> {
     let opts = transient_options(&a)?;
     let reference = match &a.reference {
@@ -187,10 +122,36 @@ pub fn run(a: TransientArgs) -> Result<(), Error> {
     };
     let model = crate::common::load_model(&a.case)?;
     let vtu_every = vtu_every(&a, &opts, &model)?;
+    let spec = model_spec(&a)?;
+    if let ModelSpec::File(path) = &spec {
+        crate::common::record_input(format!("reduced model {}", path.display()));
+    }
     let t0 = Instant::now();
-    let mut o = run_model(&a, &model, &opts, vtu_every)?;
+    let mut o = run_model(
+        &model,
+        &spec,
+        &opts,
+        &RunSettings {
+            keep_every: vtu_every,
+            low_rank: a.low_rank,
+        },
+    )?;
+    if let Some(t) = o.tolerance.as_ref().filter(|t| !t.met) {
+        eprintln!(
+            "warning: --tolerance {:e} not met: the best model ({} pairs, r = {}) estimates {:e}",
+            t.tolerance,
+            t.pairs.len(),
+            o.basis_size,
+            o.estimate
+                .as_ref()
+                .and_then(|e| e.as_ref().ok())
+                .and_then(|e| e.total.contact_force)
+                .unwrap_or(f64::NAN)
+        );
+    }
     let total_s = t0.elapsed().as_secs_f64();
-    let c = &o.res.curves;
+    let name = spec_name(&a, &spec);
+    let c = &o.run.curves;
     let reference_error = reference.as_ref().map(|r| {
         let e = r.errors(c);
         json!({
@@ -204,17 +165,17 @@ pub fn run(a: TransientArgs) -> Result<(), Error> {
     });
     let doc = json!({
         "case": model.name,
-        "model": model_name(&a),
-        "basis": model_name(&a),
+        "model": name,
+        "basis": name,
         "basis_size": o.basis_size,
         "g": o.g,
         "offline_s": o.offline_s,
         "tolerance": o.tolerance,
         "options": opts,
-        "stats": o.res.stats,
-        "events": o.res.events,
-        "wall_s": o.res.wall_s,
-        "cpu_s": o.res.cpu_s,
+        "stats": o.run.stats,
+        "events": o.run.events,
+        "wall_s": o.run.wall_s,
+        "cpu_s": o.run.cpu_s,
         "total_s": total_s,
         "error_estimate": estimate_json(&o.estimate),
         "reference_error": reference_error,
@@ -222,7 +183,7 @@ pub fn run(a: TransientArgs) -> Result<(), Error> {
         "energy_balance": c.balance(),
         "energy_check": c.energy_check(opts.energy_resolution()),
         "training": o.training,
-        "profile": o.res.profile,
+        "profile": o.run.profile,
     });
     let check = c.energy_check(opts.energy_resolution());
     if !check.ok {
@@ -245,16 +206,12 @@ pub fn run(a: TransientArgs) -> Result<(), Error> {
     if a.json {
         print_json(&doc);
     } else {
-        print_summary(&a, &model, &o, total_s);
+        print_summary(&a, &name, &model, &o, total_s);
         if let Some(r) = &reference {
             print_reference_errors(&r.errors(c));
         }
     }
-    let met = o
-        .tolerance
-        .as_ref()
-        .and_then(|t| t["met"].as_bool())
-        .unwrap_or(true);
+    let met = o.tolerance.as_ref().is_none_or(|t| t.met);
     if a.strict && !met {
         return Err(Error::Invalid(format!(
             "--strict: the estimated |f_c| error {:e} of the best model exceeds --tolerance {:e} \
@@ -264,7 +221,7 @@ pub fn run(a: TransientArgs) -> Result<(), Error> {
                 .and_then(|e| e.as_ref().ok())
                 .and_then(|e| e.total.contact_force)
                 .unwrap_or(f64::NAN),
-            a.tolerance.unwrap_or(f64::NAN)
+            a.model.tolerance.unwrap_or(f64::NAN)
         )));
     }
     Ok(())
@@ -273,12 +230,7 @@ pub fn run(a: TransientArgs) -> Result<(), Error> {
 /// The options of a `transient` run from its flags (errors name the flag).
 fn transient_options(a: &TransientArgs) -> Result<TransientOptions, Error> {
     let mut o = TransientOptions::default();
-    o.ode.iteration = match a.iteration {
-        IterationArg::Newton => Iteration::Newton {
-            linear: NewtonLinear::Problem,
-        },
-        IterationArg::Functional => Iteration::Functional { anderson: 0 },
-    };
+    o.ode.iteration = a.iteration.iteration();
     o.problem.friction = a.friction.is_on();
     o.problem.events = a.events.is_on();
     if let Some(r) = a.rtol {
@@ -354,246 +306,37 @@ fn vtu_every(
     }
 }
 
-/// The model `--model` names, or its default: `adaptive` with `--tolerance`, else `tvd`.
-fn model_name(a: &TransientArgs) -> String {
-    match (&a.model, a.tolerance) {
-        (Some(m), _) => m.clone(),
-        (None, Some(_)) => "adaptive".into(),
-        (None, None) => "tvd".into(),
-    }
-}
-
-/// `--tolerance TOL`: the tolerance-chosen model (`--model adaptive`) and its run.
-fn run_tolerance(
-    a: &TransientArgs,
-    name: &str,
-    tol: f64,
-    model: &Model,
-    opts: &TransientOptions,
-    vtu_every: Option<usize>,
-) -> Result<Outcome, Error> {
-    if name != "adaptive" {
-        return Err(Error::Invalid(format!(
-            "--tolerance builds its own model (--model adaptive); it does not apply to --model {name} \
-             (use --g to size that one)"
-        )));
-    }
-    if a.g.is_some() {
-        return Err(Error::Invalid(
-            "--tolerance and --g both size the model: give one of them".into(),
-        ));
-    }
-    if a.train_end.is_some() {
-        return Err(train_end_error());
-    }
-    let mut topts = ToleranceOptions::new(tol);
-    topts.nu = a.nu;
-    topts.transient = opts.clone();
-    let t = tolerance_model(model, &topts)?;
-    let frames = match (vtu_every, &t.rom.phi) {
-        (Some(every), Some(phi)) => {
-            // The result's states again, expanded: one more run of the (small) chosen model.
-            let (_, kept) = run_keeping(t.rom.clone(), &Scene::of(model), opts, Some(every))?;
-            expand_frames(phi, kept)
-        }
-        _ => Vec::new(),
+/// The model the flags name (default `tvd`, `adaptive` with `--tolerance`), with the POD
+/// training flags.
+fn model_spec(a: &TransientArgs) -> Result<ModelSpec, Error> {
+    let tvd = ModelSpec::Basis {
+        kind: BasisKind::Tvd,
+        g: None,
+        nu: a.model.nu,
     };
-    let info = json!({
-        "tolerance": tol,
-        "met": t.met,
-        "pairs": t.pairs,
-        "nu": t.nu,
-        "setup_s": t.setup_s,
-        "estimate_s": t.estimate_s,
-        "rounds": t.rounds,
-    });
-    if !t.met {
-        eprintln!(
-            "warning: --tolerance {tol:e} not met: the best model ({} pairs, r = {}) estimates {:e}",
-            t.pairs.len(),
-            t.rom.dim(),
-            t.estimate.total.contact_force.unwrap_or(f64::NAN)
-        );
-    }
-    Ok(Outcome {
-        basis_size: t.rom.dim(),
-        g: Some(t.pairs.len()),
-        res: t.run,
-        training: None,
-        frames,
-        offline_s: Some(t.offline_s),
-        tolerance: Some(info),
-        estimate: Some(Ok(t.estimate)),
-    })
-}
-
-fn train_end_error() -> Error {
-    Error::Invalid("--train-end applies to --model pod only".into())
-}
-
-/// Runs the model `--model` names.
-fn run_model(
-    a: &TransientArgs,
-    model: &Model,
-    opts: &TransientOptions,
-    vtu_every: Option<usize>,
-) -> Result<Outcome, Error> {
-    let name = model_name(a);
-    if a.low_rank.is_some() && name != "full" {
-        return Err(Error::Invalid(
-            "--low-rank applies to --model full (the reduced model refactors its dense matrix)"
-                .into(),
-        ));
-    }
-    if let Some(tol) = a.tolerance {
-        return run_tolerance(a, &name, tol, model, opts, vtu_every);
-    }
-    let choice = match ModelChoice::parse(&name) {
-        Err(_) | Ok(ModelChoice::Basis(_)) if a.train_end.is_some() => {
-            return Err(train_end_error())
+    let mut spec = a.model.spec(tvd)?;
+    match &mut spec {
+        ModelSpec::Pod {
+            train_end,
+            snapshots,
+            ..
+        } => {
+            *train_end = a.train_end.map(|t| positive("train-end", t)).transpose()?;
+            *snapshots = a.snapshots;
         }
-        c => c?,
-    };
-    match choice {
-        ModelChoice::Full => {
-            if a.g.is_some() {
-                return Err(Error::Invalid(
-                    "--g applies to reduced models, not --model full".into(),
-                ));
-            }
-            if a.train_end.is_some() {
-                return Err(train_end_error());
-            }
-            let mut sys = FullSystem::new(model)?;
-            if let Some(cap) = a.low_rank {
-                sys.set_low_rank_capacity(cap);
-            }
-            let (res, frames) = run_keeping(sys, &Scene::of(model), opts, vtu_every)?;
-            Ok(Outcome {
-                res,
-                basis_size: model.dofs(),
-                g: None,
-                training: None,
-                frames,
-                offline_s: None,
-                tolerance: None,
-                estimate: None,
-            })
+        _ if a.train_end.is_some() => {
+            return Err(Error::Invalid(
+                "--train-end applies to --model pod only".into(),
+            ))
         }
-        ModelChoice::Pod => run_pod(a, model, opts, vtu_every),
-        ModelChoice::File(path) => run_file(a, &path, opts),
-        ModelChoice::Basis(kind) => {
-            let t0 = Instant::now();
-            let basis = build_basis(
-                model,
-                kind,
-                &BasisOptions {
-                    g: a.g,
-                    nu: a.nu,
-                    ..Default::default()
-                },
-            )?;
-            let offline_s = t0.elapsed().as_secs_f64();
-            let mut o = run_reduced(model, basis.phi, basis.g, None, opts, vtu_every)?;
-            o.offline_s = Some(offline_s);
-            Ok(o)
-        }
+        _ => {}
     }
+    Ok(spec)
 }
 
-/// Paper Section 5.2: the POD of displacement snapshots of a full-FE run (here over
-/// [0, train_end] with the same options), Euclidean, added to Craig–Bampton.
-fn run_pod(
-    a: &TransientArgs,
-    model: &Model,
-    opts: &TransientOptions,
-    vtu_every: Option<usize>,
-) -> Result<Outcome, Error> {
-    let train_end = match a.train_end {
-        Some(t) => positive("train-end", t)?,
-        None => opts.end_time.unwrap_or(model.end_time),
-    };
-    let (basis, training) = train_snapshot_basis(
-        model,
-        opts,
-        train_end,
-        a.snapshots,
-        &BasisOptions {
-            g: a.g,
-            nu: a.nu,
-            ..Default::default()
-        },
-    )?;
-    let training = serde_json::to_value(&training).expect("the training record serialises");
-    run_reduced(model, basis.phi, basis.g, Some(training), opts, vtu_every)
-}
-
-/// A reduced model exported by `jointrom export` (schema jointrom-rom v1).
-fn run_file(a: &TransientArgs, path: &Path, opts: &TransientOptions) -> Result<Outcome, Error> {
-    if a.g.is_some() || a.train_end.is_some() {
-        return Err(Error::Invalid(
-            "--g and --train-end do not apply to --model file:PATH".into(),
-        ));
-    }
-    if a.vtu.is_some() {
-        return Err(Error::Invalid(
-            "--vtu needs the basis Φ, which an exported reduced model does not carry; \
-             run the basis by name instead (e.g. --model tvd)"
-                .into(),
-        ));
-    }
-    let f = export::RomFile::read(path)?;
-    crate::common::record_input(format!("reduced model {}", path.display()));
-    Ok(Outcome {
-        res: driver::run(f.system()?, &f.scene(), opts)?,
-        basis_size: f.dimension,
-        g: Some(f.basis.g),
-        training: None,
-        frames: Vec::new(),
-        offline_s: None,
-        tolerance: None,
-        estimate: Some(Err(
-            "an exported reduced model carries no basis Φ to correct its joint forces with".into(),
-        )),
-    })
-}
-
-/// The run of the reduced model on the basis `phi` (g added vectors).
-fn run_reduced(
-    model: &Model,
-    phi: faer::Mat<f64>,
-    g: usize,
-    training: Option<Value>,
-    opts: &TransientOptions,
-    vtu_every: Option<usize>,
-) -> Result<Outcome, Error> {
-    let rom = ReducedSystem::new(model, phi)?;
-    let basis_size = rom.dim();
-    let phi = rom.phi.clone();
-    let flex = JointFlexibility::new(model)?;
-    let mut kept = Vec::new();
-    let mut k = 0usize;
-    let (res, estimate) =
-        run_estimated(model, &flex, rom, &Scene::of(model), opts, true, |t, q| {
-            if vtu_every.is_some_and(|every| k % every == 0) {
-                kept.push((t, q.to_vec()));
-            }
-            k += 1;
-        })?;
-    let res = res.into_result()?;
-    Ok(Outcome {
-        res,
-        basis_size,
-        g: Some(g),
-        training,
-        offline_s: None,
-        tolerance: None,
-        estimate: Some(estimate.map_err(|e| e.to_string())),
-        frames: match phi {
-            Some(phi) if !kept.is_empty() => expand_frames(&phi, kept),
-            _ => kept,
-        },
-    })
+/// The model's name in the outputs: `--model` as given, else the spec's (`tvd`, `adaptive`).
+fn spec_name(a: &TransientArgs, spec: &ModelSpec) -> String {
+    a.model.model.clone().unwrap_or_else(|| spec.name())
 }
 
 /// `"error_estimate"`: the estimated relative L2 errors, or `{"unavailable": why}`; `null` for
@@ -604,38 +347,6 @@ fn estimate_json(e: &Option<Result<RunEstimate, String>>) -> Value {
         Some(Ok(e)) => serde_json::to_value(e).expect("an estimate serialises"),
         Some(Err(why)) => json!({ "unavailable": why }),
     }
-}
-
-/// A transient run that keeps every `every`-th state (with its time) when `every` is given.
-fn run_keeping<S: SecondOrderSystem>(
-    sys: S,
-    scene: &Scene,
-    opts: &TransientOptions,
-    every: Option<usize>,
-) -> Result<(Run, Frames), Error> {
-    let Some(every) = every else {
-        return Ok((driver::run(sys, scene, opts)?, Vec::new()));
-    };
-    let mut frames = Vec::new();
-    let mut k = 0usize;
-    let res = integrate(sys, scene, opts, |t, q| {
-        if k % every == 0 {
-            frames.push((t, q.to_vec()));
-        }
-        k += 1;
-    })
-    .into_result()?;
-    Ok((res, frames))
-}
-
-/// Reduced states `q` (r) to physical DOF `Φ q` (n): one product `Φ [q_1 … q_f]`.
-fn expand_frames(phi: &faer::Mat<f64>, kept: Frames) -> Frames {
-    let q = faer::Mat::from_fn(phi.ncols(), kept.len(), |i, j| kept[j].1[i]);
-    let u = phi * &q;
-    kept.iter()
-        .enumerate()
-        .map(|(j, &(t, _))| (t, u.col(j).iter().copied().collect()))
-        .collect()
 }
 
 /// `--out DIR`: DIR/transient.json (the JSON document) and DIR/curves.csv.
@@ -650,13 +361,13 @@ fn write_outputs(dir: &Path, doc: &Value, c: &Curves) -> Result<(), Error> {
 }
 
 /// The text summary of a run.
-fn print_summary(a: &TransientArgs, model: &Model, o: &Outcome, total_s: f64) {
-    let (res, c) = (&o.res, &o.res.curves);
+fn print_summary(a: &TransientArgs, name: &str, model: &Model, o: &ModelRun, total_s: f64) {
+    let (res, c) = (&o.run, &o.run.curves);
     let s = &res.stats;
     println!(
         "{} — model {} (n = {}{}), friction {}, events {}",
         jointrom::files::printable(&model.name),
-        model_name(a),
+        name,
         o.basis_size,
         o.g.map(|g| format!(", g = {g}")).unwrap_or_default(),
         a.friction.name(),

@@ -1,13 +1,14 @@
 //! Error-controlled reduction: a tolerance on the joint forces in, the smallest reduced model that
-//! meets it out, with the estimate of [`crate::reduction::estimate`] attached to every reduced run.
+//! meets it out, with the estimate of [`super::estimate`] attached to every reduced run.
 //!
 //! ## Why not the paper's w(g)
 //!
 //! Every TVD column is a static response to loads on the pairs that close, so the TVD span is the
 //! span of the pair attachment modes `K⁻¹ b_kᵀ`, and the POD ranks those directions by global
-//! strain energy, not by how much they change the gaps of the pairs that carry force: on the
-//! friction bar the a-priori g (w ≥ 0.999) misses ‖f_c‖(t) by 4 % and the multilayer sheet's by
-//! 41 % (measured, README). No threshold of w(g) fixes that.
+//! strain energy, not by how much they change the gaps of the pairs that carry force. The pairs
+//! that carry the load are often small in energy (beside the welds, which hold the sheets nearly
+//! shut), so they enter only the last POD modes, and no threshold of w(g) fixes that
+//! (docs/validation: the a-priori g against the tolerance model).
 //!
 //! ## The basis
 //!
@@ -31,33 +32,29 @@
 //!    `|‖a‖ − ‖b‖| ≤ ‖a − b‖`, the pairs left out can contribute at most θ·TOL to the next
 //!    estimate if the added pairs become exact.
 //!
-//! The cap, measured (2026-11-26, DKMQ sheets): a model far from the answer spreads its error
-//! over many pairs, so the uncapped rule took 63 of the multilayer's 86 pairs after the
-//! Craig–Bampton round for TOL 1e-2 — and the next estimate's joint part was 0.08 %, far inside
-//! the tolerance. With the cap it takes 16, then 32 pairs (r = 48 instead of 79, true error
-//! 2.9e-3 instead of 2.7e-3, one round more, online run 1.2 s instead of 1.8 s); TOL 1e-1 24
-//! pairs (was 34), 1e-3 46 (was 71, and ν 20 either way); the friction bar, which needs ≤ 15
-//! pairs, is unchanged.
+//! Why the cap: a model far from the answer spreads its error over many pairs, so an uncapped
+//! rule adds most of the interface after the Craig–Bampton round although the next estimate's
+//! joint part would be far inside the tolerance with a fraction of them. Doubling per round costs
+//! at most one round more and keeps the basis near the smallest that meets TOL.
 //!
 //! The first round's run, Craig–Bampton alone, only ranks the pairs — its joint forces are off by
-//! O(1) (2 000 % on the friction bar, 690 % on the multilayer) and its integration error at
-//! [`RANKING_LOOSENING`]× looser tolerances is a few per cent of that — so it runs at those
-//! looser tolerances; should it meet TOL, it is re-run at the user's before it is the result.
-//! (Estimating it on every second output as well was tried and not kept: on the ×13 window it
-//! kept 302 pairs instead of 316–361 and the true error rose to 1.05 %.)
+//! O(1) and its integration error at [`RANKING_LOOSENING`]× looser tolerances is a small
+//! fraction of that — so it runs at those looser tolerances; should it meet TOL, it is re-run at
+//! the user's before it is the result. It is still estimated on every output: a thinned ranking
+//! picks worse pairs on refined meshes.
 //!
 //! Pairs that never carry force in either the run or the correction have `e_k = 0` and are never
 //! added: the model keeps only the joint directions the scene uses. The estimate's truncation
 //! part (the dynamics of the fixed-interface modes beyond ν) is not removed by pairs: when it
 //! exceeds θ·TOL once the joint part is within its share, ν grows by [`NU_STEP`] (up to
 //! `TRUNCATION_MODES − NU_STEP`). The truncated modes are driven by the run's own contact forces,
-//! so while those are wrong the truncation part is inflated (on the friction bar's Craig–Bampton
-//! round it read 0.10; with the pairs in place 3e-4): growing ν in the same round as the pairs
-//! made every model 10 columns larger for nothing. The rounds' e_k come from the joint part
-//! alone, so truncation does not masquerade as pair error.
+//! so while those are wrong the truncation part is inflated by orders of magnitude: growing ν in
+//! the same round as the pairs would make every model [`NU_STEP`] columns larger for nothing.
+//! The rounds' e_k come from the joint part alone, so truncation does not masquerade as pair
+//! error.
 //!
 //! The last round's run is the result; its estimate then gains the integration part
-//! ([`integration_errors`]: one more run at 2× looser tolerances, its difference scaled to this
+//! ([`super::estimate::integration_errors`]: one more run at 2× looser tolerances, its difference scaled to this
 //! run's error by the BDF2 error model — that run does not depend on the one it checks, so every
 //! round at the user's tolerances starts it beside its own run on a second thread, and a round
 //! that is not the last discards it), and `met` says whether the
@@ -65,238 +62,25 @@
 //! user's tolerances above TOL — the best model is returned with `met = false` (the CLI warns;
 //! tighter `--rtol/--atol` lower the integration floor).
 
-use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 use serde::Serialize;
 
 use crate::error::Error;
-use crate::integrate::{integrate, ProblemOptions, Run, TransientOptions};
-use crate::joint::law::PairLaw;
+use crate::integrate::{Run, TransientOptions};
 use crate::joint::statics::ContactOptions;
 use crate::model::Model;
 use crate::reduction::estimate::TRUNCATION_MODES;
 use crate::reduction::{
-    craig_bampton, final_basis, modal_rotation, CurveErrors, Estimate, JointFlexibility, RunStates,
-    DEFAULT_DROP_TOL,
+    craig_bampton, final_basis, modal_rotation, Estimate, JointFlexibility, DEFAULT_DROP_TOL,
 };
-use crate::studies::convergence::{reduced_contact_static_restarting, scaled_load, ReducedStatic};
-use crate::studies::stability::relative_l2;
+use crate::rom::estimate::{beside, loosened, run_estimated, RunEstimate};
+use crate::rom::statics::{reduced_contact_static_restarting, scaled_load, ReducedStatic};
 use crate::system::{ReducedSystem, Scene};
 
 /// θ of the pair selection (module docs): the pairs left out may carry at most this fraction of
 /// the tolerance.
 pub const SELECTION_MARGIN: f64 = 0.5;
-
-/// The pair law of a scene's contact under a run's problem options.
-pub fn pair_law(scene: &Scene, problem: &ProblemOptions) -> PairLaw {
-    PairLaw {
-        k_n: scene.contact.normal_stiffness,
-        friction: problem.friction,
-        mu: scene.contact.friction_coefficient,
-        k_t: scene.contact.stick_stiffness,
-        tau: problem.tau,
-    }
-}
-
-/// Looser tolerances of the integration check ([`integration_errors`]): rtol and atol times
-/// this.
-pub const INTEGRATION_CHECK_FACTOR: f64 = 2.0;
-
-/// The global error of BDF2 under local error control grows as `tol^(2/3)`: between the run
-/// and its check at `F`× looser tolerances the difference is `F^(2/3) − 1` times the run's own
-/// error ([`integration_errors`]).
-pub const INTEGRATION_ORDER_EXPONENT: f64 = 2.0 / 3.0;
-
-/// The error estimate of a reduced run: the reduction error (the quasi-static joint correction,
-/// [`crate::reduction::estimate`]) and the integration error, combined as independent errors.
-#[derive(Clone, Debug, Serialize)]
-pub struct RunEstimate {
-    /// The estimated relative L2 errors against the full model (root sum of squares of the two
-    /// parts).
-    #[serde(flatten)]
-    pub total: CurveErrors,
-    /// The reduction part: the run against its quasi-static joint correction.
-    pub reduction: CurveErrors,
-    /// The integration part: the run against a re-run at [`INTEGRATION_CHECK_FACTOR`]× looser
-    /// rtol and atol, scaled to this run's error ([`integration_errors`]; `None`: not checked).
-    pub integration: Option<CurveErrors>,
-    /// The reduction estimate's details (corrected curves, per-pair errors).
-    #[serde(skip)]
-    pub detail: Estimate,
-}
-
-/// The integration part of a run's error estimate: the relative L2 differences `D` of its curves
-/// from a re-run of the same system at `F` = [`INTEGRATION_CHECK_FACTOR`] = 2× looser
-/// tolerances, divided by `F^(2/3) − 1` = 0.587 (BDF2, [`INTEGRATION_ORDER_EXPONENT`]).
-///
-/// ## Why F = 2 and the division (measured at scale, README *Scale*)
-///
-/// The check at F = 10 measured the *looser* run's error, not this one's: on the friction bar
-/// ×4 window's TOL 1e-2 model, the runs at F = 1, 2, 3.16, 5, 10 are 0.45, 0.52, 0.86, 1.12 and
-/// 3.9 % from the full FE reference in ‖f_c‖(t) — the error grows steeply past F ≈ 5, where the
-/// steps stop resolving the stick–slip transitions — so `D(10)` = 3.9 % stood for an error of
-/// 0.45 % (×13 window: 9.1 % for 0.65 %). Tighter re-runs are no reference either: the reduced
-/// model's stiff pair directions (attachment modes, ω² up to 1e14 /s²) ring once resolved (×4:
-/// 12 974 steps at rtol 1e-9, 93 784 at 1e-10 against 666) and move ‖f_c‖(t) 1.2–1.5 % *away*
-/// from the full model, whose own 1e-8 and 1e-9 runs agree to 0.27 %. A check close to the
-/// run's own tolerances stays in the regime the run is in: `D(2)` = 0.35 % on ×4, and
-/// `D / (F^(2/3) − 1)` the asymptotic estimate of the run's own integration error.
-///
-/// History: until the Newton iteration's active-set refresh (`crate::integrate::mechanical`)
-/// this was `D(10) / 10`, the tolerance-proportional model; with the refresh the runs follow
-/// their contact switches closely and that read 17× low on the multilayer's TOL 1e-3 model, so
-/// `D(10)` itself became the estimate — right in size there, 6–14× high at scale.
-///
-/// What no re-run can see: ‖f_c‖(t) of a run with thousands of pair switches has a sensitivity
-/// floor — perturbations of any kind move it by a few 1e-4 (friction bar, multilayer) to a few
-/// 1e-3 (refined meshes). The multilayer's TOL 1e-3 model is the case: its estimate (6.8e-4)
-/// sits below the 1.5e-3 by which it differs from the 100× tighter full run, while the stored
-/// full run is itself 1.6e-3 from that one (README, *Error-controlled reduction*).
-pub fn integration_errors(
-    rom: ReducedSystem,
-    scene: &Scene,
-    opts: &TransientOptions,
-    run: &Run,
-) -> Result<CurveErrors, Error> {
-    Ok(integration_errors_from(
-        &integration_check_run(rom, scene, opts)?,
-        run,
-        opts,
-    ))
-}
-
-/// The re-run of [`integration_errors`] at [`INTEGRATION_CHECK_FACTOR`]× looser tolerances. It
-/// does not depend on the run it checks, so callers start it on a second thread beside that run
-/// ([`run_estimated`], [`tolerance_model`]).
-pub fn integration_check_run(
-    rom: ReducedSystem,
-    scene: &Scene,
-    opts: &TransientOptions,
-) -> Result<Run, Error> {
-    let loose = TransientOptions {
-        record: false,
-        ..loosened(opts, INTEGRATION_CHECK_FACTOR)
-    };
-    integrate(rom, scene, &loose, |_, _| {}).into_result()
-}
-
-/// [`integration_errors`] from its re-run `check` of `run` (made by [`integration_check_run`]
-/// with the same `opts`).
-pub fn integration_errors_from(check: &Run, run: &Run, opts: &TransientOptions) -> CurveErrors {
-    let (a, b) = (&check.curves, &run.curves);
-    let scale = 1.0 / (INTEGRATION_CHECK_FACTOR.powf(INTEGRATION_ORDER_EXPONENT) - 1.0);
-    let diff = |x: &[f64], y: &[f64]| relative_l2(&a.t, x, &b.t, y).map(|d| d * scale);
-    CurveErrors {
-        contact_force: diff(&a.contact_force_norm, &b.contact_force_norm),
-        friction_force: if opts.problem.friction {
-            diff(&a.friction_force_norm, &b.friction_force_norm)
-        } else {
-            None
-        },
-        master_uy: diff(&a.master_uy, &b.master_uy),
-    }
-}
-
-/// Runs `second` as a job of rayon's pool while `main` runs on this thread, and returns both
-/// results; a panic in either resumes here. The wait for `second` is rayon's (the thread takes
-/// other jobs meanwhile), so this is safe inside a rayon worker too — a sweep's variants run
-/// [`run_estimated`] on the workers, and an OS thread joined there would block a worker that its
-/// own nested parallel solves need (measured: the sweep test deadlocked).
-fn beside<A, B: Send>(main: impl FnOnce() -> A, second: impl FnOnce() -> B + Send) -> (A, B) {
-    let mut b = None;
-    let a = rayon::in_place_scope(|s| {
-        let slot = &mut b;
-        s.spawn(move |_| *slot = Some(second()));
-        main()
-    });
-    (a, b.expect("the scope ran its job"))
-}
-
-/// `opts` with rtol and atol times `factor`.
-fn loosened(opts: &TransientOptions, factor: f64) -> TransientOptions {
-    let mut out = opts.clone();
-    out.ode.rtol *= factor;
-    out.ode.atol *= factor;
-    out
-}
-
-/// Runs a reduced model of `model` (its trajectory recorded) under `scene` (the model's own, or
-/// a variant's law) and estimates its error: the reduction part always, the integration part
-/// with `check_integration` (one more run of the same model at looser tolerances). The run's own
-/// failure is in the [`Run`]; an estimate that cannot be made is the `Err` of the second value.
-///
-/// # Errors
-/// The estimator cannot be set up (a reduced model without its basis Φ, or not of `model`).
-pub fn run_estimated(
-    model: &Model,
-    flex: &JointFlexibility,
-    rom: ReducedSystem,
-    scene: &Scene,
-    opts: &TransientOptions,
-    check_integration: bool,
-    observe: impl FnMut(f64, &[f64]),
-) -> Result<(Run, Result<RunEstimate, Error>), Error> {
-    flex.basis_of(&rom)?;
-    let opts = TransientOptions {
-        record: true,
-        ..opts.clone()
-    };
-    let opts = &opts;
-    // The estimator's setup (r refined solves, the truncated modes), the integration check and
-    // the flexibility columns the estimate will need do not depend on the run: they go on a
-    // second thread beside it, the columns only while the run lasts.
-    let aside = rom.clone();
-    let running = AtomicBool::new(false);
-    let stop = &running;
-    let (mut run, (estimator, check)) = beside(
-        || {
-            let run = integrate(rom, scene, opts, observe);
-            stop.store(true, Ordering::Relaxed);
-            run
-        },
-        move || {
-            let estimator = flex.estimator(model, &aside);
-            let check = check_integration.then(|| integration_check_run(aside, scene, opts));
-            if estimator.is_ok() {
-                // A column that fails here fails again, named, in the estimate.
-                let _ = flex.prefetch_normal_columns(stop);
-            }
-            (estimator, check)
-        },
-    );
-    let estimate = match run.trajectory.take() {
-        Some(tr) if run.status.finished() => estimator?.estimate(
-            &pair_law(scene, &opts.problem),
-            RunStates {
-                t: &run.curves.t,
-                q: &tr.q,
-                p: &tr.p,
-                s: &tr.s,
-            },
-        ),
-        _ => Err(Error::Invalid(format!(
-            "no error estimate: the run ended early ({})",
-            run.status
-        ))),
-    };
-    let estimate = estimate.and_then(|detail| {
-        let integration = match check {
-            Some(c) => Some(integration_errors_from(&c?, &run, opts)),
-            None => None,
-        };
-        Ok(RunEstimate {
-            total: match &integration {
-                Some(i) => detail.errors.combine(i),
-                None => detail.errors,
-            },
-            reduction: detail.errors,
-            integration,
-            detail,
-        })
-    });
-    Ok((run, estimate))
-}
 
 /// Options of [`tolerance_model`].
 #[derive(Clone, Debug)]
@@ -373,6 +157,25 @@ pub struct ToleranceModel {
     /// Wall time of the result's estimate after its run: the quasi-static joint correction and
     /// the wait for the integration check (which runs beside the run on a second thread), s.
     pub estimate_s: f64,
+}
+
+/// What the tolerance model chose, as the outputs report it (`"tolerance"` in a run's JSON).
+#[derive(Clone, Debug, Serialize)]
+pub struct ToleranceChoice {
+    /// The tolerance asked for.
+    pub tolerance: f64,
+    /// Whether the estimate (both parts) meets it.
+    pub met: bool,
+    /// The chosen pairs (indices into the model's joint pairs), ascending.
+    pub pairs: Vec<usize>,
+    /// The chosen number of fixed-interface modes ν.
+    pub nu: usize,
+    /// Wall time of the setup, s.
+    pub setup_s: f64,
+    /// Wall time of the result's estimate after its run, s.
+    pub estimate_s: f64,
+    /// Every round, the last one the result.
+    pub rounds: Vec<Round>,
 }
 
 /// Builds the smallest Craig–Bampton + pair-attachment-mode model whose estimated ‖f_c‖(t)

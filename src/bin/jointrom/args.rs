@@ -1,0 +1,26 @@
+//! Flag values only the command line has (the library's value enums — basis kinds, iterations,
+//! interfaces, map models — live with the types they parse into).
+
+use clap::ValueEnum;
+
+/// A switch: `on` or `off`.
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum OnOff {
+    #[value(name = "on")]
+    On,
+    #[value(name = "off")]
+    Off,
+}
+
+impl OnOff {
+    pub fn is_on(self) -> bool {
+        self == OnOff::On
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            OnOff::On => "on",
+            OnOff::Off => "off",
+        }
+    }
+}
