@@ -209,6 +209,37 @@ impl ReferenceCurves {
     }
 }
 
+/// Relative L2 difference of `a` against `reference` over the times of `a` that the reference
+/// has too (matched to 1e-6 of the smaller spacing); `None` with fewer than 2 matched nonzero
+/// points or a zero reference.
+pub fn relative_l2(t_a: &[f64], a: &[f64], t_ref: &[f64], reference: &[f64]) -> Option<f64> {
+    let spacing = |t: &[f64]| {
+        t.windows(2)
+            .map(|w| w[1] - w[0])
+            .filter(|d| *d > 0.0)
+            .fold(f64::INFINITY, f64::min)
+    };
+    let tol = 1e-6 * spacing(t_a).min(spacing(t_ref));
+    if !tol.is_finite() {
+        return None;
+    }
+    let (mut num, mut den, mut matched) = (0.0, 0.0, 0usize);
+    let mut j = 0;
+    for (i, &t) in t_a.iter().enumerate() {
+        while j < t_ref.len() && t_ref[j] < t - tol {
+            j += 1;
+        }
+        if j < t_ref.len() && (t_ref[j] - t).abs() <= tol {
+            num += (a[i] - reference[j]).powi(2);
+            den += reference[j].powi(2);
+            if reference[j] != 0.0 {
+                matched += 1;
+            }
+        }
+    }
+    (matched >= 2 && den > 0.0).then(|| (num / den).sqrt())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -263,35 +294,4 @@ mod tests {
             vec![0.0, 1.0]
         );
     }
-}
-
-/// Relative L2 difference of `a` against `reference` over the times of `a` that the reference
-/// has too (matched to 1e-6 of the smaller spacing); `None` with fewer than 2 matched nonzero
-/// points or a zero reference.
-pub fn relative_l2(t_a: &[f64], a: &[f64], t_ref: &[f64], reference: &[f64]) -> Option<f64> {
-    let spacing = |t: &[f64]| {
-        t.windows(2)
-            .map(|w| w[1] - w[0])
-            .filter(|d| *d > 0.0)
-            .fold(f64::INFINITY, f64::min)
-    };
-    let tol = 1e-6 * spacing(t_a).min(spacing(t_ref));
-    if !tol.is_finite() {
-        return None;
-    }
-    let (mut num, mut den, mut matched) = (0.0, 0.0, 0usize);
-    let mut j = 0;
-    for (i, &t) in t_a.iter().enumerate() {
-        while j < t_ref.len() && t_ref[j] < t - tol {
-            j += 1;
-        }
-        if j < t_ref.len() && (t_ref[j] - t).abs() <= tol {
-            num += (a[i] - reference[j]).powi(2);
-            den += reference[j].powi(2);
-            if reference[j] != 0.0 {
-                matched += 1;
-            }
-        }
-    }
-    (matched >= 2 && den > 0.0).then(|| (num / den).sqrt())
 }
