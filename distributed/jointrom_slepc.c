@@ -1,5 +1,5 @@
 /*
- * jointrom_slepc: the distributed offline stage of jointrom (issue 18; docs/distributed.md).
+ * jointrom_slepc: the distributed offline stage of jointrom (docs/distributed.md).
  *
  * Reads a job folder written by `jointrom distributed` (PETSc binary, see
  * src/model/petsc.rs):

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The distributed path's PETSc/SLEPc program (issue 18; docs/distributed.md). Opt-in: the
+# The distributed path's PETSc/SLEPc program (docs/distributed.md). Opt-in: the
 # default `cargo build` needs none of this.
 #
 #     scripts/dist.sh install    # apt-get install -y slepc-dev openmpi-bin (as root)

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# CI check of the distributed path (issue 18; docs/distributed.md): installs the opt-in MPI
+# CI check of the distributed path (docs/distributed.md): installs the opt-in MPI
 # stack if it is missing (apt-get install -y slepc-dev openmpi-bin), builds the PETSc/SLEPc
 # program (scripts/dist.sh build) and runs the equality tests of tests/distributed/ under
 # mpirun -n 1 and -n 2: the friction bar (ν = 10 and 30) and its 10⁵-DOF refinement against the

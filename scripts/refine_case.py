@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Writes refined copies of a case file: every sheet's element counts multiplied by each factor
-(both in-plane directions), everything else unchanged (the scaling study of issue 18).
+(both in-plane directions), everything else unchanged (the scaling study).
 
     python3 scripts/refine_case.py cases/friction_bar.json cases/scale 2 4 8 13
 

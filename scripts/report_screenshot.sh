@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Renders a report's self-contained report.html in a headless browser and saves a screenshot,
-# to check that it renders (issue 17). Needs Debian's chromium:
+# to check that it renders. Needs Debian's chromium:
 #   apt-get install --no-install-recommends chromium
 # Usage: scripts/report_screenshot.sh REPORT_DIR [OUT.png] [HEIGHT_PX]
 set -euo pipefail

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The scaling table of issue 18: `jointrom info` and `jointrom basis` (default a-priori g) on the
+# The scaling table: `jointrom info` and `jointrom basis` (default a-priori g) on the
 # friction bar and its refinements, wall time and max RSS from /usr/bin/time, and the log–log
 # slopes between consecutive rows. Run from the repository root after `cargo build --release`:
 #

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Integrates a reduced model exported by `jointrom export` with SciPy's `solve_ivp` (BDF capped at
 order 2 like jointrom, or LSODA) and an analytic Jacobian, and compares curves, steps and wall time
-with jointrom's own run of the same file (issue 15: jointrom against an established integrator).
+with jointrom's own run of the same file (jointrom against an established integrator).
 
     python3 scripts/scipy_rom.py ROM.json [--jointrom target/release/jointrom] [--method BDF|LSODA]
                                  [--end-time T]

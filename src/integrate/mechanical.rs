@@ -159,13 +159,13 @@
 //! progress in time end the run with an error (a chattering switch).
 //!
 //! Measured step counts, Newton iterations and energy balances of these runs are in
-//! `docs/measurements.md` (section `integrate::mechanical`).
+//! `docs/validation/transient.md` (section `integrate::mechanical`).
 //!
 //! ## Step size of the full model: defaults
 //!
 //! The full FE model (friction bar, 906 DOF) took ~1e5 steps of ~1e-8 s per millisecond with
 //! CVODE's defaults (the measured table of max order × velocity tolerance × friction is in
-//! `docs/measurements.md`).
+//! `docs/validation/transient.md`).
 //!
 //! Two causes, both legitimately removable:
 //!

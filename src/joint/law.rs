@@ -22,7 +22,7 @@
 //! A CVODE right-hand side must be a pure function of `(t, y)`, so `s` is integrated from a rate
 //! law. The consistency form of rate-independent plasticity (`ṡ = λ e/|e|` with `λ` from
 //! `d|p_t|/dt = 0`) makes implicit steps that cross onto the cone unsolvable (measured: the step
-//! size collapses to round-off; `docs/measurements.md`, section `joint::law`). Instead `s`
+//! size collapses to round-off; `docs/theory/contact-friction.md`, section `joint::law`). Instead `s`
 //! relaxes back to the cone (Perzyna-type regularisation):
 //!
 //! ```text
@@ -33,7 +33,7 @@
 //! state lags outside the cone by `|e| − c ≈ τ V` (1e-5 mm at 10 mm/s), which changes nothing in
 //! the force (it is capped) and only delays the stick→slip transition by ~τ. The dissipation per
 //! cycle of the exact Coulomb loop `4 μ p_n (A − c)` is reproduced closely for τ = 1e-6 s
-//! (`tests/integrate/friction.rs` checks 1 %; measured errors in `docs/measurements.md`, section
+//! (`tests/integrate/friction.rs` checks 1 %; measured errors in `docs/theory/contact-friction.md`, section
 //! `joint::law`). The price is a stiff eigenvalue `−1/τ` per sliding or open pair: fine for BDF
 //! with Newton (the structured solve of [`crate::integrate::mechanical`] treats it exactly),
 //! prohibitive for functional iteration (step ≲ τ) whenever friction is on.
@@ -46,7 +46,7 @@
 //! `p · (ġ, u̇_t) = dψ/dt + d` holds up to `k_t c · d(|e| − c)/dt`: the capped law has no exact
 //! potential, and the mismatch is of the order of the lag `τ V` above (or `τ ċ` when the normal
 //! force falls while sliding). The balance is checked in [`crate::integrate::mechanical`]; how
-//! closely it closes on the friction bar ROM is in `docs/measurements.md`, section `joint::law`.
+//! closely it closes on the friction bar ROM is in `docs/theory/contact-friction.md`, section `joint::law`.
 
 /// Default relaxation time τ of the slip memory, s.
 pub const DEFAULT_TAU: f64 = 1e-6;

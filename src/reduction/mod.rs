@@ -24,7 +24,7 @@
 //!    For TVD, [`pod_tvd`] computes the same POD from the factor form `Y = K⁻¹ B_uᵀ C` as an
 //!    SVD (no `Yᵀ K Y`), resolving eigenvalues far below the Gram's round-off, so that with all
 //!    POMs the reduced contact force converges to the full one (the measured errors are in
-//!    `docs/measurements.md`, section `reduction`).
+//!    `docs/validation/static-convergence.md`, section `reduction`).
 //! 4. [`final_basis`]: the parts concatenated and M-orthonormalized (so `M̃ = I`), dependent
 //!    directions dropped; [`build_basis`] then rotates Φ to the reduced eigenbasis
 //!    ([`modal_rotation`]: `K̃ = diag(ω²)`, same span) unless `BasisOptions::modal` is false.

@@ -49,7 +49,7 @@
 //! K-normalized coefficients. [`super::pod_tvd`] computes the K-weighted POD as the SVD of
 //! `D^½ Vᵀ C` (`G = V D Vᵀ`) instead of the eigenproblem of `Yᵀ K Y`, which squares the
 //! condition number: the directions carrying the last per cent of the contact force have POD
-//! eigenvalues below the Gram route's round-off (measured in `docs/measurements.md`, section
+//! eigenvalues below the Gram route's round-off (measured in `docs/validation/static-convergence.md`, section
 //! `reduction::tvd`).
 //!
 //! # Compressed flexibility (many pairs)

@@ -40,7 +40,7 @@
 //! ## Measured
 //!
 //! The measured map of the friction bar (which cells fail, with which flag, and why) is in
-//! `docs/measurements.md` (section `studies::stability`); the stored run is `results/stability/`.
+//! `docs/validation/transient.md` (section `studies::stability`); the stored run is `results/stability/`.
 //!
 //! ## Failure kinds
 //!

@@ -52,7 +52,7 @@
 //! the friction bar's in-plane set reaches ~1e5 Hz by its 30th mode) is an error if requested.
 //!
 //! [`JimSet::Both`] merges the two sets' modes by eigenvalue, ascending. The built-in cases'
-//! lowest JIM frequencies and how `Both` mixes the sets are in `docs/measurements.md`, section
+//! lowest JIM frequencies and how `Both` mixes the sets are in `docs/validation/static-convergence.md`, section
 //! `reduction::competitors::jim`.
 
 use faer::linalg::triangular_solve::{
