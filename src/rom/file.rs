@@ -29,6 +29,7 @@
 //! | `coordinate_size` | r | ‖Φ_j‖₂ per column over the full model's DOF (mm or rad per unit q): jointrom's tolerance scale (files without `field_dofs`: max |Φ_j|) |
 //! | `field_dofs` | count | n, the full model's DOF: with `coordinate_size` the error test measures the physical field as the full model's does (`crate::integrate::mechanical`, *The error test of a reduced model*; absent in older files: r, and the test is the coordinates' own) |
 //! | `end_time` | s | the case's simulated span |
+//! | `source_digest` | string | SHA-256 (hex) of the source model's K and M (pattern and values), DOF count and pair count ([`model_digest`]); a run of the file under a CASE checks the CASE against it ([`RomFile::check_source`]; absent in older files: the name, DOF and pair counts are checked) |
 //!
 //! The pair law: gap `g = (BΦq)_normal`, normal force `p_n = k_n·min(g, 0)`; Coulomb friction
 //! with elastic stick `k_t (u_t − s)` capped at `μ|p_n|` (see `crate::joint::law`).
@@ -134,6 +135,31 @@ pub struct RomFile {
     pub field_dofs: Option<usize>,
     /// Simulated span, s.
     pub end_time: f64,
+    /// SHA-256 of the source model's matrices ([`model_digest`]; absent in older files).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub source_digest: Option<String>,
+}
+
+/// A digest of a model's mechanics: SHA-256 (hex) over its DOF and pair counts and the pattern
+/// and values (bits) of K and M. Two models with the same digest have the same matrices, so a
+/// reduced model exported from one is a reduced model of the other.
+pub fn model_digest(model: &Model) -> String {
+    use sha2::{Digest, Sha256};
+    let mut h = Sha256::new();
+    h.update((model.dofs() as u64).to_le_bytes());
+    h.update((model.joint.pairs() as u64).to_le_bytes());
+    for a in [&model.stiffness, &model.mass] {
+        for &p in &a.col_ptr {
+            h.update((p as u64).to_le_bytes());
+        }
+        for &i in &a.row_idx {
+            h.update((i as u64).to_le_bytes());
+        }
+        for &v in &a.values {
+            h.update(v.to_bits().to_le_bytes());
+        }
+    }
+    h.finalize().iter().map(|b| format!("{b:02x}")).collect()
 }
 
 fn rows(a: &Mat<f64>) -> Vec<Vec<f64>> {
@@ -167,7 +193,42 @@ impl RomFile {
             coordinate_size: scale.column,
             field_dofs: Some(scale.field_dofs),
             end_time: model.end_time,
+            source_digest: Some(model_digest(model)),
         })
+    }
+
+    /// Checks that `model` is the model this file was exported from: the digest of its
+    /// matrices where the file has one, else its name, DOF count and pair count. A run of the
+    /// file labelled with another model's name would be mislabelled.
+    ///
+    /// # Errors
+    /// [`Error::Invalid`] naming both models and what differs.
+    pub fn check_source(&self, model: &Model, path: &Path) -> Result<(), Error> {
+        let differs = match &self.source_digest {
+            Some(d) if *d != model_digest(model) => Some("its K and M differ".to_string()),
+            Some(_) => None,
+            None if self.case != model.name => Some(format!("its name is `{}`", model.name)),
+            None if self.field_dofs.is_some_and(|n| n != model.dofs()) => Some(format!(
+                "it has {} DOF, the file's model {}",
+                model.dofs(),
+                self.field_dofs.unwrap_or(0)
+            )),
+            None if self.pairs != model.joint.pairs() => Some(format!(
+                "it has {} joint pairs, the file's model {}",
+                model.joint.pairs(),
+                self.pairs
+            )),
+            None => None,
+        };
+        match differs {
+            Some(why) => Err(Error::Invalid(format!(
+                "{}: this reduced model was exported from `{}`, not from the CASE given ({why}): \
+                 give the case it was exported from",
+                path.display(),
+                crate::files::printable(&self.case),
+            ))),
+            None => Ok(()),
+        }
     }
 
     /// Writes the file (pretty JSON).

@@ -128,7 +128,7 @@ pub fn run_model(
             o.training = Some(training);
             Ok(o)
         }
-        ModelSpec::File(path) => run_file(path, opts, every),
+        ModelSpec::File(path) => run_file(model, path, opts, every),
         &ModelSpec::Tolerance { tolerance, nu } => run_tolerance(model, tolerance, nu, opts, every),
     }
 }
@@ -184,9 +184,15 @@ fn run_tolerance(
     })
 }
 
-/// A reduced model exported by `jointrom export`: it carries no basis Φ, so neither frames nor
-/// an error estimate.
-fn run_file(path: &Path, opts: &TransientOptions, every: Option<usize>) -> Result<ModelRun, Error> {
+/// A reduced model exported by `jointrom export` from `model` (checked: a run is labelled with
+/// its model's name), with the file's slip relaxation time τ: it carries no basis Φ, so neither
+/// frames nor an error estimate.
+fn run_file(
+    model: &Model,
+    path: &Path,
+    opts: &TransientOptions,
+    every: Option<usize>,
+) -> Result<ModelRun, Error> {
     if every.is_some() {
         return Err(Error::Invalid(
             "--vtu needs the basis Φ, which an exported reduced model does not carry; \
@@ -195,8 +201,16 @@ fn run_file(path: &Path, opts: &TransientOptions, every: Option<usize>) -> Resul
         ));
     }
     let f = RomFile::read(path)?;
+    f.check_source(model, path)?;
+    let opts = TransientOptions {
+        problem: crate::integrate::ProblemOptions {
+            tau: f.friction_relaxation_time,
+            ..opts.problem.clone()
+        },
+        ..opts.clone()
+    };
     let mut out = ModelRun::of(
-        driver::run(f.system()?, &f.scene(), opts)?,
+        driver::run(f.system()?, &f.scene(), &opts)?,
         f.dimension,
         Some(f.basis.g),
     );

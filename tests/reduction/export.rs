@@ -162,3 +162,176 @@ fn cli_export_then_transient_from_the_file_matches_the_direct_run() {
     assert_eq!(from_file, direct);
     let _ = std::fs::remove_file(&path);
 }
+
+/// Every field of the file that the run uses changes the run when it changes: a field that is
+/// read, checked and then ignored would pass this loop unchanged.
+#[test]
+fn every_mechanical_field_of_the_file_changes_the_run() {
+    let model = common::model("friction_bar");
+    let b = build_basis(
+        &model,
+        BasisKind::Tvd,
+        &BasisOptions {
+            g: Some(6),
+            ..BasisOptions::default()
+        },
+    )
+    .unwrap();
+    let info = BasisInfo {
+        kind: "tvd".into(),
+        g: b.g,
+        nu: 10,
+        threshold: 0.999,
+        w: b.w.clone(),
+        tolerance: None,
+    };
+    let rom = ReducedSystem::new(&model, b.phi).unwrap();
+    let file = RomFile::new(&model, &rom, info).unwrap();
+    let good = serde_json::to_value(&file).unwrap();
+    let opts = common::until(4e-3);
+    let curves = |v: &serde_json::Value| {
+        let f: RomFile = serde_json::from_value(v.clone()).unwrap();
+        let mut o = opts.clone();
+        o.problem.tau = f.friction_relaxation_time;
+        transient::run(f.system().unwrap(), &f.scene(), &o)
+            .unwrap()
+            .curves
+    };
+    let base = curves(&good);
+    fn scale(x: &mut serde_json::Value, k: f64) {
+        *x = (x.as_f64().unwrap() * k).into();
+    }
+    let changes: Vec<(&str, Box<Damage>)> = vec![
+        (
+            "stiffness",
+            Box::new(|v| scale(&mut v["stiffness"][0][0], 1.01)),
+        ),
+        ("mass", Box::new(|v| scale(&mut v["mass"][1][1], 1.01))),
+        (
+            "joint_operator",
+            Box::new(|v| {
+                for row in v["joint_operator"].as_array_mut().unwrap() {
+                    scale(&mut row[0], 1.05);
+                }
+            }),
+        ),
+        (
+            "master_rows + reduced_loads",
+            Box::new(|v| {
+                scale(&mut v["master_rows"][1][0], 1.01);
+                scale(&mut v["reduced_loads"][1][0], 1.01);
+            }),
+        ),
+        (
+            "master_load",
+            Box::new(|v| scale(&mut v["master_load"]["fy"], 1.1)),
+        ),
+        (
+            "contact.normal_stiffness",
+            Box::new(|v| scale(&mut v["contact"]["normal_stiffness"], 2.0)),
+        ),
+        (
+            "contact.stick_stiffness",
+            Box::new(|v| scale(&mut v["contact"]["stick_stiffness"], 2.0)),
+        ),
+        (
+            "contact.friction_coefficient",
+            Box::new(|v| scale(&mut v["contact"]["friction_coefficient"], 0.5)),
+        ),
+        (
+            "friction_relaxation_time",
+            Box::new(|v| scale(&mut v["friction_relaxation_time"], 1000.0)),
+        ),
+        (
+            "coordinate_size",
+            Box::new(|v| {
+                for s in v["coordinate_size"].as_array_mut().unwrap() {
+                    scale(s, 100.0);
+                }
+            }),
+        ),
+        ("field_dofs", Box::new(|v| v["field_dofs"] = 40.into())),
+        ("end_time", Box::new(|v| scale(&mut v["end_time"], 0.5))),
+    ];
+    for (field, change) in changes {
+        let mut v = good.clone();
+        change(&mut v);
+        let mut o = opts.clone();
+        if field == "end_time" {
+            o.end_time = None;
+        }
+        let f: RomFile = serde_json::from_value(v).unwrap();
+        o.problem.tau = f.friction_relaxation_time;
+        let mut base_o = opts.clone();
+        base_o.end_time = o.end_time;
+        let reference = if field == "end_time" {
+            transient::run(file.system().unwrap(), &file.scene(), &base_o)
+                .unwrap()
+                .curves
+        } else {
+            base.clone()
+        };
+        let got = transient::run(f.system().unwrap(), &f.scene(), &o)
+            .unwrap()
+            .curves;
+        assert_ne!(got, reference, "changing `{field}` must change the run");
+    }
+}
+
+/// A file run under another CASE is refused, naming the file's model: its output would carry
+/// the other case's name.
+#[test]
+fn a_file_refuses_a_case_it_was_not_exported_from() {
+    let path = tmp("source");
+    jointrom_ok(&[
+        "export",
+        "friction_bar",
+        "--g",
+        "5",
+        "--out",
+        path.to_str().unwrap(),
+    ]);
+    let err = common::jointrom_err(&[
+        "transient",
+        "multilayer_sheet",
+        "--model",
+        &format!("file:{}", path.display()),
+        "--end-time",
+        "1e-3",
+    ]);
+    assert!(
+        err.contains("exported from `friction_bar`"),
+        "the error names the file's model: {err}"
+    );
+    let ok = jointrom_json([
+        "transient",
+        "friction_bar",
+        "--model",
+        &format!("file:{}", path.display()),
+        "--end-time",
+        "1e-3",
+        "--json",
+    ]);
+    assert_eq!(ok["case"], "friction_bar");
+    // The run takes the file's slip relaxation time τ.
+    let mut v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    v["friction_relaxation_time"] = (v["friction_relaxation_time"].as_f64().unwrap() * 1e3).into();
+    let slow = tmp("source_tau");
+    std::fs::write(&slow, serde_json::to_string(&v).unwrap()).unwrap();
+    let other = jointrom_json([
+        "transient",
+        "friction_bar",
+        "--model",
+        &format!("file:{}", slow.display()),
+        "--end-time",
+        "1e-3",
+        "--json",
+    ]);
+    assert_ne!(
+        other["curves"], ok["curves"],
+        "τ from the file changes the run"
+    );
+    let _ = std::fs::remove_file(&path);
+    let _ = std::fs::remove_file(&slow);
+}
