@@ -205,7 +205,7 @@ fn run_file(
     let opts = TransientOptions {
         problem: crate::integrate::ProblemOptions {
             tau: f.friction_relaxation_time,
-            ..opts.problem.clone()
+            ..opts.problem
         },
         ..opts.clone()
     };
