@@ -283,7 +283,7 @@ fn every_mechanical_field_of_the_file_changes_the_run() {
 #[test]
 fn a_file_refuses_a_case_it_was_not_exported_from() {
     let path = tmp("source");
-    jointrom_ok(&[
+    jointrom_ok([
         "export",
         "friction_bar",
         "--g",
@@ -291,7 +291,7 @@ fn a_file_refuses_a_case_it_was_not_exported_from() {
         "--out",
         path.to_str().unwrap(),
     ]);
-    let err = common::jointrom_err(&[
+    let err = common::jointrom_err([
         "transient",
         "multilayer_sheet",
         "--model",
