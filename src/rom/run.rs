@@ -13,7 +13,9 @@ use crate::reduction::{build_basis, BasisOptions, JointFlexibility};
 use crate::rom::estimate::{run_estimated, RunEstimate};
 use crate::rom::file::RomFile;
 use crate::rom::spec::ModelSpec;
-use crate::rom::tolerance::{tolerance_model, ToleranceChoice, ToleranceModel, ToleranceOptions};
+use crate::rom::tolerance::{
+    tolerance_model, IntegrationTolerances, ToleranceChoice, ToleranceModel, ToleranceOptions,
+};
 use crate::rom::training::{train_snapshot_basis, Training};
 use crate::system::{FullSystem, ReducedSystem, Scene, SecondOrderSystem};
 
@@ -27,6 +29,8 @@ pub struct RunSettings {
     pub keep_every: Option<usize>,
     /// The full model's capacity for low-rank updates of its Newton factor (columns).
     pub low_rank: Option<usize>,
+    /// Where the tolerance model's rtol and atol come from (the user's `--rtol/--atol` win).
+    pub integration: IntegrationTolerances,
 }
 
 /// A finished run of a spec's model.
@@ -129,7 +133,9 @@ pub fn run_model(
             Ok(o)
         }
         ModelSpec::File(path) => run_file(model, path, opts, every),
-        &ModelSpec::Tolerance { tolerance, nu } => run_tolerance(model, tolerance, nu, opts, every),
+        &ModelSpec::Tolerance { tolerance, nu } => {
+            run_tolerance(model, tolerance, nu, opts, settings)
+        }
     }
 }
 
@@ -139,11 +145,13 @@ fn run_tolerance(
     tolerance: f64,
     nu: usize,
     opts: &TransientOptions,
-    every: Option<usize>,
+    settings: &RunSettings,
 ) -> Result<ModelRun, Error> {
+    let every = settings.keep_every;
     let mut topts = ToleranceOptions::new(tolerance);
     topts.nu = nu;
     topts.transient = opts.clone();
+    topts.integration = settings.integration;
     let ToleranceModel {
         pairs,
         nu,
@@ -155,11 +163,12 @@ fn run_tolerance(
         rounds,
         offline_s,
         estimate_s,
+        transient,
     } = tolerance_model(model, &topts)?;
     let frames = match (every, &rom.phi) {
         (Some(every), Some(phi)) => {
             // The result's states again, expanded: one more run of the (small) chosen model.
-            let (_, kept) = run_keeping(rom.clone(), &Scene::of(model), opts, Some(every))?;
+            let (_, kept) = run_keeping(rom.clone(), &Scene::of(model), &transient, Some(every))?;
             expand_frames(phi, kept)
         }
         _ => Vec::new(),
@@ -180,6 +189,8 @@ fn run_tolerance(
             setup_s,
             estimate_s,
             rounds,
+            rtol: transient.ode.rtol,
+            atol: transient.ode.atol,
         }),
     })
 }

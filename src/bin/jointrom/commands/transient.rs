@@ -11,6 +11,7 @@ use jointrom::integrate::{Curves, TransientOptions};
 use jointrom::reduction::BasisKind;
 use jointrom::rom::compare::{ReferenceCurves, ReferenceErrors};
 use jointrom::rom::spec::DEFAULT_SNAPSHOTS;
+use jointrom::rom::tolerance::IntegrationTolerances;
 use jointrom::rom::{run_model, ModelFlags, ModelRun, ModelSpec, RunEstimate, RunSettings};
 use jointrom::{Error, Model};
 
@@ -134,6 +135,11 @@ pub fn run(a: TransientArgs) -> Result<(), Error> {
         &RunSettings {
             keep_every: vtu_every,
             low_rank: a.low_rank,
+            integration: if a.rtol.is_some() || a.atol.is_some() {
+                IntegrationTolerances::Given
+            } else {
+                IntegrationTolerances::FromTolerance
+            },
         },
     )?;
     if let Some(t) = o.tolerance.as_ref().filter(|t| !t.met) {
