@@ -18,6 +18,7 @@ use faer::Mat;
 
 use crate::element::{Beam2, Shell4, Weld};
 use crate::error::Error;
+use crate::linalg::sparse::column_pattern;
 use crate::linalg::SymCsc;
 use crate::mesh::Mesh;
 
@@ -296,20 +297,11 @@ impl Assembler {
                 cursor[d] += 1;
             }
         }
-        let mut col_ptr = Vec::with_capacity(n + 1);
-        col_ptr.push(0);
-        let mut row_idx = Vec::new();
-        let mut rows = Vec::new();
-        for c in 0..n {
-            rows.clear();
+        let (col_ptr, row_idx) = column_pattern(n, |c, rows| {
             for &k in &inc[inc_ptr[c]..inc_ptr[c + 1]] {
                 rows.extend_from_slice(&elements[k].dofs);
             }
-            rows.sort_unstable();
-            rows.dedup();
-            row_idx.extend_from_slice(&rows);
-            col_ptr.push(row_idx.len());
-        }
+        });
         drop(inc);
         // Positions: the element's sorted DOF walk each of its columns' sorted rows once.
         for e in &mut elements {

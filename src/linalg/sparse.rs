@@ -6,6 +6,28 @@ use faer::{Mat, MatRef};
 
 use crate::error::Error;
 
+/// The compressed-column pattern `(col_ptr, row_idx)` of `n` columns whose rows `fill(c, rows)`
+/// pushes into the (cleared) `rows`, in any order and with repeats: each column's rows sorted
+/// and deduplicated. One column is held at a time.
+pub fn column_pattern(
+    n: usize,
+    mut fill: impl FnMut(usize, &mut Vec<usize>),
+) -> (Vec<usize>, Vec<usize>) {
+    let mut col_ptr = Vec::with_capacity(n + 1);
+    col_ptr.push(0);
+    let mut row_idx = Vec::new();
+    let mut rows = Vec::new();
+    for c in 0..n {
+        rows.clear();
+        fill(c, &mut rows);
+        rows.sort_unstable();
+        rows.dedup();
+        row_idx.extend_from_slice(&rows);
+        col_ptr.push(row_idx.len());
+    }
+    (col_ptr, row_idx)
+}
+
 /// A symmetric sparse matrix in compressed sparse columns with both triangles stored.
 #[derive(Clone, Debug)]
 pub struct SymCsc {
