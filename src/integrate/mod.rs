@@ -9,7 +9,7 @@ pub mod mechanical;
 pub mod problem;
 pub mod stepper;
 #[allow(unsafe_code)]
-pub mod sundials;
+pub(crate) mod sundials;
 
 pub use crate::system::Scene;
 pub use driver::{
@@ -17,3 +17,4 @@ pub use driver::{
 };
 pub use mechanical::{EnergySample, MechanicalOde, ProblemOptions};
 pub use stepper::Stepper;
+pub use sundials::Cvode;
