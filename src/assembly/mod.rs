@@ -208,7 +208,7 @@ impl DofMap {
     }
 
     /// The independent DOF of a node's 6 DOF if the node is free (neither clamped nor tied).
-    pub fn free_dofs(&self, node: usize) -> Option<[usize; 6]> {
+    pub(crate) fn free_dofs(&self, node: usize) -> Option<[usize; 6]> {
         let d = &self.nodes[node];
         let mut out = [0; 6];
         for k in 0..6 {
@@ -346,7 +346,11 @@ impl Assembler {
     }
 
     /// Like [`Assembler::assemble`] but into an existing value array (same pattern).
-    pub fn assemble_into(&self, element_matrix: impl Fn(usize) -> Mat<f64>, values: &mut [f64]) {
+    pub(crate) fn assemble_into(
+        &self,
+        element_matrix: impl Fn(usize) -> Mat<f64>,
+        values: &mut [f64],
+    ) {
         values.iter_mut().for_each(|v| *v = 0.0);
         for (e, sc) in self.elements.iter().enumerate() {
             let ae = element_matrix(e);

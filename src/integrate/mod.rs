@@ -2,7 +2,7 @@
 //! mechanical problem of any [`crate::system::SecondOrderSystem`] with contact and friction
 //! ([`mechanical`]), the one driver loop with deadline, observer and a typed [`RunStatus`]
 //! ([`driver`]), the same run advanced from outside for co-simulation ([`stepper`]), and SUNDIALS
-//! CVODE beneath ([`sundials`], the crate's only `unsafe`).
+//! CVODE beneath (`sundials`, crate-private, the crate's only `unsafe`; [`Cvode`] re-exported).
 
 pub mod driver;
 pub mod mechanical;

@@ -1,7 +1,6 @@
 //! Symmetric sparse matrices (compressed sparse columns, both triangles stored) and their
 //! products: the storage every assembled K and M of jointrom uses.
 
-use faer::sparse::{SparseColMat, SymbolicSparseColMat};
 use faer::{Mat, MatRef};
 
 use crate::error::Error;
@@ -9,7 +8,7 @@ use crate::error::Error;
 /// The compressed-column pattern `(col_ptr, row_idx)` of `n` columns whose rows `fill(c, rows)`
 /// pushes into the (cleared) `rows`, in any order and with repeats: each column's rows sorted
 /// and deduplicated. One column is held at a time.
-pub fn column_pattern(
+pub(crate) fn column_pattern(
     n: usize,
     mut fill: impl FnMut(usize, &mut Vec<usize>),
 ) -> (Vec<usize>, Vec<usize>) {
@@ -109,20 +108,8 @@ impl SymCsc {
         Ok(out)
     }
 
-    /// A faer sparse matrix (copies).
-    pub fn to_faer(&self) -> SparseColMat<usize, f64> {
-        let sym = SymbolicSparseColMat::new_checked(
-            self.n,
-            self.n,
-            self.col_ptr.clone(),
-            None,
-            self.row_idx.clone(),
-        );
-        SparseColMat::new(sym, self.values.clone())
-    }
-
     /// A sprs matrix (copies), e.g. for MatrixMarket export.
-    pub fn to_sprs(&self) -> sprs::CsMat<f64> {
+    pub(crate) fn to_sprs(&self) -> sprs::CsMat<f64> {
         sprs::CsMat::new_csc(
             (self.n, self.n),
             self.col_ptr.clone(),

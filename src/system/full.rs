@@ -182,11 +182,6 @@ impl FullSystem {
             phi,
         )
     }
-
-    /// Number of stored entries (both triangles) of the Newton matrix pattern.
-    pub fn newton_nnz(&self) -> usize {
-        self.newton_values.len()
-    }
 }
 
 impl SecondOrderSystem for FullSystem {

@@ -115,7 +115,7 @@
 //!
 //! ## Running
 //!
-//! [`crate::integrate::driver`] drives a [`MechanicalOde`] with [`crate::integrate::sundials::Cvode`]
+//! [`crate::integrate::driver`] drives a [`MechanicalOde`] with [`crate::integrate::Cvode`]
 //! from rest to the scene's end time, sampling [`EnergySample`]s into
 //! [`crate::integrate::Curves`] every `output_step` (1e-4 s by
 //! default). With events on, every located root (a gap or a stick/slip switch changing sign)
@@ -474,7 +474,7 @@ impl<S: SecondOrderSystem> MechanicalOde<S> {
 
     /// The slip memory `s` (2w with friction, else empty; mm) of the last
     /// [`MechanicalOde::sample`].
-    pub fn slip_memory(&self) -> &[f64] {
+    pub(crate) fn slip_memory(&self) -> &[f64] {
         &self.s_phys
     }
 
@@ -484,7 +484,7 @@ impl<S: SecondOrderSystem> MechanicalOde<S> {
     }
 
     /// The initial state: at rest, undeformed, no slip, no work.
-    pub fn initial_state(&self) -> Vec<f64> {
+    pub(crate) fn initial_state(&self) -> Vec<f64> {
         vec![0.0; self.dim()]
     }
 

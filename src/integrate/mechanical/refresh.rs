@@ -84,12 +84,12 @@ impl<S: SecondOrderSystem> MechanicalOde<S> {
 
     /// Of the [`MechanicalOde::refreshes`], those done by a low-rank update of the factor
     /// ([`SecondOrderSystem::newton_update`]) instead of a refactorization.
-    pub fn low_rank_refreshes(&self) -> u64 {
+    pub(crate) fn low_rank_refreshes(&self) -> u64 {
         self.low_rank_refreshes
     }
 
     /// Pairs that had switched branch at a refresh, summed over the refreshes.
-    pub fn refresh_pairs(&self) -> u64 {
+    pub(crate) fn refresh_pairs(&self) -> u64 {
         self.refresh_pairs
     }
 }

@@ -264,7 +264,7 @@ pub fn read(path: &std::path::Path) -> Result<Deck, Error> {
 }
 
 /// Types the cards of a read deck.
-pub fn interpret(cards: Cards) -> Result<Deck, Error> {
+pub(crate) fn interpret(cards: Cards) -> Result<Deck, Error> {
     let mut deck = Deck {
         wtmass: 1.0,
         ..Deck::default()
