@@ -18,6 +18,7 @@ use faer::Mat;
 
 use crate::element::{Beam2, Shell4, Weld};
 use crate::error::Error;
+use crate::linalg::sparse::column_pattern;
 use crate::linalg::SymCsc;
 use crate::mesh::Mesh;
 
@@ -207,7 +208,7 @@ impl DofMap {
     }
 
     /// The independent DOF of a node's 6 DOF if the node is free (neither clamped nor tied).
-    pub fn free_dofs(&self, node: usize) -> Option<[usize; 6]> {
+    pub(crate) fn free_dofs(&self, node: usize) -> Option<[usize; 6]> {
         let d = &self.nodes[node];
         let mut out = [0; 6];
         for k in 0..6 {
@@ -296,20 +297,11 @@ impl Assembler {
                 cursor[d] += 1;
             }
         }
-        let mut col_ptr = Vec::with_capacity(n + 1);
-        col_ptr.push(0);
-        let mut row_idx = Vec::new();
-        let mut rows = Vec::new();
-        for c in 0..n {
-            rows.clear();
+        let (col_ptr, row_idx) = column_pattern(n, |c, rows| {
             for &k in &inc[inc_ptr[c]..inc_ptr[c + 1]] {
                 rows.extend_from_slice(&elements[k].dofs);
             }
-            rows.sort_unstable();
-            rows.dedup();
-            row_idx.extend_from_slice(&rows);
-            col_ptr.push(row_idx.len());
-        }
+        });
         drop(inc);
         // Positions: the element's sorted DOF walk each of its columns' sorted rows once.
         for e in &mut elements {
@@ -354,7 +346,11 @@ impl Assembler {
     }
 
     /// Like [`Assembler::assemble`] but into an existing value array (same pattern).
-    pub fn assemble_into(&self, element_matrix: impl Fn(usize) -> Mat<f64>, values: &mut [f64]) {
+    pub(crate) fn assemble_into(
+        &self,
+        element_matrix: impl Fn(usize) -> Mat<f64>,
+        values: &mut [f64],
+    ) {
         values.iter_mut().for_each(|v| *v = 0.0);
         for (e, sc) in self.elements.iter().enumerate() {
             let ae = element_matrix(e);

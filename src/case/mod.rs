@@ -224,7 +224,7 @@ impl LocalMesh {
     pub const AUTO_UNRESOLVED_PER_DIAMETER: f64 = 0.5;
 
     /// `true` for [`LocalMesh::Auto`] (omitted when written).
-    pub fn is_auto(&self) -> bool {
+    pub(crate) fn is_auto(&self) -> bool {
         *self == LocalMesh::Auto
     }
 }

@@ -275,12 +275,6 @@ impl Shell4 {
         Ok(shell)
     }
 
-    /// The same element with drilling factor α (dimensionless, ≥ 0).
-    pub fn with_drilling_factor(mut self, alpha: f64) -> Shell4 {
-        self.drilling_factor = alpha;
-        self
-    }
-
     /// Unit normal of the element plane (global components).
     pub fn normal(&self) -> [f64; 3] {
         self.frame[2]

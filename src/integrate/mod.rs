@@ -2,14 +2,14 @@
 //! mechanical problem of any [`crate::system::SecondOrderSystem`] with contact and friction
 //! ([`mechanical`]), the one driver loop with deadline, observer and a typed [`RunStatus`]
 //! ([`driver`]), the same run advanced from outside for co-simulation ([`stepper`]), and SUNDIALS
-//! CVODE beneath ([`sundials`], the crate's only `unsafe`).
+//! CVODE beneath (`sundials`, crate-private, the crate's only `unsafe`; [`Cvode`] re-exported).
 
 pub mod driver;
 pub mod mechanical;
 pub mod problem;
 pub mod stepper;
 #[allow(unsafe_code)]
-pub mod sundials;
+pub(crate) mod sundials;
 
 pub use crate::system::Scene;
 pub use driver::{
@@ -17,3 +17,4 @@ pub use driver::{
 };
 pub use mechanical::{EnergySample, MechanicalOde, ProblemOptions};
 pub use stepper::Stepper;
+pub use sundials::Cvode;

@@ -1,5 +1,5 @@
 //! The integrator-neutral boundary between a first-order ODE problem `y' = F(t, y)` and a time
-//! integrator (CVODE in [`crate::integrate::sundials`]).
+//! integrator (CVODE in `crate::integrate::sundials`, wrapped by [`crate::integrate::Cvode`]).
 //!
 //! A problem is data plus pure functions of `(t, y)`: the right-hand side, optional event
 //! (root) functions, and optionally its own Newton linear solver for the matrix `I − γ J`

@@ -64,7 +64,7 @@ impl PairFrame {
     }
 
     /// The global axis (0 = x, 1 = y, 2 = z) closest to the normal.
-    pub fn normal_axis(&self) -> usize {
+    pub(crate) fn normal_axis(&self) -> usize {
         let a = self.normal.map(f64::abs);
         if a[1] >= a[0] && a[1] >= a[2] {
             1

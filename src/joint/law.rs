@@ -141,7 +141,7 @@ impl PairLaw {
     /// `|e| − c`, mm: how far the elastic slip `e = u_t − s` lies outside (> 0) or inside the
     /// stick radius `c = μ k_n (−g)₊ / k_t`.
     #[inline]
-    pub fn cone_distance(&self, u: [f64; 3], s: [f64; 2]) -> f64 {
+    pub(crate) fn cone_distance(&self, u: [f64; 3], s: [f64; 2]) -> f64 {
         (u[1] - s[0]).hypot(u[2] - s[1]) - self.radius(u[0])
     }
 

@@ -74,7 +74,7 @@ impl SparseCholesky {
 
     /// The symbolic analysis of the pattern `col_ptr`/`row_idx` (n × n, both triangles,
     /// sorted rows), for sequential numeric factorizations with [`SparseCholesky::factor`].
-    pub fn analyze(
+    pub(crate) fn analyze(
         n: usize,
         col_ptr: Vec<usize>,
         row_idx: Vec<usize>,
@@ -152,7 +152,7 @@ impl SparseCholesky {
 
     /// `x ← A⁻¹ x` for one column, sequential, in preallocated scratch (NaN if the last
     /// factorization failed).
-    pub fn solve_vec_in_place(&mut self, x: &mut [f64]) {
+    pub(crate) fn solve_vec_in_place(&mut self, x: &mut [f64]) {
         if !self.factored {
             x.fill(f64::NAN);
             return;
@@ -172,7 +172,7 @@ impl SparseCholesky {
     }
 
     /// [`Self::solve_in_place`] on a matrix view (e.g. a block of columns).
-    pub fn solve_in_place_mut(&self, mut rhs: MatMut<'_, f64>) {
+    pub(crate) fn solve_in_place_mut(&self, mut rhs: MatMut<'_, f64>) {
         if !self.factored {
             rhs.fill(f64::NAN);
             return;
@@ -263,7 +263,7 @@ impl SparseCholesky {
     }
 
     /// Whether the last numeric factorization succeeded.
-    pub fn is_factored(&self) -> bool {
+    pub(crate) fn is_factored(&self) -> bool {
         self.factored
     }
 

@@ -64,17 +64,8 @@ fn check_count(n: usize, count: usize) -> Result<(), Error> {
 
 /// Deterministic pseudo-random start vector (SplitMix64 bits mapped to [−1, 1)).
 fn start_vector(n: usize) -> Vec<f64> {
-    let mut state: u64 = 0x9E37_79B9_7F4A_7C15;
-    (0..n)
-        .map(|_| {
-            state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
-            let mut z = state;
-            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-            z ^= z >> 31;
-            (z >> 11) as f64 / (1u64 << 52) as f64 - 1.0
-        })
-        .collect()
+    let mut rng = super::random::SplitMix64::new(0);
+    (0..n).map(|_| rng.next_signed()).collect()
 }
 
 fn dot(a: &[f64], b: &[f64]) -> f64 {

@@ -111,7 +111,7 @@ impl LowRankCholesky {
     /// Returns the index of the first new column, or `None` (nothing added) if m + k would
     /// exceed the capacity. The new columns couple to nothing until
     /// [`LowRankCholesky::set_coupling`]; call [`LowRankCholesky::factor`] before solving.
-    pub fn add_columns(
+    pub(crate) fn add_columns(
         &mut self,
         chol: &SparseCholesky,
         k: usize,
@@ -150,7 +150,7 @@ impl LowRankCholesky {
     }
 
     /// Sets `C_ij = C_ji = v` (columns i, j < m).
-    pub fn set_coupling(&mut self, i: usize, j: usize, v: f64) {
+    pub(crate) fn set_coupling(&mut self, i: usize, j: usize, v: f64) {
         debug_assert!(i < self.m && j < self.m);
         self.c[(i, j)] = v;
         self.c[(j, i)] = v;

@@ -12,6 +12,7 @@ pub mod eigen;
 mod error;
 pub mod kernels;
 pub mod lowrank;
+pub(crate) mod random;
 pub mod sparse;
 pub mod subset_llt;
 pub mod symmetric;

@@ -1,10 +1,31 @@
 //! Symmetric sparse matrices (compressed sparse columns, both triangles stored) and their
 //! products: the storage every assembled K and M of jointrom uses.
 
-use faer::sparse::{SparseColMat, SymbolicSparseColMat};
 use faer::{Mat, MatRef};
 
 use crate::error::Error;
+
+/// The compressed-column pattern `(col_ptr, row_idx)` of `n` columns whose rows `fill(c, rows)`
+/// pushes into the (cleared) `rows`, in any order and with repeats: each column's rows sorted
+/// and deduplicated. One column is held at a time.
+pub(crate) fn column_pattern(
+    n: usize,
+    mut fill: impl FnMut(usize, &mut Vec<usize>),
+) -> (Vec<usize>, Vec<usize>) {
+    let mut col_ptr = Vec::with_capacity(n + 1);
+    col_ptr.push(0);
+    let mut row_idx = Vec::new();
+    let mut rows = Vec::new();
+    for c in 0..n {
+        rows.clear();
+        fill(c, &mut rows);
+        rows.sort_unstable();
+        rows.dedup();
+        row_idx.extend_from_slice(&rows);
+        col_ptr.push(row_idx.len());
+    }
+    (col_ptr, row_idx)
+}
 
 /// A symmetric sparse matrix in compressed sparse columns with both triangles stored.
 #[derive(Clone, Debug)]
@@ -87,20 +108,8 @@ impl SymCsc {
         Ok(out)
     }
 
-    /// A faer sparse matrix (copies).
-    pub fn to_faer(&self) -> SparseColMat<usize, f64> {
-        let sym = SymbolicSparseColMat::new_checked(
-            self.n,
-            self.n,
-            self.col_ptr.clone(),
-            None,
-            self.row_idx.clone(),
-        );
-        SparseColMat::new(sym, self.values.clone())
-    }
-
     /// A sprs matrix (copies), e.g. for MatrixMarket export.
-    pub fn to_sprs(&self) -> sprs::CsMat<f64> {
+    pub(crate) fn to_sprs(&self) -> sprs::CsMat<f64> {
         sprs::CsMat::new_csc(
             (self.n, self.n),
             self.col_ptr.clone(),

@@ -53,7 +53,7 @@ pub struct WeldElem {
 
 /// The cell `[j, j + 1]` of the ascending node `lines` (at least two) containing `v` — the
 /// first or last cell for a value outside — and the position `t ∈ [0, 1]` of `v` in it.
-pub fn line_cell(lines: &[f64], v: f64) -> (usize, f64) {
+pub(crate) fn line_cell(lines: &[f64], v: f64) -> (usize, f64) {
     let j = lines.partition_point(|&l| l <= v).clamp(1, lines.len() - 1) - 1;
     let t = ((v - lines[j]) / (lines[j + 1] - lines[j])).clamp(0.0, 1.0);
     (j, t)

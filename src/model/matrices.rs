@@ -220,7 +220,7 @@ fn no_group() -> i32 {
 
 /// `Some(path)` if `arg` is an existing file whose top-level `schema` is [`SCHEMA`]; `None` for
 /// anything else (a case file, a built-in name), which the case loader then reports on.
-pub fn map_file(arg: &str) -> Result<Option<PathBuf>, Error> {
+pub(crate) fn map_file(arg: &str) -> Result<Option<PathBuf>, Error> {
     #[derive(Deserialize)]
     struct Peek {
         schema: Option<String>,

@@ -337,7 +337,7 @@ impl JointFlexibility {
 
     /// The attachment modes `K⁻¹ b_kᵀ` of the normal rows of `pairs` (n × |pairs|, mm/N): the
     /// static response of the structure to a unit normal force on each pair.
-    pub fn attachment_modes(&self, pairs: &[usize]) -> Mat<f64> {
+    pub(crate) fn attachment_modes(&self, pairs: &[usize]) -> Mat<f64> {
         let mut rhs = Mat::<f64>::zeros(self.stiffness.n, pairs.len());
         for (j, &k) in pairs.iter().enumerate() {
             for (i, v) in self.joint.row(3 * k + NORMAL) {
@@ -430,7 +430,7 @@ impl JointFlexibility {
     ///
     /// # Errors
     /// [`Error::Invalid`] saying which of these fails.
-    pub fn basis_of<'r>(&self, rom: &'r ReducedSystem) -> Result<&'r Mat<f64>, Error> {
+    pub(crate) fn basis_of<'r>(&self, rom: &'r ReducedSystem) -> Result<&'r Mat<f64>, Error> {
         let phi = rom.phi.as_ref().ok_or_else(|| {
             Error::Invalid(
                 "error estimate: the reduced model carries no basis Φ (read from a file)".into(),

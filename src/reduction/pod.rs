@@ -76,15 +76,8 @@ pub const RANGE_TOL: f64 = 1e-10;
 
 /// Deterministic pseudo-random matrix (SplitMix64 bits mapped to [−1, 1)).
 fn sketch(rows: usize, cols: usize, seed: u64) -> Mat<f64> {
-    let mut state: u64 = 0x9E37_79B9_7F4A_7C15 ^ seed;
-    Mat::from_fn(rows, cols, |_, _| {
-        state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = state;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^= z >> 31;
-        (z >> 11) as f64 / (1u64 << 52) as f64 - 1.0
-    })
+    let mut rng = crate::linalg::random::SplitMix64::new(seed);
+    Mat::from_fn(rows, cols, |_, _| rng.next_signed())
 }
 
 /// `(W, ℓ)` with `W = Y Q_T`, Q_T (p × ℓ) an orthonormal basis of the numerical row space of Y

@@ -496,7 +496,7 @@ fn tick(v: f64, log: bool, scale: f64) -> String {
 }
 
 /// The colour of the `k`-th series of a chart (RGB), for references drawn in a series' colour.
-pub fn series_color(k: usize) -> [u8; 3] {
+pub(crate) fn series_color(k: usize) -> [u8; 3] {
     let RGBColor(r, g, b) = palette(k);
     [r, g, b]
 }

@@ -22,7 +22,7 @@ code{background:#f4f4f4;padding:0 0.2em}h1,h2{border-bottom:1px solid #ddd}";
 /// Renders `markdown` (whose image links are relative to `dir`) as a complete HTML page titled
 /// `title`. Local PNG, SVG and JPEG images are read (bounded like every input) and inlined; an
 /// image that cannot be read is an error naming it; remote links are kept as they are.
-pub fn render(markdown: &str, dir: &Path, title: &str) -> Result<String, Error> {
+pub(crate) fn render(markdown: &str, dir: &Path, title: &str) -> Result<String, Error> {
     let mut events = Vec::new();
     for ev in Parser::new_ext(markdown, Options::ENABLE_TABLES) {
         events.push(match ev {

@@ -96,7 +96,7 @@ fn diverging(v: f64) -> RGBColor {
 
 /// Draws `modes` (n × k, k ≤ 4) as panels of the joint pairs' normal gaps (see the module docs)
 /// to `<stem>.png` and `<stem>.svg`.
-pub fn render_joint_modes(
+pub(crate) fn render_joint_modes(
     model: &Model,
     modes: MatRef<'_, f64>,
     stem: &Path,

@@ -37,7 +37,7 @@ fn status_color(s: &RunStatus) -> [u8; 3] {
 }
 
 /// The markdown table of every cell.
-pub fn markdown_table(sweep: &Sweep) -> String {
+pub(crate) fn markdown_table(sweep: &Sweep) -> String {
     let mut s = String::new();
     s.push_str(&format!(
         "# Stability map: {} (rtol {:e}, atol {:e}, window {} s ROM / {} s full, budget {} s/cell)\n\n",
@@ -108,7 +108,7 @@ pub enum MapKind {
 
 /// The heat map of a sweep: rows model × iteration × max order, columns k_n × friction ×
 /// events, in the order of the options; a combination that was not run is blank.
-pub fn heat_map(sweep: &Sweep, kind: MapKind) -> HeatMap {
+pub(crate) fn heat_map(sweep: &Sweep, kind: MapKind) -> HeatMap {
     let o = &sweep.options;
     let mut rows = Vec::new();
     for &m in &o.models {
@@ -305,7 +305,7 @@ pub fn write_outputs(sweep: &Sweep, dir: &Path, charts: bool) -> Result<Vec<Path
 
 /// The JSON document of a sweep (what `stability.json` holds): the options, models,
 /// references and every cell, plus the ‖f_c‖ curves of the references.
-pub fn sweep_json(sweep: &Sweep) -> serde_json::Value {
+pub(crate) fn sweep_json(sweep: &Sweep) -> serde_json::Value {
     let mut v = serde_json::to_value(sweep).unwrap_or(serde_json::Value::Null);
     if let Some(refs) = v.get_mut("references").and_then(|r| r.as_array_mut()) {
         for (j, r) in refs.iter_mut().zip(&sweep.references) {

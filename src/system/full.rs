@@ -25,6 +25,7 @@ use super::{ReducedSystem, SecondOrderSystem};
 use crate::case::LoadSpec;
 use crate::error::Error;
 use crate::joint::JointOperator;
+use crate::linalg::sparse::column_pattern;
 use crate::linalg::{LowRankCholesky, SparseCholesky, SymCsc};
 use crate::model::Model;
 
@@ -95,15 +96,7 @@ impl FullSystem {
                 }
             }
         }
-        let mut col_ptr = Vec::with_capacity(n + 1);
-        col_ptr.push(0);
-        let mut row_idx = Vec::new();
-        for c in &mut cols {
-            c.sort_unstable();
-            c.dedup();
-            row_idx.extend_from_slice(c);
-            col_ptr.push(row_idx.len());
-        }
+        let (col_ptr, row_idx) = column_pattern(n, |c, rows| rows.append(&mut cols[c]));
         let pos = |i: usize, j: usize| -> Result<usize, Error> {
             let col = &row_idx[col_ptr[j]..col_ptr[j + 1]];
             col.binary_search(&i).map(|p| col_ptr[j] + p).map_err(|_| {
@@ -188,11 +181,6 @@ impl FullSystem {
             self.load.clone(),
             phi,
         )
-    }
-
-    /// Number of stored entries (both triangles) of the Newton matrix pattern.
-    pub fn newton_nnz(&self) -> usize {
-        self.newton_values.len()
     }
 }
 

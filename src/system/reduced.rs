@@ -144,7 +144,7 @@ impl ReducedSystem {
     /// `b_phi` = BΦ (3w × r, mm per unit), `master` = (the rows of Φ at the six master DOF,
     /// 6 × r; the error test's scale of each coordinate and the full model's DOF count,
     /// [`ErrorScale`]), `load` the master load and its ramp, `phi` the basis if known (n × r).
-    pub fn from_matrices(
+    pub(crate) fn from_matrices(
         k: Mat<f64>,
         m: Mat<f64>,
         b_phi: Mat<f64>,

@@ -1,4 +1,4 @@
-//! The safe CVODE wrapper (`jointrom::integrate::sundials::Cvode`) against exact solutions: accuracy for
+//! The safe CVODE wrapper (`jointrom::integrate::Cvode`) against exact solutions: accuracy for
 //! every iteration type, Newton iteration counts of the problem's solver vs CVODE's dense one,
 //! stiffness, callback panics and NaN, events, options, statistics and create/drop cycles.
 
@@ -7,7 +7,7 @@ use std::f64::consts::PI;
 use jointrom::integrate::problem::{
     CallbackError, Iteration, Method, NewtonLinear, OdeOptions, OdeProblem, OdeStats, Stop,
 };
-use jointrom::integrate::sundials::Cvode;
+use jointrom::integrate::Cvode;
 use jointrom::Error;
 
 /// ω of the test oscillator, rad/s (100 Hz).

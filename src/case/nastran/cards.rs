@@ -100,7 +100,7 @@ impl Cards {
     }
 
     /// The error at a position: `file:line: what: reason`.
-    pub fn error_at(&self, what: String, at: Position, reason: impl Into<String>) -> Error {
+    pub(crate) fn error_at(&self, what: String, at: Position, reason: impl Into<String>) -> Error {
         Error::Deck {
             file: self.files[at.file].clone(),
             line: at.line,

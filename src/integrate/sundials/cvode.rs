@@ -122,7 +122,7 @@ impl<P> Drop for SharedBox<P> {
 ///
 /// ```
 /// use jointrom::integrate::problem::{CallbackError, OdeOptions, OdeProblem, Stop};
-/// use jointrom::integrate::sundials::Cvode;
+/// use jointrom::integrate::Cvode;
 ///
 /// struct Decay;
 /// impl OdeProblem for Decay {

@@ -15,8 +15,8 @@ use crate::Error;
 pub struct SerialVector {
     raw: NonNull<_generic_N_Vector>,
     len: usize,
-    // Dropped after `Drop::drop` has destroyed the vector.
-    context: Context,
+    // Kept alive (not read): dropped after `Drop::drop` has destroyed the vector.
+    _context: Context,
 }
 
 impl SerialVector {
@@ -38,7 +38,7 @@ impl SerialVector {
         let vector = Self {
             raw,
             len,
-            context: context.clone(),
+            _context: context.clone(),
         };
         // SAFETY: `raw` is a valid serial vector whose ops table N_VNew_Serial allocated for it
         // alone; the replacements compute what the library's do (see `fast_ops`), and CVODE's
@@ -62,11 +62,13 @@ impl SerialVector {
     }
 
     /// Number of entries.
+    #[cfg(test)]
     pub fn len(&self) -> usize {
         self.len
     }
 
     /// Whether the vector has no entries.
+    #[cfg(test)]
     pub fn is_empty(&self) -> bool {
         self.len == 0
     }
@@ -93,11 +95,6 @@ impl SerialVector {
         }
         // SAFETY: as in `as_slice`; `&mut self` makes this the only access to the data.
         unsafe { std::slice::from_raw_parts_mut(data, self.len) }
-    }
-
-    /// The context the vector was created in.
-    pub fn context(&self) -> &Context {
-        &self.context
     }
 
     /// The raw `N_Vector`, valid as long as `self` lives.

@@ -48,8 +48,8 @@
 //! non-symmetric `∂p_t/∂g = −μ k_n n` of sliding pairs (the friction force follows the normal
 //! force), so that the matrix stays symmetric positive definite for a Cholesky factorization:
 //! the solve is exact when no pair slides, otherwise a modified Newton direction that CVODE's
-//! iteration corrects. `z_W = r_W + γ f(t)·b` and `z_D = r_D + γ ∇D'·[a; c]` are exact.
-
+//! iteration corrects. `z_W = r_W + γ f(t)·b` and `z_D = r_D + γ ∇D'·[a; c]` are exact
+//! (`newton`).
 //!
 //! ## Active-set refresh
 //!
@@ -61,56 +61,31 @@
 //! re-factors. With [`ProblemOptions::refresh`] the problem checks each iterate's branches
 //! (one `B q` product and a comparison per pair) and, when a pair has crossed its switch by
 //! more than the margin (gap beyond 0, or `|e| − c` beyond 0 for stick/slip, in mm), re-linearizes
-//! and refactors at once with the current γ: a Newton iteration that follows the active set.
-//! Measured on the 0.2 s runs with friction (steps; wall in s; refreshes in brackets; this
-//! machine's timings vary by ±20 %):
-//!
-//! | scene, model | off | margin 1e-6 mm | **1e-8 mm** | 0 |
-//! |---|---|---|---|---|
-//! | friction bar, full FE | 22 276; 8.2 | 10 804; 5.8 (242) | **8 234; 4.0 (274)** | 7 832; 4.7 (304) |
-//! | friction bar, all joint DOF | 20 014; 0.37 | 9 918; 0.23 | **8 343; 0.20 (399)** | 7 823; 0.18 |
-//! | friction bar, TOL 1e-2 (r = 24) | 19 297; 0.18 | 13 160; 0.14 | **11 289; 0.086 (349)** | 12 772; 0.13 |
-//! | multilayer, full FE | 12 646; 5.8 | 12 660; 5.5 (34) | **10 212; 4.9 (686)** | 11 786; 5.9 (1 683) |
-//! | multilayer, all joint DOF | 13 727; 0.42 | 13 040; 0.50 | **11 938; 0.48 (651)** | 12 104; 0.58 (1 832) |
-//!
-//! Convergence failures drop from 232 → 47 (friction bar, full) and 330 → 44 (all joint DOF);
-//! on the friction bar the step count falls 2.4–2.7×, on the multilayer sheet (whose pairs are
-//! mostly closed, with many gaps hovering at round-off around 0 — margin 0 refactors 1 683 times
-//! for no fewer steps) by ~15 %. The curves move by integration-level amounts (friction bar full
-//! FE against the stored run without refresh: ‖f_c‖ 3.0e-4, u_y 3.8e-5, ‖f_R‖ 6.3e-3 — the stick–slip
-//! history's sensitivity, see `cases/reference/SOURCE.md`). Both the full and the reduced models
-//! use it: the baseline gets faster too.
+//! and refactors at once with the current γ: a Newton iteration that follows the active set
+//! (`refresh`). The margin keeps pairs hovering at round-off around a switch (gaps of a mostly
+//! closed interface) from refactoring for nothing. Both the full and the reduced models use it.
 //!
 //! A refresh re-linearizes the pairs whose branch differs from the stored one (at the
 //! iterate; pairs on the same branch are left as linearized) and first asks the system to
 //! update its factor by their blocks alone at the factored γ
 //! ([`SecondOrderSystem::newton_update`]): the full model does that exactly by a low-rank
 //! (capacitance) correction, without refactoring ([`crate::system::FullSystem`]). If the system
-//! declines (the reduced model, whose dense refactorization is cheap, or a full correction),
-//! every pair is re-linearized and the matrix refactored at the current γ, as before. (Measured
-//! and not kept for the reduced model: rank-≤ 3 Cholesky updates per switched pair at the
-//! factored γ (faer's rank-r update) took the multilayer's TOL 1e-2 ROM from 11 798 to 12 883
-//! steps and 170 to 192 ms, the friction bar's unchanged — its refactorization re-linearizes
-//! every pair at the current γ, a better Newton matrix than the update's.) The pairs
-//! on a branch with a constant tangent (open, stick) are then exactly as a full
-//! re-linearization would leave them; the sliding ones keep the tangent of their last
-//! linearization — on the refined friction bars the step counts stay within their run-to-run
-//! scatter (README, *Full FE reference at scale*).
+//! declines (the reduced model, whose dense refactorization is cheap and re-linearizes every
+//! pair at the current γ, a better Newton matrix than an update at the factored γ, or a full
+//! correction), every pair is re-linearized and the matrix refactored at the current γ, as
+//! before. The pairs on a branch with a constant tangent (open, stick) are then exactly as a
+//! full re-linearization would leave them; the sliding ones keep the tangent of their last
+//! linearization.
 //!
-//! ## What sets the step size (measured, friction bar, 0.2 s with friction, paper tolerances)
+//! ## What sets the step size
 //!
-//! | suspect | how measured | finding |
-//! |---|---|---|
-//! | accuracy of the resolved motion (BDF2) | steps vs model, friction off | Craig–Bampton only 9 881, modes g = 12 13 003, all joint DOF 20 237, full FE 30 835: BDF2 at rtol 1e-8 needs `(2/9)(hω)³ ≲ 1e-8`, h ≈ 7e-6 s for the 87 Hz mode alone — ~10⁴ steps is the floor of order 2 |
-//! | BDF order 3–5 | `--max-order 3…5`, CB only | 250 000–300 000 steps: the undamped constraint modes (axial ~7.6 kHz) sit in BDF3–5's unstable band near the imaginary axis |
-//! | joint-local high frequencies | ROM in its modal coordinates, error test off (atol × 1e6) for the 49 of 68 modes above 2e4 rad/s | 20 162 → 16 502 steps only: the high modes are not what the error test resolves |
-//! | error test over slip / energy states | `CVodeGetEstLocalErrors` × weights at the outputs; their atol × 1e6 | they carry 80–98 % of the sampled WRMS error, yet excluding them saves 12 % (19 749 → 17 395): displacements and velocities bind next |
-//! | Newton convergence failures at pair switches | CVODE's counters; active-set refresh | 232–330 failures per run, each cutting h by 4: the refresh (below) removes ~85 % of them and **60 % of the steps** |
-//! | step-size policy | `CVodeSetEtaFixedStepBounds` (`--step-growth` 1.01–1.3 vs CVODE's 1.5) | friction bar −25 … −35 % steps but erratic (±20 % run to run), multilayer ±5 %: kept at CVODE's default |
-//! | the WRMS norm's length | r = 24 ROM (154 states) vs full (1 918 states) | the mean over fewer, busier components held the ROM ~√(1918/154) = 3.5× tighter than the full model for the same field error; at 3.5× looser rtol/atol the TOL 1e-2 ROM took 5 937 instead of 11 289 steps with the same true errors (‖f_c‖ 5.7e-4 vs 6.3e-4). Now the reduced model's error test is the full model's on the field (next section): 11 289 → 8 163–9 325 steps |
-//! | the joint directions at all (step floor) | the Craig–Bampton base alone (r = 16, no joint coordinate), field error test (below) | friction bar 8 688 steps (friction off) / 9 846 (on), multilayer 10 758 / 12 468; the full model 8 414 / 8 309 and – / 12 391, the TOL 1e-2 ROM – / 8 688 and – / 11 798: every model takes the steps of the Craig–Bampton motion at order 2, so no condensation of joint directions (quasi-static or otherwise) can take a reduced model below them |
-//! | order 3–5 on that base | `--max-order 3`, `5`, Craig–Bampton base alone | friction off 139 950 / 48 721 steps, on 240 086 / 227 885: the undamped high modes of the base itself (constraint modes) forbid orders above 2 — fewer steps than the order-2 floor need the base's own stiff modes out of the integrated state (an index-1 DAE whose algebraic part carries the non-smooth contact law; not built) |
-//! | friction relaxation τ = 1e-6 s | friction off vs on | ≈ the same steps (17 924 vs 19 749): the −1/τ eigenvalues are damped by BDF2 (A-stable) and do not limit h |
+//! Every model takes about the steps of its Craig–Bampton motion at BDF order 2: the accuracy
+//! of the resolved motion sets the floor, so no condensation of joint directions can take a
+//! reduced model below it, and fewer steps would need the base's own stiff modes out of the
+//! integrated state. Orders above 2 are ruled out by the undamped high modes (next sections);
+//! the friction relaxation's −1/τ eigenvalues are damped by BDF2 (A-stable) and do not limit
+//! `h`; Newton convergence failures at pair switches, each cutting `h` by 4, are what the
+//! active-set refresh removes.
 //!
 //! ## The error test of a reduced model
 //!
@@ -138,66 +113,46 @@
 //! `reduced_error_test_is_the_full_models_on_the_field`); jointrom's M-orthonormal columns are
 //! near it.
 //!
-//! Before, a reduced coordinate's tolerance was `atol / max|Φ_j|` and the slip memory's `atol`:
-//! the mean over the reduced model's few states, most of them slip memory, held it ~L ≈ 3.5×
-//! (friction bar, r = 24) tighter than the full model on the same field, and the tolerance-chosen
-//! model took more steps than the full model (11 289 vs 8 234). Measured (`cargo bench --bench
-//! speed`, true errors against the stored full runs unchanged within their scatter): friction
-//! bar TOL 1e-2 ROM 11 289 → 9 325 steps (‖f_c‖ 6.3e-4 → 6.1e-4), TVD g = 12 12 842 → 9 715, all
-//! joint DOF 8 343 → 8 349; multilayer TOL 1e-2 12 478 → 12 153 (‖f_c‖ 5.2e-3 both). Scaling the
-//! coordinates alone and not the slip memory saves nothing (12 806 steps): the slip states bind.
-//! The reduced models now take about the full model's steps (8 309, 12 391): what is left of the
-//! speed-up is the cost per step.
-//!
 //! ## Running
 //!
-//! [`crate::integrate::driver`] drives a [`MechanicalOde`] with [`crate::integrate::sundials::Cvode`]
+//! [`crate::integrate::driver`] drives a [`MechanicalOde`] with [`crate::integrate::Cvode`]
 //! from rest to the scene's end time, sampling [`EnergySample`]s into
 //! [`crate::integrate::Curves`] every `output_step` (1e-4 s by
 //! default). With events on, every located root (a gap or a stick/slip switch changing sign)
 //! re-initialises the integrator (order 1, history discarded); 1000 roots in a row without
 //! progress in time end the run with an error (a chattering switch).
 //!
-//! Measured step counts, Newton iterations and energy balances of these runs are in
-//! `docs/validation/transient.md` (section `integrate::mechanical`).
-//!
 //! ## Step size of the full model: defaults
 //!
-//! The full FE model (friction bar, 906 DOF) took ~1e5 steps of ~1e-8 s per millisecond with
-//! CVODE's defaults (the measured table of max order × velocity tolerance × friction is in
-//! `docs/validation/transient.md`).
-//!
-//! Two causes, both legitimately removable:
+//! Two causes of tiny steps of the full FE model under CVODE's defaults, both legitimately
+//! removable:
 //!
 //! 1. **BDF orders 3–5 on an undamped structure.** The FE model has modes up to ~10⁶–10⁷ rad/s
 //!    (shell membrane/drilling, the penalty springs on nodal masses of ~1e-7 t) that the motion
 //!    does not excite. BDF3–5 are not A-stable: their stability regions miss a sector around the
 //!    imaginary axis, and on an undamped mode `hω` must stay small or the mode grows; CVODE's error
-//!    test then keeps `h` near 1e-8 s while the order climbs (15 081 steps, and 307 986 when a
-//!    looser velocity tolerance lets it climb further). Stability-limit detection
-//!    (`CVodeSetStabLimDet`) does not cure it (22 937). BDF2 is A-stable and damps the unresolved
+//!    test then keeps `h` near 1e-8 s while the order climbs. Stability-limit detection
+//!    (`CVodeSetStabLimDet`) does not cure it. BDF2 is A-stable and damps the unresolved
 //!    modes numerically (the ROM has none of them: its highest mode is the truncation's):
-//!    **max order 2** ([`DEFAULT_MAX_ORDER`]), 10× fewer steps. With friction on the order never
-//!    rose above 2 anyway (the −1/τ eigenvalues of open and sliding pairs).
+//!    **max order 2** ([`DEFAULT_MAX_ORDER`]). With friction on the order never rises above 2
+//!    anyway (the −1/τ eigenvalues of open and sliding pairs).
 //! 2. **The velocity tolerance.** With one number for both (vs = 1 1/s, velocity atol 1e-6 mm/s)
-//!    every mode above 0.16 Hz is held to atol/ω in displacement — 1e-12 mm for a 10⁶ rad/s mode
-//!    — and even BDF2 needs 25 000 steps. vs = ω_ref makes the displacement tolerance rule modes
-//!    below ω_ref and the velocity tolerance modes above it (see [`DEFAULT_VELOCITY_SCALE`]):
-//!    **vs = 1e3 1/s** (ω_ref ≈ 160 Hz, between the friction bar's first two fixed-interface
-//!    modes, 87 and 217 Hz); 1e4 saves nothing more (more Newton failures).
+//!    every mode above 0.16 Hz is held to atol/ω in displacement — 1e-12 mm for a 10⁶ rad/s mode.
+//!    vs = ω_ref makes the displacement tolerance rule modes below ω_ref and the velocity
+//!    tolerance modes above it (see [`DEFAULT_VELOCITY_SCALE`]): **vs = 1e3 1/s** (ω_ref ≈ 160 Hz,
+//!    between the friction bar's first two fixed-interface modes, 87 and 217 Hz).
 //!
-//! Newton is not the bottleneck: 1.1–1.6 iterations per step, and the convergence failures
-//! (contact pairs opening/closing within a step) cost ~10 % of the steps. With these defaults the
-//! full friction bar runs 0.2 s in 28 000–38 000 steps (~20 s CPU) and the TVD ROM (r = 28) in
-//! 7 000–11 000 steps; the same settings apply to both (tolerances in mm of the physical field,
-//! [`OdeProblem::atol_scale`]). Accuracy: see `cases/reference/SOURCE.md` (default vs 100×
-//! tighter tolerances).
+//! The same settings apply to the full and the reduced models (tolerances in mm of the physical
+//! field, [`OdeProblem::atol_scale`]).
 
 use crate::case::ContactSpec;
 use crate::error::Error;
 use crate::integrate::problem::{CallbackError, OdeProblem};
 use crate::joint::law::{evaluate_pairs, PairLaw, PairState, DEFAULT_TAU};
 use crate::system::SecondOrderSystem;
+
+mod newton;
+mod refresh;
 
 /// Default [`ProblemOptions::velocity_scale`], 1/s: velocities are held to `atol · ω_ref` with
 /// ω_ref = 1e3 rad/s (160 Hz, between the friction bar's 1st and 2nd fixed-interface modes,
@@ -519,7 +474,7 @@ impl<S: SecondOrderSystem> MechanicalOde<S> {
 
     /// The slip memory `s` (2w with friction, else empty; mm) of the last
     /// [`MechanicalOde::sample`].
-    pub fn slip_memory(&self) -> &[f64] {
+    pub(crate) fn slip_memory(&self) -> &[f64] {
         &self.s_phys
     }
 
@@ -529,7 +484,7 @@ impl<S: SecondOrderSystem> MechanicalOde<S> {
     }
 
     /// The initial state: at rest, undeformed, no slip, no work.
-    pub fn initial_state(&self) -> Vec<f64> {
+    pub(crate) fn initial_state(&self) -> Vec<f64> {
         vec![0.0; self.dim()]
     }
 
@@ -608,186 +563,6 @@ impl EnergySample {
 
 fn dot(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
-}
-
-fn mul2(a: &[[f64; 2]; 2], x: [f64; 2]) -> [f64; 2] {
-    [
-        a[0][0] * x[0] + a[0][1] * x[1],
-        a[1][0] * x[0] + a[1][1] * x[1],
-    ]
-}
-
-fn matmul2(a: &[[f64; 2]; 2], b: &[[f64; 2]; 2]) -> [[f64; 2]; 2] {
-    let mut c = [[0.0; 2]; 2];
-    for i in 0..2 {
-        for j in 0..2 {
-            c[i][j] = a[i][0] * b[0][j] + a[i][1] * b[1][j];
-        }
-    }
-    c
-}
-
-impl<S: SecondOrderSystem> MechanicalOde<S> {
-    /// The pair tangents at the kinematics in `u` and the slip memory in `s_phys` (loaded by
-    /// the caller), with each pair's branch.
-    fn linearize(&mut self) {
-        let mut slipping = 0;
-        for k in 0..self.w {
-            let state = self.linearize_pair(k);
-            if self.law.friction && state == PairState::Slip {
-                slipping += 1;
-            }
-            self.branch[k] = state;
-        }
-        self.slipping_at_setup = slipping;
-        self.have_lin = true;
-    }
-
-    /// Active-set refresh: if a pair's branch at the iterate `y` differs from the one of the
-    /// stored linearization, re-linearizes there and refactors with `gamma`.
-    fn refresh_if_switched(
-        &mut self,
-        y: &[f64],
-        gamma: f64,
-        margin: f64,
-    ) -> Result<(), CallbackError> {
-        let slip_margin = margin * self.s_scale;
-        let (n, ns) = (self.n, self.ns());
-        if y[..n] == self.rhs_q[..] && y[2 * n..2 * n + ns] == self.rhs_s[..] {
-            self.u.copy_from_slice(&self.rhs_u);
-        } else {
-            self.sys.joint_apply_into(&y[..n], &mut self.u);
-        }
-        self.load_slip(y);
-        // The pairs on another branch than linearized (`changed`); a refresh when one of them
-        // is past its switch by more than the margin.
-        self.changed.clear();
-        let mut switched = false;
-        for k in 0..self.w {
-            let (uk, sk) = self.pair_kinematics(k);
-            let (now, then) = (self.law.state(uk, sk), self.branch[k]);
-            if now == then {
-                continue;
-            }
-            self.changed.push(k);
-            switched |= if (now == PairState::Open) != (then == PairState::Open) {
-                uk[0].abs() > margin
-            } else {
-                self.law.cone_distance(uk, sk).abs() > slip_margin
-            };
-        }
-        if !switched {
-            return Ok(());
-        }
-        self.refreshes += 1;
-        self.refresh_pairs += self.changed.len() as u64;
-        if self.update_changed() {
-            self.low_rank_refreshes += 1;
-            return Ok(());
-        }
-        self.linearize();
-        self.apply_gamma(gamma);
-        self.sys
-            .newton_factor(gamma, &self.kc)
-            .map_err(|e| CallbackError::Recoverable(e.to_string()))
-    }
-
-    /// Pair k's kinematics `[g, u_t1, u_t2]` in `u` and slip memory in `s_phys` (zero with
-    /// friction off), mm.
-    /// Pair k's tangent at its kinematics into `lin[k]` (γ-dependent parts left to
-    /// [`MechanicalOde::apply_gamma_pair`]); returns its branch there.
-    fn linearize_pair(&mut self, k: usize) -> PairState {
-        let (uk, sk) = self.pair_kinematics(k);
-        let tg = self.law.tangent(uk, sk);
-        self.lin[k] = PairLin {
-            sdot_u: tg.sdot_u,
-            sdot_g: tg.sdot_g,
-            pt_u: tg.pt_u,
-            pn_g: tg.pn_g,
-            diss_u: tg.diss_u,
-            diss_g: tg.diss_g,
-            ..PairLin::default()
-        };
-        self.law.state(uk, sk)
-    }
-
-    fn pair_kinematics(&self, k: usize) -> ([f64; 3], [f64; 2]) {
-        let uk = [self.u[3 * k], self.u[3 * k + 1], self.u[3 * k + 2]];
-        let sk = if self.law.friction {
-            [self.s_phys[2 * k], self.s_phys[2 * k + 1]]
-        } else {
-            [0.0; 2]
-        };
-        (uk, sk)
-    }
-
-    /// Re-linearizes the pairs in `changed` (those on another branch than linearized) at `u`,
-    /// `s_phys` and the factored γ, and asks the system to change its factor by their blocks
-    /// alone ([`SecondOrderSystem::newton_update`]). `false` if it did not: the caller then
-    /// re-linearizes every pair and refactors at the current γ. The other pairs keep their
-    /// linearization; the ones on a branch whose tangent is constant (open, stick) are then
-    /// exactly as a full re-linearization would make them, the sliding ones as at the last
-    /// linearization (as between setups).
-    fn update_changed(&mut self) -> bool {
-        for i in 0..self.changed.len() {
-            let k = self.changed[i];
-            let state = self.linearize_pair(k);
-            let friction = self.law.friction;
-            let slip = |s: PairState| usize::from(friction && s == PairState::Slip);
-            self.slipping_at_setup = self.slipping_at_setup + slip(state) - slip(self.branch[k]);
-            self.branch[k] = state;
-            self.apply_gamma_pair(k, self.lin_gamma);
-        }
-        self.sys.newton_update(&self.kc, &self.changed)
-    }
-
-    /// Active-set refreshes so far ([`ProblemOptions::refresh`]).
-    pub fn refreshes(&self) -> u64 {
-        self.refreshes
-    }
-
-    /// Of the [`MechanicalOde::refreshes`], those done by a low-rank update of the factor
-    /// ([`SecondOrderSystem::newton_update`]) instead of a refactorization.
-    pub fn low_rank_refreshes(&self) -> u64 {
-        self.low_rank_refreshes
-    }
-
-    /// Pairs that had switched branch at a refresh, summed over the refreshes.
-    pub fn refresh_pairs(&self) -> u64 {
-        self.refresh_pairs
-    }
-
-    /// Builds K_c and the per-pair data for γ from the stored linearization.
-    fn apply_gamma(&mut self, gamma: f64) {
-        for k in 0..self.w {
-            self.apply_gamma_pair(k, gamma);
-        }
-        self.lin_gamma = gamma;
-    }
-
-    /// [`MechanicalOde::apply_gamma`] of pair k.
-    fn apply_gamma_pair(&mut self, k: usize, gamma: f64) {
-        let l = &mut self.lin[k];
-        let a = [
-            [1.0 + gamma * l.sdot_u[0][0], gamma * l.sdot_u[0][1]],
-            [gamma * l.sdot_u[1][0], 1.0 + gamma * l.sdot_u[1][1]],
-        ];
-        let det = a[0][0] * a[1][1] - a[0][1] * a[1][0];
-        l.inv = [
-            [a[1][1] / det, -a[0][1] / det],
-            [-a[1][0] / det, a[0][0] / det],
-        ];
-        let te = matmul2(&l.pt_u, &l.inv);
-        let off = 0.5 * (te[0][1] + te[1][0]);
-        l.t_eff = [[te[0][0], off], [off, te[1][1]]];
-        let b = &mut self.kc[9 * k..9 * k + 9];
-        b.fill(0.0);
-        b[0] = l.pn_g;
-        b[4] = l.t_eff[0][0];
-        b[5] = l.t_eff[0][1];
-        b[7] = l.t_eff[1][0];
-        b[8] = l.t_eff[1][1];
-    }
 }
 
 impl<S: SecondOrderSystem> OdeProblem for MechanicalOde<S> {
@@ -896,18 +671,7 @@ impl<S: SecondOrderSystem> OdeProblem for MechanicalOde<S> {
         jok: bool,
         gamma: f64,
     ) -> Result<bool, CallbackError> {
-        let n = self.n;
-        let jcur = !(jok && self.have_lin);
-        if jcur {
-            self.sys.joint_apply_into(&y[..n], &mut self.u);
-            self.load_slip(y);
-            self.linearize();
-        }
-        self.apply_gamma(gamma);
-        self.sys
-            .newton_factor(gamma, &self.kc)
-            .map_err(|e| CallbackError::Recoverable(e.to_string()))?;
-        Ok(jcur)
+        self.setup_newton(y, jok, gamma)
     }
 
     fn newton_solve(
@@ -918,74 +682,6 @@ impl<S: SecondOrderSystem> OdeProblem for MechanicalOde<S> {
         z: &mut [f64],
         gamma: f64,
     ) -> Result<(), CallbackError> {
-        if !self.have_lin {
-            return Err(CallbackError::Fatal(
-                "newton_solve called before newton_setup".into(),
-            ));
-        }
-        if let Some(margin) = self.refresh {
-            self.refresh_if_switched(y, gamma, margin)?;
-        }
-        // CVODE re-runs the setup only when γ has changed by more than ~30 %; between setups
-        // the current γ is used in the elimination (so `a − γ b = r_q` holds exactly) with the
-        // factorization and `(I + γ D_s)⁻¹` of the setup's γ.
-        let g = gamma;
-        let n = self.n;
-        let ns = self.ns();
-        let fr = self.law.friction;
-        let (rq, rest) = r.split_at(n);
-        let (rv, rest) = rest.split_at(n);
-        let (rs, rest) = rest.split_at(ns);
-        // Residuals and corrections of s, W, D in physical units (mm, N·mm) inside.
-        let ss = self.s_scale;
-        // rhs_a = M (r_q + γ r_v) + γ² Bᵀ [0; T_eff r_s]
-        for ((o, a), b) in self.tmp2.iter_mut().zip(rq).zip(rv) {
-            *o = a + g * b;
-        }
-        self.sys.mul_m_into(&self.tmp2, &mut self.tmp);
-        if fr {
-            for k in 0..self.w {
-                let l = &self.lin[k];
-                let x = mul2(&l.inv, [ss * rs[2 * k], ss * rs[2 * k + 1]]);
-                let h = mul2(&l.pt_u, x);
-                self.p[3 * k] = 0.0;
-                self.p[3 * k + 1] = g * g * h[0];
-                self.p[3 * k + 2] = g * g * h[1];
-            }
-            self.sys.joint_transpose_add(&self.p, &mut self.tmp);
-        }
-        let (za, zrest) = z.split_at_mut(n);
-        za.copy_from_slice(&self.tmp);
-        self.sys.newton_solve_in_place(za);
-        let (zb, zrest) = zrest.split_at_mut(n);
-        for ((b, a), q) in zb.iter_mut().zip(za.iter()).zip(rq) {
-            *b = (a - q) / g;
-        }
-        let (zs, ze) = zrest.split_at_mut(ns);
-        let mut zd = self.e_scale * rest[1];
-        if fr {
-            self.sys.joint_apply_into(za, &mut self.u);
-            for k in 0..self.w {
-                let l = &self.lin[k];
-                let ba = [self.u[3 * k], self.u[3 * k + 1], self.u[3 * k + 2]];
-                let du = mul2(&l.sdot_u, [ba[1], ba[2]]);
-                let rhs = [
-                    ss * rs[2 * k] + g * (du[0] + l.sdot_g[0] * ba[0]),
-                    ss * rs[2 * k + 1] + g * (du[1] + l.sdot_g[1] * ba[0]),
-                ];
-                let c = mul2(&l.inv, rhs);
-                zs[2 * k] = c[0] / ss;
-                zs[2 * k + 1] = c[1] / ss;
-                zd += g
-                    * (l.diss_u[0] * (ba[1] - c[0])
-                        + l.diss_u[1] * (ba[2] - c[1])
-                        + l.diss_g * ba[0]);
-            }
-        }
-        self.total_load_into_f(t);
-        ze[0] = rest[0] + g * dot(&self.f, zb) / self.e_scale;
-        ze[1] = zd / self.e_scale;
-        // Checked by the CVODE trampoline, as the right-hand side.
-        Ok(())
+        self.solve_newton(t, y, r, z, gamma)
     }
 }
