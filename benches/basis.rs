@@ -1,4 +1,4 @@
-//! Basis benchmarks (issue 3): the whole TVD basis of each built-in case
+//! Basis benchmarks: the whole TVD basis of each built-in case
 //! (`build_basis(.., BasisKind::Tvd, ..)`: 16 Craig–Bampton vectors → 512 TVD → K-weighted POD →
 //! M-orthonormal Φ) and its pieces separately. Target: ≤ 50 ms for the friction bar.
 

@@ -1,5 +1,5 @@
 //! Foundation benchmarks: assembly (case → mesh → K, M) and the 30 lowest fixed-interface
-//! modes, for both built-in cases. Target (issue 2): ≤ 50 ms for the friction bar.
+//! modes, for both built-in cases. Target: ≤ 50 ms for the friction bar.
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use jointrom::case::Case;

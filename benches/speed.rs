@@ -1,4 +1,4 @@
-//! Speed of the reduced models against the full FE model (issue 15), with where each run's time
+//! Speed of the reduced models against the full FE model, with where each run's time
 //! goes: `cargo bench --bench speed`.
 //!
 //! Per built-in scene (friction on, the paper's tolerances, the case's window), all in this
@@ -11,7 +11,7 @@
 //! relative L2 errors of ‖f_c‖(t), ‖f_R‖(t), u_y(t) against the stored full reference
 //! (`cases/reference/<scene>_full_friction_on.json`, made without refresh). Criterion then
 //! times the tolerance-chosen model's run over 0.02 s (10 samples).
-//! Measured figures: README, "Speed of the accurate reduced model".
+//! Measured figures: docs/performance/speed.md.
 
 use std::time::Duration;
 

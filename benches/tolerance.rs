@@ -1,4 +1,4 @@
-//! Error-controlled reduction benchmarks (issue 14): the tolerance-chosen model
+//! Error-controlled reduction benchmarks: the tolerance-chosen model
 //! (`jointrom::rom::tolerance`, TOL = 1e-2) against the full FE run, with friction, at the
 //! paper's tolerances, on both built-in scenes.
 //!
@@ -9,7 +9,7 @@
 //! issue's target is offline + online ≤ 10 % of the full run — and the whole with the result's
 //! own estimate (its quasi-static correction and the wait for the integration check, which runs
 //! beside it). Criterion then times the whole tolerance build and run over a 0.02 s window with
-//! 10 samples. Measured figures: README, "Error-controlled reduction".
+//! 10 samples. Measured figures: docs/performance/tolerance-cost.md.
 
 use std::time::Duration;
 

@@ -1,4 +1,4 @@
-//! Transient benchmarks (issue 4): the friction bar with friction, at the paper's Table 1
+//! Transient benchmarks: the friction bar with friction, at the paper's Table 1
 //! tolerances (rtol 1e-8, atol 1e-6 mm) with the transient defaults (BDF max order 2, velocity
 //! atol 1e3 1/s × atol, events off, see `jointrom::integrate::mechanical`):
 //!
@@ -11,7 +11,7 @@
 //! would take hours; the printout extrapolates. Override with `JOINTROM_BENCH_ROM_END`,
 //! `JOINTROM_BENCH_FULL_END`, `JOINTROM_BENCH_FULL_FUNCTIONAL_END`. Criterion then times a shorter
 //! window (ROM 0.02 s, full 1e-4 s) with 10 samples. Target for the ROM with friction: ≤ 0.3 s
-//! wall for 0.2 s. Measured figures: README, "Transient runs".
+//! wall for 0.2 s. Measured figures: docs/validation/transient.md.
 
 use std::time::Duration;
 

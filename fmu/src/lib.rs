@@ -21,8 +21,7 @@
 //! jointrom's Rust code (faer, serde, ...) is linked in statically; SUNDIALS is linked
 //! dynamically, as in the `jointrom` executable (`sundials-sys` links Debian's
 //! `libsundials_cvode.so.6`, `libsundials_nvecserial.so.6`, ...; package `libsundials-dev`, or
-//! its runtime packages). `ldd` on the binary lists them (README, *The reduced model as an
-//! FMU*).
+//! its runtime packages). `ldd` on the binary lists them (docs/guide/fmu.md).
 
 #![deny(unsafe_code)]
 

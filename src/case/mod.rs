@@ -216,7 +216,7 @@ pub enum LocalMesh {
 
 impl LocalMesh {
     /// The automatic shell size as a fraction of the nugget diameter: 1/16 (0.3125 mm for a
-    /// 5 mm nugget; README, *Spot welds as area connections*).
+    /// 5 mm nugget; docs/validation/welds.md).
     pub const AUTO_SIZE_PER_DIAMETER: f64 = 1.0 / 16.0;
 
     /// A sheet side longer than this fraction of d leaves the nugget unresolved, so `"auto"`

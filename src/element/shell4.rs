@@ -37,11 +37,10 @@
 //! `[γ_xz, γ_yz] = J⁻¹ [γ_r, γ_s]`, `D_s = κ G t` with κ = 5/6. Thin (φ → 0): the
 //! Kirchhoff constraint on every edge, the DKQ element (the edge's deflection is the Hermite
 //! cubic of its nodal w and β_s); thick (φ ≫ 1): Δβ → 0 and MITC4. Rigid motions and constant
-//! curvatures give Δβ_k = 0 (patch test). Measured against MITC4 (the bending part until
-//! 2026-11-26) on the paper's 5 × 12.5 mm shells: a clamped 40 × 25 mm plate's modes change
-//! 0.05–2.9 % from ×2 to ×4 (MITC4 0.7–4.2 %); the friction bar's modes and the multilayer's
-//! converge to < 0.4 % from ×2 to ×4 with the weld neighbourhoods' sides in the same form
-//! (`super::weld_patch`; README, *Spot welds as area connections*).
+//! curvatures give Δβ_k = 0 (patch test). Why DKMQ rather than MITC4's bending: on the paper's
+//! coarse 5 × 12.5 mm shells it converges faster under refinement, and the weld
+//! neighbourhoods' sides use the same edge field (`super::weld_patch`), so sheets and welds
+//! converge together (measured: docs/validation/welds.md).
 //!
 //! **Drilling** — the rotation θ3 about the normal has no stiffness of its own in shell theory;
 //! a small penalty ties it to the in-plane rotation of the membrane field (Hughes & Brezzi):

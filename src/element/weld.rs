@@ -40,7 +40,7 @@
 //! slope across the disc, the rotations carry the nodes' own bending rotations. Measured on the
 //! friction bar against a converged solid model (20-node bricks, `scripts/solid_reference.py`),
 //! translations only were 2–10 % stiff on the default mesh, translations and rotations within
-//! 4 % (README, *Spot welds*).
+//! 4 % (docs/validation/welds.md).
 //!
 //! An edge weld (centre on a free edge, as on the multilayer sheet) keeps the part of the disc
 //! inside the sheets; the fit is the same, about the weld centre, over the half disc.
@@ -64,7 +64,7 @@
 //! (+7 % on the first mode, +26 % on the tenth at the default mesh). The RBE3 + beam weld does
 //! not lock; what it leaves out is the fused disc's composite stiffness, which makes its
 //! converged limit 1–5 % softer than the solid in the modes where the sheets move against each
-//! other (README, *Spot welds*). With a re-meshed neighbourhood (a weld's `local_mesh`,
+//! other (docs/validation/welds.md). With a re-meshed neighbourhood (a weld's `local_mesh`,
 //! [`super::weld_patch`]) the slab no longer locks, and that is the model used there — by
 //! default (`"auto"`) wherever the sheets' shells do not resolve the nugget; this module's RBE3
 //! + beam weld is what `"off"`, a NASTRAN CWELD and sheets fine enough for the nugget get.

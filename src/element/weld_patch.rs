@@ -7,7 +7,7 @@
 //! The area weld (`super::weld`) converges under uniform refinement, but only once the shells
 //! around the nugget are about 0.6 mm or smaller: on the friction bar the ratio of consecutive
 //! changes of the frequencies is ≈ 2 up to 8× the paper's mesh (pre-asymptotic) and 3.6–4.1
-//! from 8× to 16× (README, *Spot welds as area connections*). On the paper's mesh (5 × 12.5 mm
+//! from 8× to 16× (docs/validation/welds.md). On the paper's mesh (5 × 12.5 mm
 //! shells around a 5 mm nugget) the local field of the sheets around the nugget is not
 //! resolved. Refining the whole structured sheet for it multiplies the DOF by ~10–40; this
 //! module resolves only the neighbourhood and keeps the sheets' DOF.
@@ -45,7 +45,7 @@
 //! shells bonds whole shells), and the RBE3 + beam weld of `super::weld` converges to a limit
 //! 4–5 % soft in f7–f10 (it ties only the disc's mean rigid motion, not the fused disc's
 //! composite bending); on the re-meshed neighbourhood the slab neither locks nor leaves that
-//! out (README, *Spot welds as area connections*).
+//! out (docs/validation/welds.md).
 //!
 //! # Condensation
 //!
@@ -98,10 +98,10 @@ enum Role {
 ///
 /// — the Hermite cubic of the edge's end values when thin. The side's other DOF (in-plane
 /// translations, the rotation about the side's normal in-plane direction, the drilling
-/// rotation) are linear, as the shells' membrane and bending fields along an edge. Measured
-/// (2026-11-26): with linear sides the patch's sides were the stiff part of the ×1 and ×2
-/// models (friction bar f10 +4.7 % / +1.6 % from the solid, the neighbourhood's extent moved
-/// it); with these sides −2.1 % / −0.9 %, and ×2 → ×4 changes ≤ 0.2 % (README).
+/// rotation) are linear, as the shells' membrane and bending fields along an edge. Why: sides
+/// that are linear in everything are stiffer than the shells they join, and on coarse sheets
+/// that stiffness dominates the weld (the measured comparison of both side forms against a
+/// converged solid is in docs/validation/welds.md).
 #[derive(Clone, Copy, Debug)]
 struct Side {
     /// Along global x (else z).

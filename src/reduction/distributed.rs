@@ -1,4 +1,4 @@
-//! The distributed offline stage (issue 18, first piece; design in `docs/distributed.md`): the
+//! The distributed offline stage (design in `docs/distributed.md`): the
 //! Craig–Bampton eigen solve and the TVD's multi-right-hand-side solve handed to PETSc/SLEPc
 //! (+ MUMPS) over MPI, and the results compared with the native path.
 //!

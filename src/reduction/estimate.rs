@@ -103,7 +103,7 @@
 //! neglects the inertia of the correction's pair directions (quasi-static: their frequencies lie
 //! far above the load's), the back-coupling of the error into the reduced coordinates, and takes
 //! the slip memory from the reduced run — so ‖f_R‖ and the master u_y are estimated less well
-//! than ‖f_c‖ (measured effectivities in the README). The per-pair differences
+//! than ‖f_c‖ (measured effectivities in docs/validation/error-control.md). The per-pair differences
 //! `Σ_t (p_{n,k} − p_{n,k}*)²` say which pairs' attachment modes `K⁻¹ b_kᵀ` the basis needs
 //! ([`Estimate::pair_error`]); `crate::rom::tolerance` enriches the basis with them (and ν)
 //! until the estimate meets a tolerance, and adds the integration error of the run.

@@ -201,7 +201,7 @@ impl Tvd {
 /// own size: `max|δu| ≲ c ε s_j` for the constraint modes (backward-stable solve with K), the
 /// eigen-solver's residual for the modes. So round-off in a gap is a fraction of s_j, whatever
 /// the gaps are, and `tol · s_j` is a round-off bound for every vector. Relative to the largest
-/// gap instead (the rule before issue 14), a vector that opens no gap compares round-off with
+/// gap instead (an earlier rule), a vector that opens no gap compares round-off with
 /// round-off: its active sets were the signs of round-off, and multiplying the multilayer
 /// sheet's K and M entrywise by `1 ± 1e-15` moved its reduced `‖f_c‖` by 2.5e-2 … 1.1e-1
 /// (`tests/reduction/roundoff.rs`). Translations only:
@@ -211,7 +211,7 @@ impl Tvd {
 /// # Why `tol = 1e-8`
 /// Measured on the built-in cases (Craig–Bampton, ν = 10; `tests/reduction/reduction.rs`,
 /// `tvd_zero_gap_rule_counts`): with the welds' re-meshed neighbourhoods (the default since
-/// issue 13) the round-off gaps are ≤ 5.7e-10 s_j (friction bar: its centre-line pairs under the
+/// the default weld model) the round-off gaps are ≤ 5.7e-10 s_j (friction bar: its centre-line pairs under the
 /// vectors antisymmetric in z — the condensed neighbourhoods carry the round-off of their
 /// 60 k-DOF solve; multilayer ≤ 5.5e-11 s_j, every gap of its in-plane constraint modes ux, uz,
 /// ry), the physical ones ≥ 3.4e-5 s_j (friction bar) and ≥ 5.8e-6 s_j (multilayer), and no gap

@@ -1,4 +1,4 @@
-//! The stability map of issue 4: where the integrator's methods fail on the jointed structures.
+//! The stability map: where the integrator's methods fail on the jointed structures.
 //!
 //! ## The sweep
 //!

@@ -30,7 +30,7 @@ use crate::linalg::{LowRankCholesky, SparseCholesky, SymCsc};
 use crate::model::Model;
 
 /// Default capacity of the low-rank correction of the Newton factor, columns (module docs):
-/// measured on the refined friction bars, see `README.md`, *Full FE reference at scale*.
+/// measured on the refined friction bars, see docs/performance/scale.md.
 pub const DEFAULT_LOW_RANK_COLUMNS: usize = 96;
 
 /// No column of the low-rank correction.

@@ -87,7 +87,7 @@ pub fn model(name: &str) -> Model {
 }
 
 /// The built-in model `name` with every weld a point weld (`"model": "point"`): the model before
-/// issue 13, kept where a test needs a behaviour measured on it (an active-set cycle).
+/// the RBE3 weld, kept where a test needs a behaviour measured on it (an active-set cycle).
 #[allow(dead_code)]
 pub fn point_weld_model(name: &str) -> Model {
     let mut case = builtin_case(name);

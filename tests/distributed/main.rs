@@ -1,4 +1,4 @@
-//! The distributed path (issue 18; `docs/distributed.md`): `jointrom distributed` runs the
+//! The distributed path (`docs/distributed.md`): `jointrom distributed` runs the
 //! Craig–Bampton eigen solve and the TVD multi-right-hand-side solve on PETSc/SLEPc (+ MUMPS)
 //! under `mpirun -n 1` and `-n 2` and must reproduce the native path.
 //!

@@ -1,9 +1,9 @@
-//! Smoke fuzzing of every parser on stable Rust (issue 16), run by `cargo test`: a seeded,
+//! Smoke fuzzing of every parser on stable Rust, run by `cargo test`: a seeded,
 //! structure-aware mutator derives thousands of inputs from valid seeds — the built-in case
 //! files, a small model's exported K.mtx/M.mtx/model.json, an exported reduced model, a sweep's
 //! variants — and each parser must answer every one with `Ok` or an error, never a panic, and
 //! within a time bound. The coverage-guided fuzzing with libFuzzer (`fuzz/`, `scripts/fuzz.sh`)
-//! runs the same parsers for longer; its figures are in the README.
+//! runs the same parsers for longer; its figures are in docs/validation/hostile-input.md.
 //!
 //! `JOINTROM_FUZZ_CASES=N` changes the number of inputs per parser (default 4000).
 

@@ -1,10 +1,10 @@
-//! Hostile and careless input (issue 16): a corpus of bad case files, matrix maps and
+//! Hostile and careless input: a corpus of bad case files, matrix maps and
 //! MatrixMarket files, reduced-model files, sweep variants, flags and output paths, each run
 //! through the `jointrom` binary. Every entry must end the way the corpus says — a clear error
 //! (non-zero exit, a message naming the file, field, line or flag), a warning on a run that
 //! finishes, or a contained success — and never in a panic, a signal, a hang or a silent exit 0.
 //!
-//! The README's table of bad-input classes is printed from this corpus:
+//! The table of bad-input classes (docs/validation/hostile-input.md) is printed from this corpus:
 //! `cargo test --release --test hostile -- --ignored --nocapture print_table`.
 
 #[path = "../common/mod.rs"]
@@ -39,10 +39,10 @@ fn corpus_ids_are_unique() {
     assert_eq!(ids.len(), n, "duplicate corpus ids");
 }
 
-/// Prints the README's table: input kind, bad input, and the answer jointrom gives (the line of
+/// Prints the bad-input table (docs/validation/hostile-input.md): input kind, bad input, and the answer jointrom gives (the line of
 /// its message that the corpus checks).
 #[test]
-#[ignore = "prints the README table"]
+#[ignore = "prints the table of docs/validation/hostile-input.md"]
 fn print_table() {
     let cases = corpus();
     let (failures, answers) = runner::run_all(&cases);
@@ -68,7 +68,7 @@ fn print_table() {
     }
 }
 
-/// Two runs writing into one folder at the same time (issue 16: 14 of 30 rounds left files that
+/// Two runs writing into one folder at the same time (without the journal 14 of 30 rounds left files that
 /// did not load): with atomic writes every round leaves whole files — the reduced model and the
 /// exported matrices load, whichever run renamed last.
 #[test]

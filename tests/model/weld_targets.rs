@@ -7,8 +7,8 @@ use jointrom::{Interface, Model};
 
 use crate::common;
 
-/// The friction bar as a converged 3-D solid (20-node bricks, extrapolated; README, *Spot welds
-/// as area connections*): `python3 scripts/solid_reference.py --case friction_bar --refine
+/// The friction bar as a converged 3-D solid (20-node bricks, extrapolated;
+/// docs/validation/welds.md): `python3 scripts/solid_reference.py --case friction_bar --refine
 /// 1,2,3,4 --grade 8 --out solid.json`. Fixed-interface frequencies (Hz).
 const SOLID_HZ: [f64; 10] = [
     90.53, 225.22, 305.27, 624.00, 824.15, 846.22, 890.72, 1082.37, 1301.14, 1336.10,

@@ -1,4 +1,4 @@
-//! Round-off independence of the TVD basis (issue 14): perturbing the model's K and M at the
+//! Round-off independence of the TVD basis: perturbing the model's K and M at the
 //! level of their last digits must leave the active sets, the kept TVD columns, w(g), the
 //! a-priori g and the reduced contact statics where they were.
 
@@ -203,7 +203,7 @@ fn measure(name: &str, gs: &[usize]) -> Moved {
 /// the same a-priori g, w(g) and the reduced contact statics to the round-off of the base.
 ///
 /// The multilayer sheet's in-plane constraint modes (ux, uz, ry) open no gap: their gaps are
-/// round-off, ≤ 1e-13 of their displacement. Judged against the largest gap (before issue 14),
+/// round-off, ≤ 1e-13 of their displacement. Judged against the largest gap (a rule not kept),
 /// their active sets were signs of round-off, and this perturbation flipped 35, 63 and 64 of
 /// their 86 pairs (and one round-off pair of uy), moved the a-priori g from 21 to 20, w(g) by
 /// 2.4e-2 and the reduced ‖f_c‖ by 2.5e-2, 2.9e-3 and 1.1e-1 at g = 12, 20, 40.

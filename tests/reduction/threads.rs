@@ -1,4 +1,4 @@
-//! Bit-identical results for any number of threads (issue 16): the exported reduced models,
+//! Bit-identical results for any number of threads: the exported reduced models,
 //! the tolerance-chosen model and the transient curves of both built-in scenes, run with
 //! `RAYON_NUM_THREADS=1` and `=2`.
 

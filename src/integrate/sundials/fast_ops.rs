@@ -8,7 +8,7 @@
 //! These replacements do the **same IEEE operations in the same order** as
 //! `nvector_serial.c` of SUNDIALS 6.4 (sequential sums, `prod = x·w; sum += prod·prod`), so
 //! results are bit-for-bit those of the library; only the speed changes. They read a vector's
-//! length and data from the serial content struct directly (issue 15: `N_VGetLength` and
+//! length and data from the serial content struct directly (`N_VGetLength` and
 //! `N_VGetArrayPointer` are two indirect calls each, per vector and operation — 4 % of a
 //! TOL 1e-2 reduced run; the friction bar's ROM run 57.8 → 54.8 ms, the multilayer's 174 → 168
 //! ms, same steps).
