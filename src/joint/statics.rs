@@ -63,6 +63,7 @@ use faer::{Mat, MatRef, Side};
 use crate::error::Error;
 use crate::joint::{JointOperator, NORMAL};
 use crate::linalg::compensated::{Dot2, REFINEMENT_STEPS};
+use crate::linalg::sparse::column_pattern;
 use crate::linalg::LinalgError;
 use crate::linalg::SymCsc;
 
@@ -366,23 +367,17 @@ impl ContactPattern {
         let rows: Vec<Vec<(usize, f64)>> = (0..joint.pairs())
             .map(|i| joint.row(3 * i + NORMAL).collect())
             .collect();
-        let mut cols: Vec<Vec<usize>> = (0..n)
-            .map(|j| k.row_idx[k.col_ptr[j]..k.col_ptr[j + 1]].to_vec())
-            .collect();
+        // Rows each column gains from the pairs' b_iᵀ b_i, beside K's own.
+        let mut extra: Vec<Vec<usize>> = vec![Vec::new(); n];
         for row in &rows {
             for &(cj, _) in row {
-                cols[cj].extend(row.iter().map(|&(ci, _)| ci));
+                extra[cj].extend(row.iter().map(|&(ci, _)| ci));
             }
         }
-        let mut col_ptr = Vec::with_capacity(n + 1);
-        col_ptr.push(0);
-        let mut row_idx = Vec::new();
-        for c in &mut cols {
-            c.sort_unstable();
-            c.dedup();
-            row_idx.extend_from_slice(c);
-            col_ptr.push(row_idx.len());
-        }
+        let (col_ptr, row_idx) = column_pattern(n, |c, out| {
+            out.extend_from_slice(&k.row_idx[k.col_ptr[c]..k.col_ptr[c + 1]]);
+            out.extend_from_slice(&extra[c]);
+        });
         let pos = |i: usize, j: usize| -> usize {
             let col = &row_idx[col_ptr[j]..col_ptr[j + 1]];
             // Every queried entry was inserted above.

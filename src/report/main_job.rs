@@ -137,7 +137,7 @@ fn time_charts(rep: &Report, dir: &Path) -> Result<Vec<PathBuf>, Error> {
     wanted.dedup();
     for g in wanted {
         if let Some(r) = rep.runs.iter().find(|r| {
-            r.model == "tvd" && r.g == Some(g) && r.iteration == "newton" && !r.t.is_empty()
+            r.model == "tvd" && r.g == Some(g) && r.iteration == "newton" && !r.curves.t.is_empty()
         }) {
             shown.push(r);
         }
@@ -152,16 +152,18 @@ fn time_charts(rep: &Report, dir: &Path) -> Result<Vec<PathBuf>, Error> {
             "contact force norm ‖f_c‖",
             "‖f_c‖ (N)",
             "N",
-            |r| &r.fc,
+            |r| &r.curves.contact_force_norm,
         ),
         (
             "fr",
             "friction force norm ‖f_R‖",
             "‖f_R‖ (N)",
             "N",
-            |r| &r.fr,
+            |r| &r.curves.friction_force_norm,
         ),
-        ("uy", "master displacement u_y", "u_y (mm)", "mm", |r| &r.uy),
+        ("uy", "master displacement u_y", "u_y (mm)", "mm", |r| {
+            &r.curves.master_uy
+        }),
     ];
     for (stem, what, axis, unit, get) in quantities {
         files.extend(
@@ -246,7 +248,12 @@ fn history_chart(
         }
         let mut s = Series::new(
             text,
-            r.t.iter().copied().zip(get(r).iter().copied()).collect(),
+            r.curves
+                .t
+                .iter()
+                .copied()
+                .zip(get(r).iter().copied())
+                .collect(),
         );
         s.markers = false;
         c.series.push(s);
@@ -277,12 +284,14 @@ fn error_chart(rep: &Report, shown: &[&RunRecord], what: &str, get: Curve) -> Op
     c.legend = LegendPosition::LowerRight;
     for (k, r) in shown.iter().enumerate().skip(1) {
         // The runs share the output times; a run that stopped early is compared where it ran.
-        let pts: Vec<(f64, f64)> =
-            r.t.iter()
-                .zip(get(r))
-                .zip(reference)
-                .map(|((&t, &q), &q0)| (t, (q - q0).abs() / scale))
-                .collect();
+        let pts: Vec<(f64, f64)> = r
+            .curves
+            .t
+            .iter()
+            .zip(get(r))
+            .zip(reference)
+            .map(|((&t, &q), &q0)| (t, (q - q0).abs() / scale))
+            .collect();
         let mut s = Series::new(run_label(rep, r), pts);
         s.markers = false;
         // The colour the run has in the history chart.

@@ -309,8 +309,8 @@ pub(crate) fn sweep_json(sweep: &Sweep) -> serde_json::Value {
     let mut v = serde_json::to_value(sweep).unwrap_or(serde_json::Value::Null);
     if let Some(refs) = v.get_mut("references").and_then(|r| r.as_array_mut()) {
         for (j, r) in refs.iter_mut().zip(&sweep.references) {
-            j["t"] = serde_json::json!(r.outcome.t);
-            j["contact_force_norm"] = serde_json::json!(r.outcome.fc);
+            j["t"] = serde_json::json!(r.outcome.curves.t);
+            j["contact_force_norm"] = serde_json::json!(r.outcome.curves.contact_force_norm);
         }
     }
     v

@@ -23,9 +23,11 @@ use serde::Serialize;
 use crate::error::Error;
 use crate::integrate::Curves;
 
-/// The compared curves of a reference run.
-#[derive(Clone, Debug, PartialEq)]
-pub struct ReferenceCurves {
+/// The four curves every comparison of runs is about — ‖f_c‖(t), ‖f_R‖(t) and the master's
+/// u_y(t) at the output times — of a run (`From<Curves>`) or of a stored reference
+/// ([`JointCurves::read`]).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct JointCurves {
     /// Output times, s (strictly increasing).
     pub t: Vec<f64>,
     /// ‖f_c‖, N.
@@ -59,25 +61,50 @@ const COLUMNS: [&str; 4] = [
     "master_uy",
 ];
 
-impl ReferenceCurves {
+impl From<Curves> for JointCurves {
+    /// The four compared curves of a run, taken from it.
+    fn from(c: Curves) -> JointCurves {
+        JointCurves {
+            t: c.t,
+            contact_force_norm: c.contact_force_norm,
+            friction_force_norm: c.friction_force_norm,
+            master_uy: c.master_uy,
+        }
+    }
+}
+
+/// Stored reference curves are [`JointCurves`].
+pub type ReferenceCurves = JointCurves;
+
+impl JointCurves {
+    /// The relative L2 errors of these curves against `reference` (module docs).
+    pub fn errors_against(&self, reference: &JointCurves) -> ReferenceErrors {
+        reference.errors_of(
+            &self.t,
+            &self.contact_force_norm,
+            &self.friction_force_norm,
+            &self.master_uy,
+        )
+    }
+
     /// Reads a reference file: JSON if its name ends in `.json`, else CSV (module docs).
     ///
     /// # Errors
     /// [`Error::Invalid`] naming the file (and the line of a CSV) for a missing column, a value
     /// that is not a finite number, curves of different lengths, fewer than two outputs or
     /// times that do not increase.
-    pub fn read(path: &Path) -> Result<ReferenceCurves, Error> {
+    pub fn read(path: &Path) -> Result<JointCurves, Error> {
         let text = crate::files::read_text(path)?;
         let what = path.display().to_string();
         if path.extension().is_some_and(|e| e == "json") {
-            ReferenceCurves::parse_json(&text, &what)
+            JointCurves::parse_json(&text, &what)
         } else {
-            ReferenceCurves::parse_csv(&text, &what)
+            JointCurves::parse_csv(&text, &what)
         }
     }
 
     /// Parses the CSV form; `what` names the source in errors.
-    pub fn parse_csv(text: &str, what: &str) -> Result<ReferenceCurves, Error> {
+    pub fn parse_csv(text: &str, what: &str) -> Result<JointCurves, Error> {
         let bad = |m: String| Error::Invalid(format!("reference {what}: {m}"));
         let mut r = csv::ReaderBuilder::new()
             .trim(csv::Trim::All)
@@ -110,11 +137,11 @@ impl ReferenceCurves {
             }
         }
         let [t, fc, fr, uy] = cols;
-        ReferenceCurves::checked(t, fc, fr, uy, what)
+        JointCurves::checked(t, fc, fr, uy, what)
     }
 
     /// Parses the compact JSON form (`cases/reference/compact.py`).
-    pub fn parse_json(text: &str, what: &str) -> Result<ReferenceCurves, Error> {
+    pub fn parse_json(text: &str, what: &str) -> Result<JointCurves, Error> {
         let bad = |m: String| Error::Invalid(format!("reference {what}: {m}"));
         let v: serde_json::Value = serde_json::from_str(text).map_err(|e| bad(e.to_string()))?;
         let arr = |name: &str| -> Result<Vec<f64>, Error> {
@@ -129,7 +156,7 @@ impl ReferenceCurves {
                 })
                 .collect()
         };
-        ReferenceCurves::checked(
+        JointCurves::checked(
             arr(COLUMNS[0])?,
             arr(COLUMNS[1])?,
             arr(COLUMNS[2])?,
@@ -144,7 +171,7 @@ impl ReferenceCurves {
         friction_force_norm: Vec<f64>,
         master_uy: Vec<f64>,
         what: &str,
-    ) -> Result<ReferenceCurves, Error> {
+    ) -> Result<JointCurves, Error> {
         let bad = |m: String| Error::Invalid(format!("reference {what}: {m}"));
         let n = t.len();
         if [&contact_force_norm, &friction_force_norm, &master_uy]
@@ -164,7 +191,7 @@ impl ReferenceCurves {
                 t[i]
             )));
         }
-        Ok(ReferenceCurves {
+        Ok(JointCurves {
             t,
             contact_force_norm,
             friction_force_norm,
@@ -174,12 +201,22 @@ impl ReferenceCurves {
 
     /// The errors of a run's curves against the reference (module docs).
     pub fn errors(&self, c: &Curves) -> ReferenceErrors {
-        let l2 = |a: &[f64], r: &[f64]| relative_l2(&c.t, a, &self.t, r);
-        let (count, until) = self.shared_times(&c.t);
+        self.errors_of(
+            &c.t,
+            &c.contact_force_norm,
+            &c.friction_force_norm,
+            &c.master_uy,
+        )
+    }
+
+    /// The errors of the curves `fc`, `fr`, `uy` at times `t` against these.
+    fn errors_of(&self, t: &[f64], fc: &[f64], fr: &[f64], uy: &[f64]) -> ReferenceErrors {
+        let l2 = |a: &[f64], r: &[f64]| relative_l2(t, a, &self.t, r);
+        let (count, until) = self.shared_times(t);
         ReferenceErrors {
-            contact_force: l2(&c.contact_force_norm, &self.contact_force_norm),
-            friction_force: l2(&c.friction_force_norm, &self.friction_force_norm),
-            master_uy: l2(&c.master_uy, &self.master_uy),
+            contact_force: l2(fc, &self.contact_force_norm),
+            friction_force: l2(fr, &self.friction_force_norm),
+            master_uy: l2(uy, &self.master_uy),
             compared_outputs: count,
             compared_until: until,
         }
@@ -259,7 +296,7 @@ mod tests {
 
     #[test]
     fn csv_reference_errors() {
-        let r = ReferenceCurves::parse_csv(CSV, "test").unwrap();
+        let r = JointCurves::parse_csv(CSV, "test").unwrap();
         assert_eq!(r.t.len(), 4);
         let exact = curves(&r.t.clone(), |x| 1e4 * x);
         let e = r.errors(&exact);
@@ -276,21 +313,21 @@ mod tests {
     #[test]
     fn bad_references_are_refused_with_their_place() {
         let missing = "t,contact_force_norm,master_uy\n0,0,0\n1,1,1\n";
-        let e = ReferenceCurves::parse_csv(missing, "f.csv").unwrap_err();
+        let e = JointCurves::parse_csv(missing, "f.csv").unwrap_err();
         assert!(e.to_string().contains("friction_force_norm"), "{e}");
         let nan = CSV.replace("2e-4,2,", "2e-4,nan,");
-        let e = ReferenceCurves::parse_csv(&nan, "f.csv").unwrap_err();
+        let e = JointCurves::parse_csv(&nan, "f.csv").unwrap_err();
         assert!(e.to_string().contains("line 4"), "{e}");
         let back = CSV.replace("3e-4,3", "1e-4,3");
-        let e = ReferenceCurves::parse_csv(&back, "f.csv").unwrap_err();
+        let e = JointCurves::parse_csv(&back, "f.csv").unwrap_err();
         assert!(e.to_string().contains("do not increase"), "{e}");
         let json =
             r#"{"t":[0,1],"contact_force_norm":[0,1],"friction_force_norm":[0],"master_uy":[0,1]}"#;
-        let e = ReferenceCurves::parse_json(json, "f.json").unwrap_err();
+        let e = JointCurves::parse_json(json, "f.json").unwrap_err();
         assert!(e.to_string().contains("different lengths"), "{e}");
         let ok = json.replace(r#"[0],"#, r#"[0,0.5],"#);
         assert_eq!(
-            ReferenceCurves::parse_json(&ok, "f.json").unwrap().t,
+            JointCurves::parse_json(&ok, "f.json").unwrap().t,
             vec![0.0, 1.0]
         );
     }

@@ -37,7 +37,7 @@ pub mod tolerance;
 pub mod training;
 
 pub use build::{build_rom, BuiltRom};
-pub use compare::{relative_l2, ReferenceCurves, ReferenceErrors};
+pub use compare::{relative_l2, JointCurves, ReferenceCurves, ReferenceErrors};
 pub use estimate::{run_estimated, RunEstimate};
 pub use run::{run_model, Frames, ModelRun, RunSettings};
 pub use spec::{ModelFlags, ModelSpec};

@@ -45,7 +45,7 @@ use crate::integrate::problem::{Iteration, OdeOptions, OdeStats};
 use crate::integrate::{integrate, ProblemOptions, Run, RunStatus, Scene, TransientOptions};
 use crate::model::Model;
 use crate::reduction::{build_basis, snapshot_basis, BasisKind, BasisOptions, JointFlexibility};
-use crate::rom::compare::relative_l2;
+use crate::rom::compare::JointCurves;
 use crate::rom::estimate::{run_estimated, RunEstimate};
 use crate::rom::tolerance::{tolerance_model, ToleranceOptions};
 use crate::studies::convergence::{self as study, StudyOptions};
@@ -137,18 +137,9 @@ pub struct RunRecord {
     pub cpu_percent: Option<f64>,
     /// On the Pareto front of (CPU time, error of ‖f_c‖).
     pub pareto: bool,
-    /// Output times, s.
+    /// ‖f_c‖(t), ‖f_R‖(t) and master u_y(t) at the output times.
     #[serde(skip)]
-    pub t: Vec<f64>,
-    /// ‖f_c‖(t), N.
-    #[serde(skip)]
-    pub fc: Vec<f64>,
-    /// ‖f_R‖(t), N.
-    #[serde(skip)]
-    pub fr: Vec<f64>,
-    /// Master u_y(t), mm.
-    #[serde(skip)]
-    pub uy: Vec<f64>,
+    pub curves: JointCurves,
 }
 
 /// The paper's CPU-time ratio of a reduced run to the full run.
@@ -303,10 +294,7 @@ fn record(
         speedup: None,
         cpu_percent: None,
         pareto: false,
-        t: o.t,
-        fc: o.fc,
-        fr: o.fr,
-        uy: o.uy,
+        curves: o.curves,
     }
 }
 
@@ -804,23 +792,15 @@ fn tolerance_runs(
 /// Each finished reduced run's relative L2 errors of ‖f_c‖, ‖f_R‖ and u_y against the full run
 /// (`runs[0]`) and its CPU speed-up.
 fn compare_to_full(runs: &mut [RunRecord]) {
-    let (t_ref, fc_ref, fr_ref, uy_ref, cpu_ref) = {
-        let f = &runs[0];
-        (
-            f.t.clone(),
-            f.fc.clone(),
-            f.fr.clone(),
-            f.uy.clone(),
-            f.cpu_s,
-        )
-    };
+    let (full, cpu_ref) = (runs[0].curves.clone(), runs[0].cpu_s);
     for r in runs.iter_mut().skip(1) {
         if !r.status.finished() {
             continue;
         }
-        r.error_fc = relative_l2(&r.t, &r.fc, &t_ref, &fc_ref);
-        r.error_uy = relative_l2(&r.t, &r.uy, &t_ref, &uy_ref);
-        r.error_fr = relative_l2(&r.t, &r.fr, &t_ref, &fr_ref);
+        let e = r.curves.errors_against(&full);
+        r.error_fc = e.contact_force;
+        r.error_uy = e.master_uy;
+        r.error_fr = e.friction_force;
         if r.cpu_s > 0.0 && cpu_ref.is_finite() {
             r.speedup = Some(cpu_ref / r.cpu_s);
             r.cpu_percent = Some(100.0 * r.cpu_s / cpu_ref);

@@ -79,7 +79,7 @@ use crate::integrate::problem::{Iteration, NewtonLinear, OdeOptions, OdeStats};
 use crate::integrate::{integrate, ProblemOptions, Run, RunStatus, Scene, TransientOptions};
 use crate::model::Model;
 use crate::reduction::{build_basis, BasisKind, BasisOptions};
-use crate::rom::compare::relative_l2;
+use crate::rom::compare::{relative_l2, JointCurves};
 use crate::system::{FullSystem, ReducedSystem};
 
 /// The model of a cell (the CLI's `--models` values).
@@ -297,18 +297,9 @@ pub struct Outcome {
     pub wall_s: f64,
     /// Process CPU time of the integration, s (10 ms resolution; NaN where unavailable).
     pub cpu_s: f64,
-    /// Output times, s.
+    /// ‖f_c‖, ‖f_R‖ and master u_y at the output times.
     #[serde(skip)]
-    pub t: Vec<f64>,
-    /// ‖f_c‖ at the output times, N.
-    #[serde(skip)]
-    pub fc: Vec<f64>,
-    /// ‖f_R‖ at the output times, N.
-    #[serde(skip)]
-    pub fr: Vec<f64>,
-    /// Master u_y at the output times, mm.
-    #[serde(skip)]
-    pub uy: Vec<f64>,
+    pub curves: JointCurves,
 }
 
 impl Outcome {
@@ -327,10 +318,7 @@ impl Outcome {
             events_found: run.events,
             wall_s: run.wall_s,
             cpu_s: run.cpu_s,
-            t: run.curves.t,
-            fc: run.curves.contact_force_norm,
-            fr: run.curves.friction_force_norm,
-            uy: run.curves.master_uy,
+            curves: run.curves.into(),
         }
     }
 }
@@ -635,7 +623,7 @@ impl Pass<'_> {
             ));
             let vs_full = vs_full(&refs.full, *kind, &o);
             if *kind == ModelKind::Full && o.ok() {
-                refs.full = Some((o.t.clone(), o.fc.clone()));
+                refs.full = Some((o.curves.t.clone(), o.curves.contact_force_norm.clone()));
             }
             references.push(Reference {
                 model: *kind,
@@ -722,7 +710,12 @@ impl Pass<'_> {
             .find(|(k, r)| *k == cell.model && r.ok())
             .map(|(_, r)| r);
         cell.error = match reference {
-            Some(r) if o.ok() => relative_l2(&o.t, &o.fc, &r.t, &r.fc),
+            Some(r) if o.ok() => relative_l2(
+                &o.curves.t,
+                &o.curves.contact_force_norm,
+                &r.curves.t,
+                &r.curves.contact_force_norm,
+            ),
             _ => None,
         };
         self.progress(&format!(
@@ -751,7 +744,7 @@ impl Pass<'_> {
 fn vs_full(full: &Option<(Vec<f64>, Vec<f64>)>, kind: ModelKind, o: &Outcome) -> Option<f64> {
     match (full, kind) {
         (Some((t, f)), ModelKind::RomG0 | ModelKind::Rom) if o.ok() => {
-            relative_l2(&o.t, &o.fc, t, f)
+            relative_l2(&o.curves.t, &o.curves.contact_force_norm, t, f)
         }
         _ => None,
     }

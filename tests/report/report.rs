@@ -61,8 +61,13 @@ fn quick_report_on_the_friction_bar() {
     // Functional and Newton iteration solve the same ROM: same curves within the tolerances.
     let fun = run("tvd", g, "functional");
     if fun.status.name() == "ok" {
-        let d =
-            jointrom::rom::compare::relative_l2(&fun.t, &fun.fc, &chosen.t, &chosen.fc).unwrap();
+        let d = jointrom::rom::compare::relative_l2(
+            &fun.curves.t,
+            &fun.curves.contact_force_norm,
+            &chosen.curves.t,
+            &chosen.curves.contact_force_norm,
+        )
+        .unwrap();
         assert!(d < 1e-2, "functional vs Newton ‖f_c‖ differ by {d}");
     }
     // Speed-ups are CPU ratios; the Pareto front is non-empty and not dominated.
