@@ -102,7 +102,7 @@ pub struct ToleranceOptions {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum IntegrationTolerances {
     /// From the tolerance: the paper's Table 1 values loosened by [`integration_looseness`],
-    /// tightened tenfold while the estimate's integration part takes more than its share.
+    /// tightened tenfold while the estimate misses the tolerance.
     #[default]
     FromTolerance,
     /// The transient options' own rtol and atol (the user gave them).
@@ -111,10 +111,10 @@ pub enum IntegrationTolerances {
 
 /// The factor `s` on the paper's Table 1 rtol and atol (1e-8, 1e-6 mm) at which the tolerance
 /// model of tolerance `tol` starts: `s = clamp(tol / 1e-4, 1, 1e4)` — ten times looser per
-/// decade of tolerance above 1e-4, the paper's tolerances from 1e-4 down. The estimate's
-/// integration part (a re-run ten times tighter, [`super::estimate::integration_errors`])
-/// checks the choice: while it exceeds θ·TOL (θ = [`SELECTION_MARGIN`]) or the total misses
-/// TOL, `s` drops tenfold and the model is re-run, down to `s = 1`.
+/// decade of tolerance above 1e-4, the paper's tolerances from 1e-4 down. The estimate, whose
+/// integration part is a re-run ten times tighter ([`super::estimate::integration_errors`]),
+/// checks the choice: while its total misses TOL, `s` drops tenfold and the model is re-run,
+/// down to `s = 1`.
 pub fn integration_looseness(tol: f64) -> f64 {
     (tol / 1e-4).clamp(1.0, 1e4)
 }
@@ -290,14 +290,11 @@ pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<Toleran
             // A ranking run is never the result: the same model again at the user's tolerances.
             continue;
         }
-        // The integration part takes more than its share at the chosen tolerances: the same
-        // model again, ten times tighter.
-        let integration = estimate.integration.and_then(|i| i.contact_force);
+        // The estimate misses the tolerance at loosened integration tolerances: the same model
+        // again, ten times tighter (the reduction part is within its share, or the loop would
+        // have added pairs).
         let total = estimate.total.contact_force.unwrap_or(0.0);
-        if !changed
-            && looseness > 1.0
-            && integration.is_some_and(|i| i > SELECTION_MARGIN * tol || total > tol)
-        {
+        if !changed && looseness > 1.0 && estimate.integration.is_some() && total > tol {
             looseness = (looseness / 10.0).max(1.0);
             continue;
         }
