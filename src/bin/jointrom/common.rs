@@ -6,12 +6,25 @@ use std::sync::Mutex;
 use jointrom::{Error, Model};
 use serde_json::Value;
 
-/// Prints one pretty JSON document on stdout.
+/// Prints one pretty JSON document on stdout. A document of a command that loaded a model gains
+/// `"model_s"`: the wall time of reading and building the model (s), so that the end-to-end time
+/// of a command is visible beside its `offline_s` and `wall_s`.
 pub fn print_json(v: &Value) {
+    let mut v = v.clone();
+    if let (Value::Object(map), Some(s)) = (&mut v, model_seconds()) {
+        map.entry("model_s").or_insert(Value::from(s));
+    }
     println!(
         "{}",
-        serde_json::to_string_pretty(v).expect("JSON values serialise")
+        serde_json::to_string_pretty(&v).expect("JSON values serialise")
     );
+}
+
+/// Wall time of the model loads of this command, s (`None` before one).
+static MODEL_S: Mutex<Option<f64>> = Mutex::new(None);
+
+fn model_seconds() -> Option<f64> {
+    MODEL_S.lock().ok().and_then(|g| *g)
 }
 
 /// Prints the six master displacements `u[k]`, one a line (mm, then rad).
@@ -64,7 +77,11 @@ pub fn inputs() -> Vec<String> {
 /// Loads a case file, built-in scene or matrix map ([`Model::from_case_name`]) and records
 /// where its matrices came from.
 pub fn load_model(arg: &str) -> Result<Model, Error> {
+    let start = std::time::Instant::now();
     let model = Model::from_case_name(arg)?;
+    if let Ok(mut g) = MODEL_S.lock() {
+        *g = Some(g.unwrap_or(0.0) + start.elapsed().as_secs_f64());
+    }
     record_input(format!("model {}", model.describe_source()));
     for w in &model.warnings {
         eprintln!("warning: {}", jointrom::files::printable(w));
