@@ -9,6 +9,7 @@
 mod beam2;
 mod shell4;
 mod weld;
+mod weld_cache;
 mod weld_patch;
 
 pub use beam2::Beam2;

@@ -147,7 +147,8 @@ impl Weld {
     /// that a re-meshed neighbourhood equal to an earlier weld's up to a translation (the same
     /// geometry relative to the weld centre, to 1e-9 mm, and the same material) reuses that
     /// weld's condensed matrices — within the scene (the friction bar's two welds are one
-    /// condensation) and across scenes built by this process (a cache bounded at 512 MB).
+    /// condensation), across scenes built by this process (a cache bounded at 512 MB) and across
+    /// commands (the disk cache of [`super::weld_cache`]).
     pub fn build_all(
         welds: &[WeldElem],
         nodes: &[[f64; 3]],
@@ -164,9 +165,16 @@ impl Weld {
             let condensed = match CONDENSED.get(&key) {
                 Some(c) => c,
                 None => {
-                    let c = Weld::new(w, material)?
-                        .condensed
-                        .expect("a weld with a neighbourhood is condensed");
+                    let c = match super::weld_cache::load(&key) {
+                        Some(km) => Arc::new(km),
+                        None => {
+                            let c = Weld::new(w, material)?
+                                .condensed
+                                .expect("a weld with a neighbourhood is condensed");
+                            super::weld_cache::store(&key, &c.0, &c.1);
+                            c
+                        }
+                    };
                     CONDENSED.insert(key, c.clone());
                     c
                 }
