@@ -164,13 +164,11 @@ where
         active_counts.push(active.iter().filter(|&&a| a).count());
         solve(&active, &mut gaps)?;
         if let Some(i) = gaps.iter().position(|g| !g.is_finite()) {
-            return Err(Error::LinearAlgebra(
-                format!(
-                    "contact iteration {it}: gap of pair {i} is not finite ({})",
-                    gaps[i]
-                )
-                .into(),
-            ));
+            return Err(Error::LinearAlgebra(LinalgError::GapNotFinite {
+                context: format!("contact iteration {it}"),
+                pair: i,
+                value: Some(gaps[i]),
+            }));
         }
         let next: Vec<bool> = gaps.iter().map(|&g| g < 0.0).collect();
         if next == active {
@@ -193,26 +191,21 @@ where
         }
         if let Some(&first) = visited.get(&next) {
             let len = it + 1 - first;
-            return Err(Error::LinearAlgebra(
-                format!(
-                    "contact active-set Newton cycles: the active set after iteration {it} \
-                 ({} pairs in contact) repeats that of iteration {first} (cycle of length {len})",
-                    next.iter().filter(|&&a| a).count()
-                )
-                .into(),
-            ));
+            return Err(Error::LinearAlgebra(LinalgError::ActiveSetCycle {
+                iteration: it,
+                in_contact: next.iter().filter(|&&a| a).count(),
+                first,
+                length: len,
+            }));
         }
         active = next;
     }
     let last = active_counts.last().copied().unwrap_or(0);
-    Err(Error::LinearAlgebra(
-        format!(
-            "contact active-set Newton did not converge in {} iterations \
-         (last active set: {last} of {pairs} pairs)",
-            opts.max_iterations
-        )
-        .into(),
-    ))
+    Err(Error::LinearAlgebra(LinalgError::ActiveSetNotConverged {
+        iterations: opts.max_iterations,
+        last,
+        pairs,
+    }))
 }
 
 /// Frictionless penalty contact statics of a sparse system `K q = f − B_nᵀ p` with the normal
@@ -242,13 +235,14 @@ pub fn contact_static_sparse(
         let mat = SparseColMatRef::new(pattern.symbolic_matrix.as_ref(), &values);
         let llt = Llt::try_new_with_symbolic(pattern.symbolic_llt.clone(), mat, Side::Lower)
             .map_err(|e| {
-                Error::LinearAlgebra(LinalgError::caused_by(
-                    format!(
-                        "K + K_c ({n}×{n}, {} pairs active) is not positive definite: {e:?}",
+                Error::LinearAlgebra(LinalgError::NotPositiveDefinite {
+                    what: format!(
+                        "K + K_c ({n}×{n}, {} pairs active)",
                         active.iter().filter(|&&a| a).count()
                     ),
-                    e,
-                ))
+                    hint: "",
+                    source: Box::new(e),
+                })
             })?;
         for i in 0..n {
             rhs[(i, 0)] = f[i];
@@ -315,13 +309,14 @@ pub fn contact_static_reduced(
             }
         }
         let llt = a.llt(Side::Lower).map_err(|e| {
-            Error::LinearAlgebra(LinalgError::caused_by(
-                format!(
-                    "reduced K_r + K_c ({r}×{r}, {} pairs active) is not positive definite: {e:?}",
+            Error::LinearAlgebra(LinalgError::NotPositiveDefinite {
+                what: format!(
+                    "reduced K_r + K_c ({r}×{r}, {} pairs active)",
                     active.iter().filter(|&&a| a).count()
                 ),
-                e,
-            ))
+                hint: "",
+                source: Box::new(e),
+            })
         })?;
         let mut x = llt.solve(&rhs);
         for _ in 0..REFINEMENT_STEPS {
@@ -410,10 +405,10 @@ impl ContactPattern {
             SymbolicSparseColMat::new_checked(n, n, col_ptr.clone(), None, row_idx.clone());
         let symbolic_llt =
             SymbolicLlt::try_new(symbolic_matrix.as_ref(), Side::Lower).map_err(|e| {
-                Error::LinearAlgebra(LinalgError::caused_by(
-                    format!("symbolic Cholesky of K + K_c ({n}×{n}): {e:?}"),
-                    e,
-                ))
+                Error::LinearAlgebra(LinalgError::Symbolic {
+                    what: format!("Cholesky of K + K_c ({n}×{n})"),
+                    source: Box::new(e),
+                })
             })?;
         Ok(ContactPattern {
             col_ptr,

@@ -4,7 +4,7 @@
 use faer::sparse::{SparseColMat, SymbolicSparseColMat};
 use faer::{Mat, MatRef};
 
-use crate::error::Error;
+use super::LinalgError;
 
 /// A symmetric sparse matrix in compressed sparse columns with both triangles stored.
 #[derive(Clone, Debug)]
@@ -74,11 +74,11 @@ impl SymCsc {
     }
 
     /// `A + s B` for matrices with the same pattern (e.g. the shifted `K − σ M`).
-    pub fn add_scaled(&self, s: f64, other: &SymCsc) -> Result<SymCsc, Error> {
+    pub fn add_scaled(&self, s: f64, other: &SymCsc) -> Result<SymCsc, LinalgError> {
         if self.col_ptr != other.col_ptr || self.row_idx != other.row_idx {
-            return Err(Error::Invalid(
-                "add_scaled needs two matrices with the same sparsity pattern".into(),
-            ));
+            return Err(LinalgError::PatternMismatch {
+                operation: "add_scaled",
+            });
         }
         let mut out = self.clone();
         for (v, o) in out.values.iter_mut().zip(&other.values) {

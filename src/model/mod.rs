@@ -374,10 +374,14 @@ impl Model {
     /// The lowest `count` eigenmodes with the master node free or clamped.
     pub fn modes(&self, count: usize, interface: Interface) -> Result<Modes, Error> {
         match interface {
-            Interface::Free => modes::lowest_modes(&self.stiffness, &self.mass, count),
+            Interface::Free => Ok(modes::lowest_modes(&self.stiffness, &self.mass, count)?),
             Interface::Fixed => {
                 let m = self.dofs() - 6;
-                modes::lowest_modes(&self.stiffness.leading(m), &self.mass.leading(m), count)
+                Ok(modes::lowest_modes(
+                    &self.stiffness.leading(m),
+                    &self.mass.leading(m),
+                    count,
+                )?)
             }
         }
     }

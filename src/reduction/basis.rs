@@ -10,6 +10,7 @@ use crate::error::Error;
 use crate::linalg::compensated::{split, two_product_sums};
 use crate::linalg::sparse::{sym_mul_vec_into, SymCsc};
 use crate::linalg::symmetric_eigen;
+use crate::linalg::LinalgError;
 use crate::model::Model;
 
 /// Default relative drop tolerance of [`final_basis`].
@@ -205,9 +206,9 @@ pub fn modal_rotation(model: &Model, phi: Mat<f64>) -> Result<(Mat<f64>, Vec<f64
         symmetric_eigen(k.as_ref(), "reduced eigenproblem ΦᵀKΦ").map_err(Error::LinearAlgebra)?;
     let lambda = evd.values;
     if let Some(l) = lambda.iter().find(|l| !(l.is_finite() && **l > 0.0)) {
-        return Err(Error::LinearAlgebra(
-            format!("reduced stiffness ΦᵀKΦ is not positive definite (eigenvalue {l:e})").into(),
-        ));
+        return Err(Error::LinearAlgebra(LinalgError::ReducedStiffness {
+            eigenvalue: *l,
+        }));
     }
     Ok((&phi * &evd.vectors, lambda))
 }

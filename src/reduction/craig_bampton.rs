@@ -5,6 +5,7 @@ use faer::Mat;
 use crate::error::Error;
 use crate::linalg::cholesky::SparseCholesky;
 use crate::linalg::eigen::lowest_modes_factored;
+use crate::linalg::LinalgError;
 use crate::model::Model;
 
 /// The Craig–Bampton basis `[Φ_S | Φ_V]` (n × (6 + ν)) of a model whose master node's six DOF
@@ -74,9 +75,9 @@ pub fn craig_bampton(model: &Model, nu: usize) -> Result<Mat<f64>, Error> {
         }
     }
     if phi.col_iter().any(|c| c.iter().any(|v| !v.is_finite())) {
-        return Err(Error::LinearAlgebra(
-            "Craig–Bampton basis is not finite".into(),
-        ));
+        return Err(Error::LinearAlgebra(LinalgError::not_finite(
+            "Craig–Bampton basis",
+        )));
     }
     Ok(phi)
 }

@@ -49,6 +49,7 @@ use crate::files;
 use crate::linalg::compensated::{solve_refined_steps, sym_mul_compensated};
 use crate::linalg::sparse::sym_mul_mat;
 use crate::linalg::symmetric_eigenvalues;
+use crate::linalg::LinalgError;
 use crate::linalg::{Modes, SparseCholesky, SymCsc};
 use crate::model::petsc;
 use crate::model::{Interface, Model};
@@ -386,9 +387,10 @@ fn span_measure(
     for j in 0..nu {
         let norm = gram[(j, j)].sqrt();
         if !(norm.is_finite() && norm > 0.0) {
-            return Err(Error::LinearAlgebra(
-                format!("distributed: SLEPc mode {} has M-norm {norm:e}", j + 1).into(),
-            ));
+            return Err(Error::LinearAlgebra(LinalgError::ModeNorm {
+                what: format!("distributed: SLEPc mode {}", j + 1),
+                norm,
+            }));
         }
         phi_p.col_mut(j).iter_mut().for_each(|v| *v /= norm);
     }

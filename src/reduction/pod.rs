@@ -5,6 +5,7 @@ use faer::{Mat, MatRef};
 use crate::error::Error;
 use crate::linalg::sparse::sym_mul_mat;
 use crate::linalg::symmetric_eigen;
+use crate::linalg::LinalgError;
 use crate::linalg::SymCsc;
 use crate::model::Model;
 
@@ -154,10 +155,11 @@ fn pod_dense_lambda_poms(
     let u = evd.vectors.as_ref();
     let lmax = s[p - 1];
     if !(lmax.is_finite() && lmax > 0.0) {
-        return Err(Error::LinearAlgebra(
-            format!("POD: largest eigenvalue of YᵀAY is {lmax:e} (zero or indefinite weight)")
-                .into(),
-        ));
+        return Err(Error::LinearAlgebra(LinalgError::NotPositive {
+            what: "POD: largest eigenvalue of YᵀAY",
+            value: lmax,
+            hint: " (zero or indefinite weight)",
+        }));
     }
     let order: Vec<usize> = (0..p).rev().collect(); // descending
     let kept: Vec<usize> = order
@@ -245,10 +247,11 @@ pub fn pod(y: MatRef<'_, f64>, weight: Option<&SymCsc>) -> Result<Pod, Error> {
     let x = evd.vectors.as_ref();
     let lmax = s[k - 1];
     if !(lmax.is_finite() && lmax > 0.0) {
-        return Err(Error::LinearAlgebra(
-            format!("POD: largest eigenvalue of YᵀAY is {lmax:e} (zero or indefinite weight)")
-                .into(),
-        ));
+        return Err(Error::LinearAlgebra(LinalgError::NotPositive {
+            what: "POD: largest eigenvalue of YᵀAY",
+            value: lmax,
+            hint: " (zero or indefinite weight)",
+        }));
     }
     let kept: Vec<usize> = (0..k)
         .rev()
@@ -353,7 +356,10 @@ fn pod_tvd_with(model: &Model, tvd: &Tvd, weighted: bool, want_poms: bool) -> Re
         (&r * &f.coefficients, q)
     };
     let svd = a.thin_svd().map_err(|e| {
-        Error::LinearAlgebra(format!("POD: SVD of the TVD coefficients: {e:?}").into())
+        Error::LinearAlgebra(LinalgError::SvdNotConverged {
+            what: "POD: SVD of the TVD coefficients",
+            error: e,
+        })
     })?;
     let s = svd.S().column_vector();
     let k = s.nrows();
@@ -361,9 +367,11 @@ fn pod_tvd_with(model: &Model, tvd: &Tvd, weighted: bool, want_poms: bool) -> Re
     order.sort_by(|&x, &y| s[y].total_cmp(&s[x]));
     let smax = s[order[0]];
     if !(smax.is_finite() && smax > 0.0) {
-        return Err(Error::LinearAlgebra(
-            format!("POD: largest singular value of the TVD coefficients is {smax:e}").into(),
-        ));
+        return Err(Error::LinearAlgebra(LinalgError::NotPositive {
+            what: "POD: largest singular value of the TVD coefficients",
+            value: smax,
+            hint: "",
+        }));
     }
     let cut = sigma_zero(m, p) * smax;
     let kept: Vec<usize> = order.into_iter().filter(|&i| s[i] > cut).collect();

@@ -670,13 +670,11 @@ fn scale_to_unit_energy(
             .map(|(x, y)| x * y)
             .sum();
         if !(e.is_finite() && e > 0.0) {
-            return Err(Error::LinearAlgebra(
-                format!(
-                    "TVD column {c} ({:?}) has strain energy {e:e}; K is not positive definite",
-                    index[c]
-                )
-                .into(),
-            ));
+            return Err(Error::LinearAlgebra(LinalgError::TvdStrainEnergy {
+                column: c,
+                index: (index[c].i, index[c].k, index[c].j),
+                energy: e,
+            }));
         }
         let s = e.sqrt();
         q.col_mut(a).iter_mut().for_each(|v| *v /= s);
@@ -705,20 +703,20 @@ fn shifted_solve(
         Some(s) => s.clone(),
         None => {
             let s = SymbolicLu::try_new(faer_a.symbolic()).map_err(|e| {
-                Error::LinearAlgebra(LinalgError::caused_by(
-                    format!("symbolic LU of K − Ω²M: {e:?}"),
-                    e,
-                ))
+                Error::LinearAlgebra(LinalgError::Symbolic {
+                    what: "LU of K − Ω²M".to_string(),
+                    source: Box::new(e),
+                })
             })?;
             *symbolic = Some(s.clone());
             s
         }
     };
     let lu = Lu::try_new_with_symbolic(sym, faer_a.as_ref()).map_err(|e| {
-        Error::LinearAlgebra(LinalgError::caused_by(
-            format!("LU of K − Ω²M for base vector {mode} (Ω² = {om2:e}): {e:?}"),
-            e,
-        ))
+        Error::LinearAlgebra(LinalgError::Factorization {
+            step: format!("LU of K − Ω²M for base vector {mode} (Ω² = {om2:e})"),
+            source: Box::new(e),
+        })
     })?;
     let mut z = rhs.clone();
     lu.solve_in_place(z.as_mut());
@@ -737,13 +735,11 @@ fn shifted_solve(
         };
     }
     if worst > 1e-10 {
-        return Err(Error::LinearAlgebra(
-            format!(
-            "TVD with inertia: (K − Ω²M) solve for base vector {mode} (Ω² = {om2:e}) has backward \
-             error {worst:.2e} > 1e-10 (Ω² is (nearly) a free-interface eigenvalue)"
-        )
-            .into(),
-        ));
+        return Err(Error::LinearAlgebra(LinalgError::TvdBackwardError {
+            mode,
+            omega2: om2,
+            backward: worst,
+        }));
     }
     Ok(z)
 }

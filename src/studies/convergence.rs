@@ -190,9 +190,10 @@ pub fn reduced_contact_static_restarting(
         Ok(sol) => Ok((sol, None)),
         Err(first) => match reduced_contact_static_damped(model, rm, scale, opts) {
             Ok(sol) => Ok((sol, Some(first))),
-            Err(second) => Err(Error::LinearAlgebra(
-                format!("reduced contact statics failed: {first}; then, damped: {second}").into(),
-            )),
+            Err(second) => Err(Error::LinearAlgebra(LinalgError::ContactFallback {
+                first: Box::new(first),
+                second: Box::new(second),
+            })),
         },
     }
 }
@@ -254,20 +255,19 @@ pub fn reduced_contact_static_damped(
             }
         }
         let llt = h.llt(Side::Lower).map_err(|e| {
-            Error::LinearAlgebra(LinalgError::caused_by(
-                format!(
-                    "damped reduced contact, step {it}: K̃ + K_c is not positive definite: {e:?}"
-                ),
-                e,
-            ))
+            Error::LinearAlgebra(LinalgError::NotPositiveDefinite {
+                what: format!("damped reduced contact, step {it}: K̃ + K_c"),
+                hint: "",
+                source: Box::new(e),
+            })
         })?;
         let rhs = Mat::from_fn(r, 1, |i, _| f[i]);
         let x = faer::linalg::solvers::Solve::solve(&llt, &rhs);
         let full: Vec<f64> = (0..r).map(|i| x[(i, 0)]).collect();
         if full.iter().any(|v| !v.is_finite()) {
-            return Err(Error::LinearAlgebra(
-                format!("damped reduced contact, step {it}: solution is not finite").into(),
-            ));
+            return Err(Error::LinearAlgebra(LinalgError::not_finite(format!(
+                "damped reduced contact, step {it}: solution"
+            ))));
         }
         let gaps = gaps_of(&full);
         let next: Vec<bool> = gaps.iter().map(|&g| g < 0.0).collect();
@@ -314,19 +314,14 @@ pub fn reduced_contact_static_damped(
             }
             t *= 0.5;
             if t < 1e-12 {
-                return Err(Error::LinearAlgebra(
-                    format!(
-                    "damped reduced contact, step {it}: line search failed (no decrease of the \
-                     contact energy along the Newton direction)"
-                )
-                    .into(),
-                ));
+                return Err(Error::LinearAlgebra(LinalgError::LineSearch { step: it }));
             }
         }
     }
-    Err(Error::LinearAlgebra(
-        format!("damped reduced contact did not converge in {max_steps} steps").into(),
-    ))
+    Err(Error::LinearAlgebra(LinalgError::NotConverged {
+        what: "damped reduced contact",
+        steps: max_steps,
+    }))
 }
 
 /// What `jointrom static --basis` reports.

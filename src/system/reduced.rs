@@ -232,10 +232,11 @@ impl ReducedSystem {
                 Default::default(),
             )
             .map_err(|e| {
-                Error::LinearAlgebra(LinalgError::caused_by(
-                    format!("reduced mass ({r}×{r}) not positive definite: {e:?}"),
-                    e,
-                ))
+                Error::LinearAlgebra(LinalgError::ReducedNotPositiveDefinite {
+                    matrix: "reduced mass",
+                    r,
+                    source: Box::new(e),
+                })
             })?;
         }
         let w3 = b_phi.nrows();
@@ -417,10 +418,11 @@ impl SecondOrderSystem for ReducedSystem {
             Default::default(),
         )
         .map_err(|e| {
-            Error::LinearAlgebra(LinalgError::caused_by(
-                format!("reduced Newton matrix ({r}×{r}) not positive definite: {e:?}"),
-                e,
-            ))
+            Error::LinearAlgebra(LinalgError::ReducedNotPositiveDefinite {
+                matrix: "reduced Newton matrix",
+                r,
+                source: Box::new(e),
+            })
         })?;
         self.newton_ok = true;
         Ok(())

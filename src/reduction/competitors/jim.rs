@@ -167,12 +167,11 @@ fn condensed_modes(
     let g = xs.transpose() * &mx;
     let g = Mat::from_fn(p, p, |a, b| 0.5 * (g[(a, b)] + g[(b, a)]));
     let llt = f.llt(Side::Lower).map_err(|e| {
-        Error::LinearAlgebra(LinalgError::caused_by(
-            format!(
-            "Joint Interface Modes: the {p}×{p} joint flexibility is not positive definite: {e:?}"
-        ),
-            e,
-        ))
+        Error::LinearAlgebra(LinalgError::NotPositiveDefinite {
+            what: format!("Joint Interface Modes: the {p}×{p} joint flexibility"),
+            hint: "",
+            source: Box::new(e),
+        })
     })?;
     let l = llt.L();
     // C = L⁻¹ G L⁻ᵀ: Y = L⁻¹ G, then C = L⁻¹ Yᵀ.
@@ -202,10 +201,11 @@ fn condensed_modes(
             let ugu: f64 = (0..p).map(|a| ui[a] * gu[a]).sum();
             let ufu: f64 = (0..p).map(|a| ui[a] * fu[a]).sum();
             if !(ugu > 0.0 && ufu > 0.0) {
-                return Err(Error::LinearAlgebra(
-                    format!("Joint Interface Modes: mode {k} has uᵀGu = {ugu:e}, uᵀFu = {ufu:e}")
-                        .into(),
-                ));
+                return Err(Error::LinearAlgebra(LinalgError::JimProducts {
+                    mode: k,
+                    ugu,
+                    ufu,
+                }));
             }
             lambda.push(ufu / ugu);
             let inv = 1.0 / ugu.sqrt();
@@ -270,9 +270,10 @@ pub fn joint_interface_modes(
     let kii = SparseCholesky::new(&model.stiffness.leading(m))?;
     kii.solve_in_place(&mut x);
     if x.col_iter().any(|c| c.iter().any(|v| !v.is_finite())) {
-        return Err(Error::LinearAlgebra(
-            "Joint Interface Modes: static responses are not finite".into(),
-        ));
+        return Err(Error::LinearAlgebra(LinalgError::NotFinite {
+            what: "Joint Interface Modes: static responses".to_string(),
+            plural: true,
+        }));
     }
     let mut parts: Vec<(JimSet, Vec<f64>, Mat<f64>, usize)> = Vec::new();
     let mut start = 0;
@@ -294,15 +295,11 @@ pub fn joint_interface_modes(
     picks.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
     picks.truncate(count);
     if let Some(&(_, s, k)) = picks.iter().find(|p| !p.0.is_finite()) {
-        return Err(Error::LinearAlgebra(
-            format!(
-                "Joint Interface Mode {} of the {} set has a numerically infinite frequency \
-             (condensed mass eigenvalue ≤ 1e-12 of the largest): request fewer than {count}",
-                k + 1,
-                parts[s].0.name()
-            )
-            .into(),
-        ));
+        return Err(Error::LinearAlgebra(LinalgError::JimInfiniteFrequency {
+            mode: k + 1,
+            set: parts[s].0.name(),
+            count,
+        }));
     }
     let mut vectors = Mat::<f64>::zeros(n, count);
     let mut mphi = vec![0.0; n];
@@ -322,9 +319,10 @@ pub fn joint_interface_modes(
             .sum::<f64>()
             .sqrt();
         if !(norm.is_finite() && norm > 0.0) {
-            return Err(Error::LinearAlgebra(
-                format!("Joint Interface Mode {c} has M-norm {norm:e}").into(),
-            ));
+            return Err(Error::LinearAlgebra(LinalgError::ModeNorm {
+                what: format!("Joint Interface Mode {c}"),
+                norm,
+            }));
         }
         full.iter_mut().for_each(|v| *v /= norm);
         for r in 0..m {
