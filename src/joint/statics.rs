@@ -60,7 +60,7 @@ use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
 use faer::{Mat, MatRef, Side};
 
-use crate::error::Error;
+use crate::error::{Error, JointError};
 use crate::joint::{JointOperator, NORMAL};
 use crate::linalg::compensated::{Dot2, REFINEMENT_STEPS};
 use crate::linalg::LinalgError;
@@ -132,7 +132,7 @@ pub struct ContactSolution {
 /// write all pairs' normal gaps (mm) into `gaps`; it keeps its own solution vector, which on
 /// success belongs to the returned (converged) active set, since the last call is made with it.
 ///
-/// Errors: invalid `k_n` or options ([`Error::Invalid`]), a failure of `solve`, non-finite gaps,
+/// Errors: invalid `k_n` or options ([`Error::Joint`]), a failure of `solve`, non-finite gaps,
 /// a revisited active set (cycle) or more than `opts.max_iterations` solves
 /// ([`Error::LinearAlgebra`]).
 pub fn active_set_newton<S>(
@@ -145,14 +145,10 @@ where
     S: FnMut(&[bool], &mut [f64]) -> Result<(), Error>,
 {
     if !(k_n.is_finite() && k_n > 0.0) {
-        return Err(Error::Invalid(format!(
-            "contact normal stiffness must be finite and positive, got {k_n} N/mm"
-        )));
+        return Err(JointError::NormalStiffness { k_n }.into());
     }
     if opts.max_iterations == 0 {
-        return Err(Error::Invalid(
-            "contact options: max_iterations must be at least 1".into(),
-        ));
+        return Err(JointError::NoIterations.into());
     }
     let mut active = vec![opts.start == ActiveStart::Closed; pairs];
     let mut gaps = vec![0.0; pairs];
@@ -219,11 +215,12 @@ pub fn contact_static_sparse(
 ) -> Result<(Vec<f64>, ContactState), Error> {
     let n = k.n;
     if joint.dofs() != n || f.len() != n {
-        return Err(Error::Invalid(format!(
-            "contact statics: K is {n}×{n}, the joint operator has {} columns and the load {} entries",
-            joint.dofs(),
-            f.len()
-        )));
+        return Err(JointError::StaticsSizes {
+            n,
+            joint_dofs: joint.dofs(),
+            load: f.len(),
+        }
+        .into());
     }
     let pattern = ContactPattern::new(k, joint)?;
     let mut values = vec![0.0; pattern.row_idx.len()];
@@ -280,14 +277,12 @@ pub fn contact_static_reduced(
 ) -> Result<(Vec<f64>, ContactState), Error> {
     let r = k_red.nrows();
     if k_red.ncols() != r || b_n_phi.ncols() != r || f_red.len() != r {
-        return Err(Error::Invalid(format!(
-            "reduced contact statics: K_r is {}×{}, B_n Φ is {}×{}, f_r has {} entries",
-            k_red.nrows(),
-            k_red.ncols(),
-            b_n_phi.nrows(),
-            b_n_phi.ncols(),
-            f_red.len()
-        )));
+        return Err(JointError::ReducedStaticsSizes {
+            k_r: (k_red.nrows(), k_red.ncols()),
+            b_n_phi: (b_n_phi.nrows(), b_n_phi.ncols()),
+            load: f_red.len(),
+        }
+        .into());
     }
     let w = b_n_phi.nrows();
     // Nonzero columns of each pair row (B_n Φ is sparse when Φ selects DOF).

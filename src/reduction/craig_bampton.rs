@@ -2,7 +2,7 @@
 
 use faer::Mat;
 
-use crate::error::Error;
+use crate::error::{Error, ReductionError};
 use crate::linalg::cholesky::SparseCholesky;
 use crate::linalg::eigen::lowest_modes_factored;
 use crate::linalg::LinalgError;
@@ -22,24 +22,26 @@ use crate::model::Model;
 pub fn craig_bampton(model: &Model, nu: usize) -> Result<Mat<f64>, Error> {
     let n = model.dofs();
     if n <= 6 {
-        return Err(Error::Invalid(format!(
-            "Craig–Bampton needs interior DOF: the model has only {n} DOF"
-        )));
+        return Err(ReductionError::NoInteriorDofs {
+            method: "Craig–Bampton",
+            dofs: n,
+        }
+        .into());
     }
     let m = n - 6;
     if nu > m {
-        return Err(Error::Invalid(format!(
-            "--nu {nu}: the model has only {m} interior DOF, so at most {m} fixed-interface \
-             modes"
-        )));
+        return Err(ReductionError::FixedInterfaceModes { nu, interior: m }.into());
     }
     let master = model.master_dofs();
     for (c, &d) in master.iter().enumerate() {
         if d != m + c {
-            return Err(Error::Invalid(format!(
-                "Craig–Bampton expects the master DOF last: master DOF {c} is independent DOF {d}, not {}",
-                m + c
-            )));
+            return Err(ReductionError::MasterNotLast {
+                method: "Craig–Bampton",
+                master: c,
+                dof: d,
+                expected: m + c,
+            }
+            .into());
         }
     }
     let k = &model.stiffness;

@@ -44,7 +44,7 @@ use std::time::Instant;
 use faer::{Mat, MatRef};
 use serde::{Deserialize, Serialize};
 
-use crate::error::Error;
+use crate::error::{Error, ReductionError};
 use crate::files;
 use crate::linalg::compensated::{solve_refined_steps, sym_mul_compensated};
 use crate::linalg::sparse::sym_mul_mat;
@@ -169,10 +169,10 @@ pub fn prepare(model: &Model, nu: usize, dir: &Path) -> Result<NativeReference, 
     drop(base);
     seconds.rhs = t.elapsed().as_secs_f64();
     if rhs.ncols() == 0 {
-        return Err(Error::Invalid(format!(
-            "distributed: {} has no TVD right-hand sides (no joint pair is ever active)",
-            files::printable(&model.name)
-        )));
+        return Err(ReductionError::NoTvdRhs {
+            case: files::printable(&model.name).to_string(),
+        }
+        .into());
     }
 
     let t = Instant::now();
@@ -202,7 +202,7 @@ pub fn prepare(model: &Model, nu: usize, dir: &Path) -> Result<NativeReference, 
         files: job_files(),
     };
     let text = serde_json::to_string_pretty(&manifest)
-        .map_err(|e| Error::Invalid(format!("distributed: job manifest: {e}")))?;
+        .map_err(|source| ReductionError::JobManifest { source })?;
     files::write_atomic(&dir.join("job.json"), text)?;
     seconds.export = t.elapsed().as_secs_f64();
     Ok(NativeReference {

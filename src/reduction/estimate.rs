@@ -113,7 +113,7 @@ use std::sync::{Arc, Mutex};
 
 use faer::{Mat, MatRef};
 
-use crate::error::Error;
+use crate::error::{Error, ReductionError};
 use crate::joint::law::PairLaw;
 use crate::joint::JointOperator;
 use crate::joint::{NORMAL, T1, T2};
@@ -429,22 +429,20 @@ impl JointFlexibility {
     /// carries Φ, of this model's DOF and pairs.
     ///
     /// # Errors
-    /// [`Error::Invalid`] saying which of these fails.
+    /// [`Error::Reduction`] saying which of these fails.
     pub fn basis_of<'r>(&self, rom: &'r ReducedSystem) -> Result<&'r Mat<f64>, Error> {
-        let phi = rom.phi.as_ref().ok_or_else(|| {
-            Error::Invalid(
-                "error estimate: the reduced model carries no basis Φ (read from a file)".into(),
-            )
-        })?;
+        let phi = rom
+            .phi
+            .as_ref()
+            .ok_or_else(|| Error::Reduction(ReductionError::EstimateNoBasis))?;
         if phi.nrows() != self.stiffness.n || rom.pairs() != self.pairs() {
-            return Err(Error::Invalid(format!(
-                "error estimate: basis {}×{} with {} pairs does not fit the model ({} DOF, {} pairs)",
-                phi.nrows(),
-                phi.ncols(),
-                rom.pairs(),
-                self.stiffness.n,
-                self.pairs()
-            )));
+            return Err(ReductionError::EstimateBasis {
+                basis: (phi.nrows(), phi.ncols()),
+                basis_pairs: rom.pairs(),
+                dofs: self.stiffness.n,
+                pairs: self.pairs(),
+            }
+            .into());
         }
         Ok(phi)
     }
@@ -628,9 +626,7 @@ impl ErrorEstimator<'_> {
             || states.p.len() != outputs * 3 * w
             || states.s.len() != outputs * ns
         {
-            return Err(Error::Invalid(format!(
-                "error estimate: run states do not fit {outputs} outputs of r = {r}, w = {w}"
-            )));
+            return Err(ReductionError::EstimateStates { outputs, r, w }.into());
         }
         let qdd = self.accelerations(states)?;
         let load = Mat::from_fn(6, outputs, |d, j| self.rom.load.master_at(states.t[j])[d]);
@@ -768,9 +764,7 @@ impl ErrorEstimator<'_> {
             rom.joint_transpose_add(&neg_p, &mut rhs);
             rom.solve_m_in_place(&mut rhs);
             if let Some(v) = rhs.iter().find(|v| !v.is_finite()) {
-                return Err(Error::Invalid(format!(
-                    "error estimate: reduced acceleration at t = {t:e} s is not finite ({v})"
-                )));
+                return Err(ReductionError::EstimateAcceleration { t, value: *v }.into());
             }
             for (i, v) in rhs.iter().enumerate() {
                 acc[(i, j)] = *v;

@@ -2,7 +2,7 @@
 
 use faer::{Mat, MatRef};
 
-use crate::error::Error;
+use crate::error::{Error, ReductionError};
 use crate::linalg::sparse::sym_mul_mat;
 use crate::linalg::symmetric_eigen;
 use crate::linalg::LinalgError;
@@ -219,10 +219,7 @@ pub fn pod(y: MatRef<'_, f64>, weight: Option<&SymCsc>) -> Result<Pod, Error> {
     let p = y.ncols();
     if let Some(a) = weight {
         if a.n != n {
-            return Err(Error::Invalid(format!(
-                "POD weight is {0}×{0}, the vectors have {1} rows",
-                a.n, n
-            )));
+            return Err(ReductionError::PodWeight { n: a.n, rows: n }.into());
         }
     }
     if p == 0 {
@@ -235,7 +232,10 @@ pub fn pod(y: MatRef<'_, f64>, weight: Option<&SymCsc>) -> Result<Pod, Error> {
         });
     }
     if y.col_iter().any(|c| c.iter().any(|v| !v.is_finite())) {
-        return Err(Error::Invalid("POD: the vectors are not finite".into()));
+        return Err(ReductionError::NotFinite {
+            what: "POD: the vectors are",
+        }
+        .into());
     }
     // Orthonormal basis Q_T (p × ℓ) of the row space of Y, W = Y Q_T.
     let (w_mat, k) = row_space(y)?;
@@ -314,12 +314,14 @@ fn pod_tvd_with(model: &Model, tvd: &Tvd, weighted: bool, want_poms: bool) -> Re
     let n = tvd.vectors.nrows();
     let (m, p) = (f.coefficients.nrows(), f.coefficients.ncols());
     if f.flexibility.nrows() != n || f.flexibility.ncols() != m || p != tvd.vectors.ncols() {
-        return Err(Error::Invalid(format!(
-            "TVD factor form is {}×{} times {m}×{p}, the vectors {n}×{}",
-            f.flexibility.nrows(),
-            f.flexibility.ncols(),
-            tvd.vectors.ncols()
-        )));
+        return Err(ReductionError::TvdFactorForm {
+            flexibility: (f.flexibility.nrows(), f.flexibility.ncols()),
+            m,
+            p,
+            n,
+            columns: tvd.vectors.ncols(),
+        }
+        .into());
     }
     if p == 0 || m == 0 {
         return pod(tvd.vectors.as_ref(), weight);
@@ -328,9 +330,10 @@ fn pod_tvd_with(model: &Model, tvd: &Tvd, weighted: bool, want_poms: bool) -> Re
         .col_iter()
         .any(|c| c.iter().any(|v| !v.is_finite()))
     {
-        return Err(Error::Invalid(
-            "POD: the TVD coefficients are not finite".into(),
-        ));
+        return Err(ReductionError::NotFinite {
+            what: "POD: the TVD coefficients are",
+        }
+        .into());
     }
     // A = Rᵀ C (weighted) or R_Z C (plain), m × p; `left` maps A's left singular vectors to POMs
     // for the plain route.

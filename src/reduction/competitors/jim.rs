@@ -60,7 +60,7 @@ use faer::linalg::triangular_solve::{
 };
 use faer::{Mat, Par, Side};
 
-use crate::error::Error;
+use crate::error::{Error, ReductionError};
 use crate::linalg::cholesky::SparseCholesky;
 use crate::linalg::symmetric_eigen;
 use crate::linalg::LinalgError;
@@ -108,20 +108,20 @@ pub fn jim_dofs(model: &Model, set: JimSet) -> Result<Vec<usize>, Error> {
             JimSet::InPlane => &in_plane,
             JimSet::Both => &[a, in_plane[0], in_plane[1]],
         };
-        let deps = model.dof_map.nodes.get(node).ok_or_else(|| {
-            Error::Invalid(format!(
-                "joint pair names node {node}, which does not exist"
-            ))
-        })?;
+        let deps = model
+            .dof_map
+            .nodes
+            .get(node)
+            .ok_or_else(|| Error::Reduction(ReductionError::UnknownJointNode { node }))?;
         for &d in dirs {
             match deps[d].as_free() {
                 Some(i) if i < m => out.push(i),
                 _ => {
-                    return Err(Error::Invalid(format!(
-                        "Joint Interface Modes: joint node {node}, direction {} is not an \
-                         independent interior DOF (clamped, tied or the master node)",
-                        ["x", "y", "z"][d]
-                    )))
+                    return Err(ReductionError::JimDependentDof {
+                        node,
+                        axis: ["x", "y", "z"][d],
+                    }
+                    .into())
                 }
             }
         }
@@ -130,20 +130,25 @@ pub fn jim_dofs(model: &Model, set: JimSet) -> Result<Vec<usize>, Error> {
 }
 
 /// The interior size m = n − 6, checking that the master DOF are the last six.
-pub(crate) fn interior_size(model: &Model, what: &str) -> Result<usize, Error> {
+pub(crate) fn interior_size(model: &Model, what: &'static str) -> Result<usize, Error> {
     let n = model.dofs();
     if n <= 6 {
-        return Err(Error::Invalid(format!(
-            "{what} needs interior DOF: the model has only {n} DOF"
-        )));
+        return Err(ReductionError::NoInteriorDofs {
+            method: what,
+            dofs: n,
+        }
+        .into());
     }
     let m = n - 6;
     for (c, &d) in model.master_dofs().iter().enumerate() {
         if d != m + c {
-            return Err(Error::Invalid(format!(
-                "{what} expects the master DOF last: master DOF {c} is independent DOF {d}, not {}",
-                m + c
-            )));
+            return Err(ReductionError::MasterNotLast {
+                method: what,
+                master: c,
+                dof: d,
+                expected: m + c,
+            }
+            .into());
         }
     }
     Ok(m)
@@ -239,10 +244,12 @@ pub fn joint_interface_modes(
         JimSet::Both => normal.len() + in_plane.len(),
     };
     if count > available {
-        return Err(Error::Invalid(format!(
-            "{count} Joint Interface Modes requested, the {} set has {available} joint DOF",
-            set.name()
-        )));
+        return Err(ReductionError::JimCount {
+            count,
+            set: set.name(),
+            available,
+        }
+        .into());
     }
     if count == 0 {
         return Ok(JointInterfaceModes {
