@@ -1,4 +1,9 @@
 //! The crate's error type: one enum, a variant per layer, each naming what was wrong and where.
+//! The layers' own typed reasons live here too, so that every layer can use them and this
+//! module imports nothing from the layers but [`LinalgError`]: [`ElementError`] (elements and
+//! materials), the request errors of `request.rs` ([`ModelError`], [`JointError`],
+//! [`SystemError`], [`ReductionError`], [`IntegrationError`], [`ReportError`]), and SUNDIALS'
+//! return flag [`CvodeFlag`].
 
 use std::path::PathBuf;
 
