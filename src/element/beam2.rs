@@ -80,7 +80,7 @@
 use faer::Mat;
 
 use super::Material;
-use crate::error::Error;
+use crate::error::{ElementError, Error};
 
 /// Number of DOF of the element (2 nodes × 6).
 const NDOF: usize = 12;
@@ -121,21 +121,17 @@ impl Beam2 {
         let d = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
         let length = norm(d);
         if !(length.is_finite() && length > 0.0) {
-            return Err(Error::Element(format!(
-                "Beam2: length |b - a| = {length} mm between a = {a:?} and b = {b:?} \
-                 (need a finite length > 0)"
-            )));
+            return Err(ElementError::Beam2Length { length, a, b }.into());
         }
         if !(diameter.is_finite() && diameter > 0.0) {
-            return Err(Error::Element(format!(
-                "Beam2: diameter = {diameter} mm between a = {a:?} and b = {b:?} \
-                 (need a finite diameter > 0)"
-            )));
+            return Err(ElementError::Beam2Diameter { diameter, a, b }.into());
         }
         material.validate().map_err(|e| match e {
-            Error::Element(m) => {
-                Error::Element(format!("Beam2 between a = {a:?} and b = {b:?}: {m}"))
-            }
+            Error::Element(source) => Error::Element(ElementError::Beam2Material {
+                a,
+                b,
+                source: Box::new(source),
+            }),
             other => other,
         })?;
 
@@ -157,10 +153,13 @@ impl Beam2 {
         let k = beam.local_stiffness();
         let m = beam.local_mass();
         if k.iter().chain(m.iter()).flatten().any(|x| !x.is_finite()) {
-            return Err(Error::Element(format!(
-                "Beam2: L = {length} mm, d = {diameter} mm between a = {a:?} and b = {b:?} \
-                 give a stiffness or mass that is not representable in f64"
-            )));
+            return Err(ElementError::Beam2NotRepresentable {
+                length,
+                diameter,
+                a,
+                b,
+            }
+            .into());
         }
         Ok(beam)
     }

@@ -16,4 +16,5 @@ pub use beam2::Beam2;
 pub use shell4::Shell4;
 pub use weld::Weld;
 
+pub use crate::error::{ElementError, WeldLayerProblem};
 pub use crate::mesh::Material;

@@ -61,7 +61,7 @@
 use faer::Mat;
 
 use super::Material;
-use crate::error::Error;
+use crate::error::{ElementError, Error};
 
 const NODE_R: [f64; 4] = [-1.0, 1.0, 1.0, -1.0];
 const NODE_S: [f64; 4] = [-1.0, -1.0, 1.0, 1.0];
@@ -208,14 +208,10 @@ impl Shell4 {
     pub fn new(nodes: [[f64; 3]; 4], thickness: f64, material: Material) -> Result<Shell4, Error> {
         material.validate()?;
         if !(thickness.is_finite() && thickness > 0.0) {
-            return Err(Error::Element(format!(
-                "Shell4 thickness must be positive and finite, got {thickness} mm"
-            )));
+            return Err(ElementError::Shell4Thickness { thickness }.into());
         }
         if nodes.iter().flatten().any(|c| !c.is_finite()) {
-            return Err(Error::Element(format!(
-                "Shell4 node coordinates are not finite: {nodes:?}"
-            )));
+            return Err(ElementError::Shell4NotFinite { nodes }.into());
         }
         let centre = scale(
             [0, 1, 2].map(|k| nodes.iter().map(|p| p[k]).sum::<f64>()),
@@ -227,17 +223,17 @@ impl Shell4 {
         let size = norm(d13).max(norm(d24));
         let area2 = norm(normal);
         if size == 0.0 || area2 <= 1e-12 * size * size {
-            return Err(Error::Element(format!(
-                "Shell4 is degenerate (zero area): {nodes:?}"
-            )));
+            return Err(ElementError::Shell4Degenerate { nodes }.into());
         }
         let n = scale(normal, 1.0 / area2);
         for p in &nodes {
             let off = dot(sub(*p, centre), n);
             if off.abs() > 1e-6 * size {
-                return Err(Error::Element(format!(
-                    "Shell4 is warped: node {p:?} lies {off:.3e} mm off the element plane (flat elements only)"
-                )));
+                return Err(ElementError::Shell4Warped {
+                    node: *p,
+                    offset: off,
+                }
+                .into());
             }
         }
         let mut e1 = sub(
@@ -247,9 +243,7 @@ impl Shell4 {
         e1 = sub(e1, scale(n, dot(e1, n)));
         let e1n = norm(e1);
         if e1n <= 1e-12 * size {
-            return Err(Error::Element(format!(
-                "Shell4 has no usable edge direction: {nodes:?}"
-            )));
+            return Err(ElementError::Shell4NoEdge { nodes }.into());
         }
         let e1 = scale(e1, 1.0 / e1n);
         let e2 = cross(n, e1);
@@ -266,9 +260,7 @@ impl Shell4 {
         };
         for &(r, s) in GAUSS_POINTS.iter().chain(&[(0.0, 0.0)]) {
             if shell.shape_at(r, s).det_j <= 0.0 {
-                return Err(Error::Element(format!(
-                    "Shell4 is not convex or its nodes are not in cyclic order: {nodes:?}"
-                )));
+                return Err(ElementError::Shell4NotConvex { nodes }.into());
             }
         }
         Ok(shell)

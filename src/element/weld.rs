@@ -80,7 +80,7 @@ use faer::linalg::solvers::Solve;
 use faer::{Mat, Side};
 
 use super::{Beam2, Material};
-use crate::error::Error;
+use crate::error::{ElementError, Error, WeldLayerProblem};
 use crate::mesh::{NuggetLayer, WeldElem, WeldPatch};
 
 /// An area spot weld through a stack of sheets (see the module docs). Its matrices are on the
@@ -132,7 +132,10 @@ impl Weld {
             })
             .collect::<Result<Vec<_>, _>>()
             .map_err(|e| match e {
-                Error::Element(m) => Error::Element(format!("welds[{}]: {m}", weld.index)),
+                Error::Element(source) => Error::Element(ElementError::InWeld {
+                    index: weld.index,
+                    source: Box::new(source),
+                }),
                 other => other,
             })?;
         Ok(Weld {
@@ -247,16 +250,16 @@ fn reference_map(
     layer: &NuggetLayer,
     touched: &[usize],
 ) -> Result<Mat<f64>, Error> {
-    let fail = |why: &str| {
-        Error::Element(format!(
-            "welds[{}] at (x, z) = ({}, {}) mm on sheet {}: {why}",
-            weld.index, weld.centre[0], weld.centre[1], layer.sheet
-        ))
+    let fail = |problem: WeldLayerProblem| {
+        Error::Element(ElementError::WeldLayer {
+            index: weld.index,
+            centre: weld.centre,
+            sheet: layer.sheet,
+            problem,
+        })
     };
     if layer.points.len() < 3 {
-        return Err(fail(
-            "fewer than three points of the nugget lie inside the sheets",
-        ));
+        return Err(fail(WeldLayerProblem::TooFewPoints));
     }
     let offset = |p: [f64; 2]| [p[0] - weld.centre[0], 0.0, p[1] - weld.centre[1]];
     let area: f64 = layer.points.iter().map(|p| p.weight).sum();
@@ -282,7 +285,7 @@ fn reference_map(
     }
     let llt = a
         .llt(Side::Lower)
-        .map_err(|_| fail("the nugget's points are collinear: no rigid fit"))?;
+        .map_err(|_| fail(WeldLayerProblem::Collinear))?;
     let dofs = 6 * touched.len();
     let mut rhs = Mat::<f64>::zeros(6, dofs);
     for p in &layer.points {

@@ -68,7 +68,7 @@ use faer::Mat;
 
 use super::shell4::dkmq_phi;
 use super::{Material, Shell4};
-use crate::error::Error;
+use crate::error::{ElementError, Error};
 use crate::linalg::{SparseCholesky, SymCsc};
 use crate::mesh::{line_cell, NuggetLayer, PatchLayer, WeldElem, WeldPatch};
 
@@ -333,10 +333,14 @@ fn add_slab(
             .zip(&upper.points)
             .all(|(a, b)| a.xz == b.xz && a.weight == b.weight);
     if !same || gap.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
-        return Err(Error::Element(format!(
-            "welds[{index}]: the nugget is not sampled alike on sheets {} and {}",
-            lower.sheet, upper.sheet
-        )));
+        return Err(ElementError::InWeld {
+            index,
+            source: Box::new(ElementError::NuggetSampling {
+                lower: lower.sheet,
+                upper: upper.sheet,
+            }),
+        }
+        .into());
     }
     let e = material.youngs_modulus;
     let g = e / (2.0 * (1.0 + material.poisson_ratio));
@@ -454,11 +458,9 @@ pub(super) fn condense(
             weld.index,
         )?;
     }
-    let what = |e: Error| {
-        Error::Element(format!(
-            "welds[{}]: the re-meshed neighbourhood's internal stiffness: {e}",
-            weld.index
-        ))
+    let what = |source| ElementError::InWeld {
+        index: weld.index,
+        source: Box::new(ElementError::NeighbourhoodStiffness { source }),
     };
     let kii = k.ii_matrix();
     let chol = SparseCholesky::new(&kii).map_err(what)?;

@@ -47,7 +47,7 @@ use super::mechanical::{EnergySample, MechanicalOde, ProblemOptions};
 use super::problem::{OdeOptions, OdeProblem, OdeStats};
 use super::sundials::Cvode;
 use crate::case::ContactSpec;
-use crate::error::Error;
+use crate::error::{Error, IntegrationError};
 use crate::system::SecondOrderSystem;
 
 /// A mechanical run advanced from outside (see the module docs).
@@ -71,7 +71,7 @@ impl<S: SecondOrderSystem> Stepper<S> {
     /// system's own load until [`Stepper::set_load`].
     ///
     /// # Errors
-    /// [`Error::Invalid`] for a non-finite `t0` or a bad option (naming it), errors of the
+    /// [`Error::Integration`] for a non-finite `t0` or a bad option (naming it), errors of the
     /// integrator's setup ([`Error::Sundials`] naming the C function).
     pub fn new(
         system: S,
@@ -81,9 +81,7 @@ impl<S: SecondOrderSystem> Stepper<S> {
         problem: &ProblemOptions,
     ) -> Result<Stepper<S>, Error> {
         if !t0.is_finite() {
-            return Err(Error::Invalid(format!(
-                "the start time must be finite, got {t0} s"
-            )));
+            return Err(IntegrationError::StartTime { t0 }.into());
         }
         let mut mech = MechanicalOde::new(system, contact, problem)?;
         let y = mech.initial_state();
@@ -141,7 +139,7 @@ impl<S: SecondOrderSystem> Stepper<S> {
     /// Integrates to `t_next` (s, after the current time) and returns the outputs there.
     ///
     /// # Errors
-    /// [`Error::Invalid`] for a `t_next` that is not finite or not after the current time, or
+    /// [`Error::Integration`] for a `t_next` that is not finite or not after the current time, or
     /// an output that is not finite at `t_next` (an overflow); integrator failures
     /// ([`Error::Sundials`] with the flag and the time reached — `CV_TOO_MUCH_WORK` after
     /// [`OdeOptions::max_steps`] internal steps in this advance —, [`Error::Callback`],
@@ -150,9 +148,7 @@ impl<S: SecondOrderSystem> Stepper<S> {
     pub fn advance(&mut self, t_next: f64) -> Result<&EnergySample, Error> {
         let t = self.cv.t();
         if !(t_next.is_finite() && t_next > t) {
-            return Err(Error::Invalid(format!(
-                "a step must end after the current time {t} s, got {t_next} s"
-            )));
+            return Err(IntegrationError::StepEnd { t, t_next }.into());
         }
         if self.restart {
             self.y.copy_from_slice(self.cv.y());
@@ -167,10 +163,7 @@ impl<S: SecondOrderSystem> Stepper<S> {
         self.y.copy_from_slice(self.cv.y());
         let s = self.cv.problem_mut().sample(t, &self.y);
         if let Some(what) = non_finite(&s) {
-            return Err(Error::Invalid(format!(
-                "the run's {what} is not finite at t = {t} s (an overflow: check k_n, k_t and \
-                 the load)"
-            )));
+            return Err(IntegrationError::OutputNotFinite { what, t }.into());
         }
         self.last = s;
         Ok(&self.last)

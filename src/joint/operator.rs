@@ -18,7 +18,7 @@
 use faer::{Mat, MatRef};
 
 use crate::assembly::DofMap;
-use crate::error::Error;
+use crate::error::{Error, JointError};
 use crate::joint::PairFrame;
 
 /// Row kinds within a pair's three rows.
@@ -51,22 +51,22 @@ impl JointOperator {
             for dir in pair.directions() {
                 let mut entries: Vec<(usize, f64)> = Vec::new();
                 for (node, sign) in [(pair.upper, 1.0), (pair.lower, -1.0)] {
-                    let dep = map.nodes.get(node).ok_or_else(|| {
-                        Error::Invalid(format!(
-                            "joint pair {k} names node {node}, which does not exist"
-                        ))
-                    })?;
+                    let dep = map
+                        .nodes
+                        .get(node)
+                        .ok_or_else(|| Error::Joint(JointError::UnknownNode { pair: k, node }))?;
                     for (axis, &w) in dir.iter().enumerate() {
                         if w == 0.0 {
                             continue;
                         }
                         let terms: Vec<(usize, f64)> = dep[axis].terms().collect();
                         if terms.is_empty() {
-                            return Err(Error::Invalid(format!(
-                                "joint pair {k}: node {node} has no independent {} translation \
-                                 (clamped or not in the matrices); a joint node must move",
-                                ["x", "y", "z"][axis]
-                            )));
+                            return Err(JointError::FixedNode {
+                                pair: k,
+                                node,
+                                axis: ["x", "y", "z"][axis],
+                            }
+                            .into());
                         }
                         for (i, c) in terms {
                             entries.push((i, sign * w * c));

@@ -60,7 +60,7 @@ use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
 use faer::{Mat, MatRef, Side};
 
-use crate::error::Error;
+use crate::error::{Error, JointError};
 use crate::joint::{JointOperator, NORMAL};
 use crate::linalg::compensated::{Dot2, REFINEMENT_STEPS};
 use crate::linalg::sparse::column_pattern;
@@ -133,7 +133,7 @@ pub struct ContactSolution {
 /// write all pairs' normal gaps (mm) into `gaps`; it keeps its own solution vector, which on
 /// success belongs to the returned (converged) active set, since the last call is made with it.
 ///
-/// Errors: invalid `k_n` or options ([`Error::Invalid`]), a failure of `solve`, non-finite gaps,
+/// Errors: invalid `k_n` or options ([`Error::Joint`]), a failure of `solve`, non-finite gaps,
 /// a revisited active set (cycle) or more than `opts.max_iterations` solves
 /// ([`Error::LinearAlgebra`]).
 pub fn active_set_newton<S>(
@@ -146,14 +146,10 @@ where
     S: FnMut(&[bool], &mut [f64]) -> Result<(), Error>,
 {
     if !(k_n.is_finite() && k_n > 0.0) {
-        return Err(Error::Invalid(format!(
-            "contact normal stiffness must be finite and positive, got {k_n} N/mm"
-        )));
+        return Err(JointError::NormalStiffness { k_n }.into());
     }
     if opts.max_iterations == 0 {
-        return Err(Error::Invalid(
-            "contact options: max_iterations must be at least 1".into(),
-        ));
+        return Err(JointError::NoIterations.into());
     }
     let mut active = vec![opts.start == ActiveStart::Closed; pairs];
     let mut gaps = vec![0.0; pairs];
@@ -165,13 +161,11 @@ where
         active_counts.push(active.iter().filter(|&&a| a).count());
         solve(&active, &mut gaps)?;
         if let Some(i) = gaps.iter().position(|g| !g.is_finite()) {
-            return Err(Error::LinearAlgebra(
-                format!(
-                    "contact iteration {it}: gap of pair {i} is not finite ({})",
-                    gaps[i]
-                )
-                .into(),
-            ));
+            return Err(Error::LinearAlgebra(LinalgError::GapNotFinite {
+                context: format!("contact iteration {it}"),
+                pair: i,
+                value: Some(gaps[i]),
+            }));
         }
         let next: Vec<bool> = gaps.iter().map(|&g| g < 0.0).collect();
         if next == active {
@@ -194,26 +188,21 @@ where
         }
         if let Some(&first) = visited.get(&next) {
             let len = it + 1 - first;
-            return Err(Error::LinearAlgebra(
-                format!(
-                    "contact active-set Newton cycles: the active set after iteration {it} \
-                 ({} pairs in contact) repeats that of iteration {first} (cycle of length {len})",
-                    next.iter().filter(|&&a| a).count()
-                )
-                .into(),
-            ));
+            return Err(Error::LinearAlgebra(LinalgError::ActiveSetCycle {
+                iteration: it,
+                in_contact: next.iter().filter(|&&a| a).count(),
+                first,
+                length: len,
+            }));
         }
         active = next;
     }
     let last = active_counts.last().copied().unwrap_or(0);
-    Err(Error::LinearAlgebra(
-        format!(
-            "contact active-set Newton did not converge in {} iterations \
-         (last active set: {last} of {pairs} pairs)",
-            opts.max_iterations
-        )
-        .into(),
-    ))
+    Err(Error::LinearAlgebra(LinalgError::ActiveSetNotConverged {
+        iterations: opts.max_iterations,
+        last,
+        pairs,
+    }))
 }
 
 /// Frictionless penalty contact statics of a sparse system `K q = f − B_nᵀ p` with the normal
@@ -227,11 +216,12 @@ pub fn contact_static_sparse(
 ) -> Result<(Vec<f64>, ContactState), Error> {
     let n = k.n;
     if joint.dofs() != n || f.len() != n {
-        return Err(Error::Invalid(format!(
-            "contact statics: K is {n}×{n}, the joint operator has {} columns and the load {} entries",
-            joint.dofs(),
-            f.len()
-        )));
+        return Err(JointError::StaticsSizes {
+            n,
+            joint_dofs: joint.dofs(),
+            load: f.len(),
+        }
+        .into());
     }
     let pattern = ContactPattern::new(k, joint)?;
     let mut values = vec![0.0; pattern.row_idx.len()];
@@ -243,13 +233,14 @@ pub fn contact_static_sparse(
         let mat = SparseColMatRef::new(pattern.symbolic_matrix.as_ref(), &values);
         let llt = Llt::try_new_with_symbolic(pattern.symbolic_llt.clone(), mat, Side::Lower)
             .map_err(|e| {
-                Error::LinearAlgebra(LinalgError::caused_by(
-                    format!(
-                        "K + K_c ({n}×{n}, {} pairs active) is not positive definite: {e:?}",
+                Error::LinearAlgebra(LinalgError::NotPositiveDefinite {
+                    what: format!(
+                        "K + K_c ({n}×{n}, {} pairs active)",
                         active.iter().filter(|&&a| a).count()
                     ),
-                    e,
-                ))
+                    hint: "",
+                    source: Box::new(e),
+                })
             })?;
         for i in 0..n {
             rhs[(i, 0)] = f[i];
@@ -287,14 +278,12 @@ pub fn contact_static_reduced(
 ) -> Result<(Vec<f64>, ContactState), Error> {
     let r = k_red.nrows();
     if k_red.ncols() != r || b_n_phi.ncols() != r || f_red.len() != r {
-        return Err(Error::Invalid(format!(
-            "reduced contact statics: K_r is {}×{}, B_n Φ is {}×{}, f_r has {} entries",
-            k_red.nrows(),
-            k_red.ncols(),
-            b_n_phi.nrows(),
-            b_n_phi.ncols(),
-            f_red.len()
-        )));
+        return Err(JointError::ReducedStaticsSizes {
+            k_r: (k_red.nrows(), k_red.ncols()),
+            b_n_phi: (b_n_phi.nrows(), b_n_phi.ncols()),
+            load: f_red.len(),
+        }
+        .into());
     }
     let w = b_n_phi.nrows();
     // Nonzero columns of each pair row (B_n Φ is sparse when Φ selects DOF).
@@ -316,13 +305,14 @@ pub fn contact_static_reduced(
             }
         }
         let llt = a.llt(Side::Lower).map_err(|e| {
-            Error::LinearAlgebra(LinalgError::caused_by(
-                format!(
-                    "reduced K_r + K_c ({r}×{r}, {} pairs active) is not positive definite: {e:?}",
+            Error::LinearAlgebra(LinalgError::NotPositiveDefinite {
+                what: format!(
+                    "reduced K_r + K_c ({r}×{r}, {} pairs active)",
                     active.iter().filter(|&&a| a).count()
                 ),
-                e,
-            ))
+                hint: "",
+                source: Box::new(e),
+            })
         })?;
         let mut x = llt.solve(&rhs);
         for _ in 0..REFINEMENT_STEPS {
@@ -405,10 +395,10 @@ impl ContactPattern {
             SymbolicSparseColMat::new_checked(n, n, col_ptr.clone(), None, row_idx.clone());
         let symbolic_llt =
             SymbolicLlt::try_new(symbolic_matrix.as_ref(), Side::Lower).map_err(|e| {
-                Error::LinearAlgebra(LinalgError::caused_by(
-                    format!("symbolic Cholesky of K + K_c ({n}×{n}): {e:?}"),
-                    e,
-                ))
+                Error::LinearAlgebra(LinalgError::Symbolic {
+                    what: format!("Cholesky of K + K_c ({n}×{n})"),
+                    source: Box::new(e),
+                })
             })?;
         Ok(ContactPattern {
             col_ptr,
@@ -484,14 +474,12 @@ pub fn contact_static_reduced_damped(
 ) -> Result<(Vec<f64>, ContactState), Error> {
     let (w, r) = (b_n_phi.nrows(), k_red.nrows());
     if k_red.ncols() != r || b_n_phi.ncols() != r || f.len() != r {
-        return Err(Error::Invalid(format!(
-            "damped reduced contact statics: K_r is {}×{}, B_n Φ is {}×{}, f_r has {} entries",
-            k_red.nrows(),
-            k_red.ncols(),
-            b_n_phi.nrows(),
-            b_n_phi.ncols(),
-            f.len()
-        )));
+        return Err(JointError::ReducedStaticsSizes {
+            k_r: (k_red.nrows(), k_red.ncols()),
+            b_n_phi: (b_n_phi.nrows(), b_n_phi.ncols()),
+            load: f.len(),
+        }
+        .into());
     }
     let b = b_n_phi;
     let gaps_of = |eta: &[f64]| -> Vec<f64> {
@@ -525,20 +513,19 @@ pub fn contact_static_reduced_damped(
             }
         }
         let llt = h.llt(Side::Lower).map_err(|e| {
-            Error::LinearAlgebra(LinalgError::caused_by(
-                format!(
-                    "damped reduced contact, step {it}: K̃ + K_c is not positive definite: {e:?}"
-                ),
-                e,
-            ))
+            Error::LinearAlgebra(LinalgError::NotPositiveDefinite {
+                what: format!("damped reduced contact, step {it}: K̃ + K_c"),
+                hint: "",
+                source: Box::new(e),
+            })
         })?;
         let rhs = Mat::from_fn(r, 1, |i, _| f[i]);
         let x = faer::linalg::solvers::Solve::solve(&llt, &rhs);
         let full: Vec<f64> = (0..r).map(|i| x[(i, 0)]).collect();
         if full.iter().any(|v| !v.is_finite()) {
-            return Err(Error::LinearAlgebra(
-                format!("damped reduced contact, step {it}: solution is not finite").into(),
-            ));
+            return Err(Error::LinearAlgebra(LinalgError::not_finite(format!(
+                "damped reduced contact, step {it}: solution"
+            ))));
         }
         let gaps = gaps_of(&full);
         let next: Vec<bool> = gaps.iter().map(|&g| g < 0.0).collect();
@@ -578,17 +565,12 @@ pub fn contact_static_reduced_damped(
             }
             t *= 0.5;
             if t < 1e-12 {
-                return Err(Error::LinearAlgebra(
-                    format!(
-                    "damped reduced contact, step {it}: line search failed (no decrease of the \
-                     contact energy along the Newton direction)"
-                )
-                    .into(),
-                ));
+                return Err(Error::LinearAlgebra(LinalgError::LineSearch { step: it }));
             }
         }
     }
-    Err(Error::LinearAlgebra(
-        format!("damped reduced contact did not converge in {max_steps} steps").into(),
-    ))
+    Err(Error::LinearAlgebra(LinalgError::NotConverged {
+        what: "damped reduced contact",
+        steps: max_steps,
+    }))
 }

@@ -17,7 +17,6 @@ use faer::sparse::FaerError;
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
 use faer::{get_global_parallelism, Conj, Mat, MatMut, Par, Side};
 
-use crate::error::Error;
 use crate::linalg::LinalgError;
 use crate::linalg::SymCsc;
 
@@ -46,28 +45,24 @@ impl SparseCholesky {
     /// Factors `a` (symbolic analysis with AMD ordering, then numeric, with faer's global
     /// parallelism). Errors if `a` is not positive definite (e.g. an unsupported, singular
     /// structure).
-    pub fn new(a: &SymCsc) -> Result<SparseCholesky, Error> {
+    pub fn new(a: &SymCsc) -> Result<SparseCholesky, LinalgError> {
         let mut chol = SparseCholesky::analyze_with(
             a.n,
             a.col_ptr.clone(),
             a.row_idx.clone(),
             get_global_parallelism(),
         )
-        .map_err(|e| {
-            Error::LinearAlgebra(LinalgError::caused_by(
-                format!("symbolic Cholesky of a {0}×{0} matrix: {e:?}", a.n),
-                e,
-            ))
+        .map_err(|e| LinalgError::Symbolic {
+            what: format!("Cholesky of a {0}×{0} matrix", a.n),
+            source: Box::new(e),
         })?;
         chol.factor_with(&a.values, |e| {
             let e = SparseLltError::Numeric(e);
-            Error::LinearAlgebra(LinalgError::caused_by(
-                format!(
-                    "the {0}×{0} matrix is not positive definite (singular or unsupported structure): {e:?}",
-                    a.n
-                ),
-                e,
-            ))
+            LinalgError::NotPositiveDefinite {
+                what: format!("the {0}×{0} matrix", a.n),
+                hint: " (singular or unsupported structure)",
+                source: Box::new(e),
+            }
         })?;
         Ok(chol)
     }
@@ -78,12 +73,12 @@ impl SparseCholesky {
         n: usize,
         col_ptr: Vec<usize>,
         row_idx: Vec<usize>,
-    ) -> Result<SparseCholesky, Error> {
+    ) -> Result<SparseCholesky, LinalgError> {
         SparseCholesky::analyze_with(n, col_ptr, row_idx, Par::Seq).map_err(|e| {
-            Error::LinearAlgebra(LinalgError::caused_by(
-                format!("symbolic Cholesky ({n}×{n}): {e:?}"),
-                e,
-            ))
+            LinalgError::Symbolic {
+                what: format!("Cholesky ({n}×{n})"),
+                source: Box::new(e),
+            }
         })
     }
 
@@ -118,21 +113,20 @@ impl SparseCholesky {
 
     /// Factors the values of the analysed pattern; `what` names the matrix in the error if it
     /// is not positive definite.
-    pub fn factor(&mut self, values: &[f64], what: &str) -> Result<(), Error> {
+    pub fn factor(&mut self, values: &[f64], what: &str) -> Result<(), LinalgError> {
         let n = self.n;
-        self.factor_with(values, |e| {
-            Error::LinearAlgebra(LinalgError::caused_by(
-                format!("{what} ({n}×{n}) is not positive definite: {e:?}"),
-                e,
-            ))
+        self.factor_with(values, |e| LinalgError::NotPositiveDefinite {
+            what: format!("{what} ({n}×{n})"),
+            hint: "",
+            source: Box::new(e),
         })
     }
 
     fn factor_with(
         &mut self,
         values: &[f64],
-        error: impl FnOnce(LltError) -> Error,
-    ) -> Result<(), Error> {
+        error: impl FnOnce(LltError) -> LinalgError,
+    ) -> Result<(), LinalgError> {
         self.factored = false;
         let a = SparseColMatRef::new(self.pattern.as_ref(), values);
         self.symbolic
@@ -332,7 +326,7 @@ fn triangular(
 }
 
 /// Solves `A x = b` for every `b` in `rhs` with one factorization; checks the residual.
-pub fn solve_spd(a: &SymCsc, rhs: &[Vec<f64>]) -> Result<Vec<Vec<f64>>, Error> {
+pub fn solve_spd(a: &SymCsc, rhs: &[Vec<f64>]) -> Result<Vec<Vec<f64>>, LinalgError> {
     let chol = SparseCholesky::new(a)?;
     let n = a.n;
     let mut b = Mat::from_fn(n, rhs.len(), |i, j| rhs[j][i]);
@@ -343,7 +337,7 @@ pub fn solve_spd(a: &SymCsc, rhs: &[Vec<f64>]) -> Result<Vec<Vec<f64>>, Error> {
     for (j, r) in rhs.iter().enumerate() {
         let x: Vec<f64> = (0..n).map(|i| b[(i, j)]).collect();
         if x.iter().any(|v| !v.is_finite()) {
-            return Err(Error::LinearAlgebra("static solution is not finite".into()));
+            return Err(LinalgError::not_finite("static solution"));
         }
         a.mul_vec(&x, &mut ax);
         let res = ax
@@ -356,9 +350,7 @@ pub fn solve_spd(a: &SymCsc, rhs: &[Vec<f64>]) -> Result<Vec<Vec<f64>>, Error> {
         // Normwise backward error; a stable Cholesky gives ~1e-16.
         let backward = res / (a_norm * x_norm + b_norm).max(f64::MIN_POSITIVE);
         if backward > 1e-10 {
-            return Err(Error::LinearAlgebra(format!(
-                "static solve backward error {backward:.3e} exceeds 1e-10 (singular or ill-conditioned stiffness)"
-            ).into()));
+            return Err(LinalgError::StaticBackwardError { backward });
         }
         out.push(x);
     }

@@ -21,7 +21,6 @@ use faer::matrix_free::eigen::{partial_eigen, partial_eigen_scratch, PartialEige
 use faer::matrix_free::LinOp;
 use faer::{c64, Col, ColRef, Mat, MatMut, MatRef, Par, Scale, Side};
 
-use crate::error::Error;
 use crate::linalg::cholesky::SparseCholesky;
 use crate::linalg::sparse::{sym_mul_mat, sym_mul_vec_into};
 use crate::linalg::symmetric_eigen;
@@ -53,11 +52,9 @@ impl Modes {
     }
 }
 
-fn check_count(n: usize, count: usize) -> Result<(), Error> {
+fn check_count(n: usize, count: usize) -> Result<(), LinalgError> {
     if count == 0 || count > n {
-        return Err(Error::Invalid(format!(
-            "cannot compute {count} modes of a model with {n} DOF (need 1 ≤ count ≤ {n})"
-        )));
+        return Err(LinalgError::ModeCount { count, dofs: n });
     }
     Ok(())
 }
@@ -73,17 +70,14 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
 }
 
 /// The lowest `count` modes of `K φ = ω² M φ` (K and M symmetric positive definite).
-pub fn lowest_modes(k: &SymCsc, m: &SymCsc, count: usize) -> Result<Modes, Error> {
+pub fn lowest_modes(k: &SymCsc, m: &SymCsc, count: usize) -> Result<Modes, LinalgError> {
     let n = k.n;
     check_count(n, count)?;
     if n <= 64 || 3 * count > n {
         return dense_modes(k, m, count);
     }
-    let chol = SparseCholesky::new(k).map_err(|e| {
-        Error::LinearAlgebra(
-            format!("eigenproblem: K must be positive definite (is the structure supported?): {e}")
-                .into(),
-        )
+    let chol = SparseCholesky::new(k).map_err(|e| LinalgError::EigenStiffness {
+        source: Box::new(e),
     })?;
     lowest_modes_factored(k, m, &chol, count)
 }
@@ -95,7 +89,7 @@ pub(crate) fn lowest_modes_factored(
     m: &SymCsc,
     chol: &SparseCholesky,
     count: usize,
-) -> Result<Modes, Error> {
+) -> Result<Modes, LinalgError> {
     let n = k.n;
     check_count(n, count)?;
     if n <= 64 || 3 * count > n {
@@ -117,9 +111,7 @@ pub(crate) fn lowest_modes_factored(
     );
     let rq = (v0.transpose() * cv.col(0)) / (v0.transpose() * &v0);
     if !(rq.is_finite() && rq > 0.0) {
-        return Err(Error::LinearAlgebra(format!(
-            "eigenproblem: Rayleigh quotient {rq:e} of L⁻¹ M L⁻ᵀ is not positive (M not positive definite?)"
-        ).into()));
+        return Err(LinalgError::RayleighQuotient { value: rq });
     }
     let mut tol = LOCK_TOL * rq;
     let mut max_dim = 2 * count + 20;
@@ -136,9 +128,11 @@ pub(crate) fn lowest_modes_factored(
         tol = LOCK_TOL * mu[count - 1];
         max_dim *= 2;
     }
-    Err(Error::LinearAlgebra(format!(
-        "Krylov–Schur: {count} modes not converged (relative residual {worst:.2e} > {RESIDUAL_TOL:e})"
-    ).into()))
+    Err(LinalgError::KrylovSchurNotConverged {
+        count,
+        residual: worst,
+        bound: RESIDUAL_TOL,
+    })
 }
 
 /// Locking tolerance of the Krylov–Schur iteration relative to the smallest wanted μ.
@@ -207,7 +201,7 @@ fn krylov_schur(
     count: usize,
     tol: f64,
     max_dim: usize,
-) -> Result<Mat<f64>, Error> {
+) -> Result<Mat<f64>, LinalgError> {
     let n = op.m.n;
     // faer needs max_dim < n; the callers keep 3 count ≤ n and n > 64.
     let params = PartialEigenParams {
@@ -228,13 +222,11 @@ fn krylov_schur(
         params,
     );
     if info.n_converged_eigen < count {
-        return Err(Error::LinearAlgebra(
-            format!(
-                "Krylov–Schur converged {} of {count} modes in {} restarts",
-                info.n_converged_eigen, params.max_restarts
-            )
-            .into(),
-        ));
+        return Err(LinalgError::KrylovSchurIncomplete {
+            converged: info.n_converged_eigen,
+            count,
+            restarts: params.max_restarts,
+        });
     }
     let mut z = Mat::<f64>::zeros(n, count);
     for (j, col) in zc.col_iter().enumerate() {
@@ -260,7 +252,7 @@ fn krylov_schur(
 /// Rayleigh–Ritz on one subspace-iteration step: `W = C Z` is orthonormalised (Q) and the
 /// pairs of the symmetric `Qᵀ C Q` are the refined ones (largest μ first), orthonormal to
 /// round-off. Also returns the largest true relative residual `‖C z − μ z‖ / μ`.
-fn refine(op: &InverseOperator<'_>, z: Mat<f64>) -> Result<(Vec<f64>, Mat<f64>, f64), Error> {
+fn refine(op: &InverseOperator<'_>, z: Mat<f64>) -> Result<(Vec<f64>, Mat<f64>, f64), LinalgError> {
     let (n, count) = z.shape();
     let stack = &mut MemBuffer::new(StackReq::EMPTY);
     let mut w = Mat::<f64>::zeros(n, count);
@@ -269,14 +261,11 @@ fn refine(op: &InverseOperator<'_>, z: Mat<f64>) -> Result<(Vec<f64>, Mat<f64>, 
     op.apply(w.as_mut(), q.as_ref(), Par::Seq, MemStack::new(stack));
     let g = q.transpose() * &w;
     let g = Mat::from_fn(count, count, |i, j| 0.5 * (g[(i, j)] + g[(j, i)]));
-    let evd = symmetric_eigen(g.as_ref(), "Rayleigh–Ritz").map_err(Error::LinearAlgebra)?;
+    let evd = symmetric_eigen(g.as_ref(), "Rayleigh–Ritz")?;
     let s = &evd.values;
     let mu: Vec<f64> = (0..count).map(|c| s[count - 1 - c]).collect();
     if let Some(&bad) = mu.iter().find(|&&v| !(v.is_finite() && v > 0.0)) {
-        return Err(Error::LinearAlgebra(
-            format!("non-positive Ritz value μ = 1/ω² = {bad:e}: K or M is not positive definite")
-                .into(),
-        ));
+        return Err(LinalgError::RitzValue { value: bad });
     }
     let u = Mat::from_fn(count, count, |i, c| evd.vectors[(i, count - 1 - c)]);
     let z = &q * &u;
@@ -293,16 +282,17 @@ fn to_modes(
     m: &SymCsc,
     mu: &[f64],
     mut z: Mat<f64>,
-) -> Result<Modes, Error> {
+) -> Result<Modes, LinalgError> {
     chol.half_solve_transpose(z.as_mut());
     let mut mphi = vec![0.0; m.n];
     for c in 0..z.ncols() {
         sym_mul_vec_into(m, z.col_as_slice(c), &mut mphi);
         let norm = dot(z.col_as_slice(c), &mphi).sqrt();
         if !(norm.is_finite() && norm > 0.0) {
-            return Err(Error::LinearAlgebra(
-                "mass matrix is not positive definite (mode M-norm vanished)".into(),
-            ));
+            return Err(LinalgError::Indefinite {
+                what: "mass matrix".to_string(),
+                hint: " (mode M-norm vanished)",
+            });
         }
         let inv = 1.0 / norm;
         z.col_mut(c).iter_mut().for_each(|v| *v *= inv);
@@ -312,7 +302,7 @@ fn to_modes(
 
 /// Checks the normwise backward error of every pair,
 /// `‖K φ − ω² M φ‖∞ / ((‖K‖∞ + ω² ‖M‖∞) ‖φ‖∞) ≤ 1e-10`.
-fn verify(k: &SymCsc, m: &SymCsc, modes: &Modes) -> Result<(), Error> {
+fn verify(k: &SymCsc, m: &SymCsc, modes: &Modes) -> Result<(), LinalgError> {
     let n = k.n;
     let (kn, mn) = (k.inf_norm(), m.inf_norm());
     let mut kphi = vec![0.0; n];
@@ -329,15 +319,11 @@ fn verify(k: &SymCsc, m: &SymCsc, modes: &Modes) -> Result<(), Error> {
         let phi_norm = phi.iter().map(|v| v.abs()).fold(0.0, f64::max);
         let backward = res / ((kn + lam * mn) * phi_norm);
         if backward.is_nan() || backward > 1e-10 {
-            return Err(Error::LinearAlgebra(
-                format!(
-                    "mode {} ({:.4} Hz) has backward error {:.2e} > 1e-10",
-                    c + 1,
-                    modes.frequencies_hz[c],
-                    backward
-                )
-                .into(),
-            ));
+            return Err(LinalgError::ModeBackwardError {
+                mode: c + 1,
+                frequency_hz: modes.frequencies_hz[c],
+                backward,
+            });
         }
     }
     Ok(())
@@ -347,18 +333,17 @@ fn verify(k: &SymCsc, m: &SymCsc, modes: &Modes) -> Result<(), Error> {
 /// `K = L Lᵀ`, `L⁻¹ M L⁻ᵀ y = μ y` with `μ = 1/ω²` (the largest μ are the lowest modes),
 /// `φ = L⁻ᵀ y / sqrt(μ)` (M-normalised). Factoring M instead would mix the drilling and
 /// membrane eigenvalues (~1e16) into the low ones and lose them to round-off.
-pub fn dense_modes(k: &SymCsc, m: &SymCsc, count: usize) -> Result<Modes, Error> {
+pub fn dense_modes(k: &SymCsc, m: &SymCsc, count: usize) -> Result<Modes, LinalgError> {
     let n = k.n;
     check_count(n, count)?;
     let kd = k.to_dense();
-    let llt = kd.llt(Side::Lower).map_err(|e| {
-        Error::LinearAlgebra(LinalgError::caused_by(
-            format!(
-                "stiffness matrix is not positive definite (is the structure supported?): {e:?}"
-            ),
-            e,
-        ))
-    })?;
+    let llt = kd
+        .llt(Side::Lower)
+        .map_err(|e| LinalgError::NotPositiveDefinite {
+            what: "stiffness matrix".to_string(),
+            hint: " (is the structure supported?)",
+            source: Box::new(e),
+        })?;
     let l = llt.L();
     let mut c = m.to_dense();
     // C = L⁻¹ M L⁻ᵀ: solve L X = M, then L Cᵀ = Xᵀ.
@@ -366,7 +351,7 @@ pub fn dense_modes(k: &SymCsc, m: &SymCsc, count: usize) -> Result<Modes, Error>
     let mut ct = c.transpose().to_owned();
     solve_lower_triangular_in_place(l, ct.as_mut(), Par::Seq);
     let sym = Mat::from_fn(n, n, |i, j| 0.5 * (ct[(i, j)] + ct[(j, i)]));
-    let evd = symmetric_eigen(sym.as_ref(), "dense modes").map_err(Error::LinearAlgebra)?;
+    let evd = symmetric_eigen(sym.as_ref(), "dense modes")?;
     let s = &evd.values;
     let mut eigenvalues = Vec::with_capacity(count);
     let mut shapes = Mat::<f64>::zeros(n, count);
@@ -374,9 +359,10 @@ pub fn dense_modes(k: &SymCsc, m: &SymCsc, count: usize) -> Result<Modes, Error>
         let idx = n - 1 - c;
         let mu = s[idx];
         if mu <= 0.0 {
-            return Err(Error::LinearAlgebra(
-                "mass matrix is not positive definite".into(),
-            ));
+            return Err(LinalgError::Indefinite {
+                what: "mass matrix".to_string(),
+                hint: "",
+            });
         }
         eigenvalues.push(1.0 / mu);
         let inv = 1.0 / mu.sqrt();

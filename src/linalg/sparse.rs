@@ -3,7 +3,7 @@
 
 use faer::{Mat, MatRef};
 
-use crate::error::Error;
+use super::LinalgError;
 
 /// The compressed-column pattern `(col_ptr, row_idx)` of `n` columns whose rows `fill(c, rows)`
 /// pushes into the (cleared) `rows`, in any order and with repeats: each column's rows sorted
@@ -95,11 +95,11 @@ impl SymCsc {
     }
 
     /// `A + s B` for matrices with the same pattern (e.g. the shifted `K − σ M`).
-    pub fn add_scaled(&self, s: f64, other: &SymCsc) -> Result<SymCsc, Error> {
+    pub fn add_scaled(&self, s: f64, other: &SymCsc) -> Result<SymCsc, LinalgError> {
         if self.col_ptr != other.col_ptr || self.row_idx != other.row_idx {
-            return Err(Error::Invalid(
-                "add_scaled needs two matrices with the same sparsity pattern".into(),
-            ));
+            return Err(LinalgError::PatternMismatch {
+                operation: "add_scaled",
+            });
         }
         let mut out = self.clone();
         for (v, o) in out.values.iter_mut().zip(&other.values) {

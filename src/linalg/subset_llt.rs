@@ -119,11 +119,9 @@ impl SubsetLlt {
     ) -> Result<(), LinalgError> {
         let n = set.len();
         let s = Mat::from_fn(n, n, |i, j| entry(set[i], set[j]));
-        let llt = s.llt(Side::Lower).map_err(|e| {
-            LinalgError::caused_by(
-                format!("Cholesky of a {n}×{n} principal submatrix: {e:?}"),
-                e,
-            )
+        let llt = s.llt(Side::Lower).map_err(|e| LinalgError::Factorization {
+            step: format!("Cholesky of a {n}×{n} principal submatrix"),
+            source: Box::new(e),
         })?;
         self.l = llt.L().to_owned();
         self.order = set.to_vec();
@@ -154,14 +152,12 @@ impl SubsetLlt {
             w.as_mut(),
             alpha.as_mut().col_mut(0).as_diagonal_mut(),
         )
-        .map_err(|e| {
-            LinalgError::caused_by(
-                format!(
-                    "Cholesky downdate removing {} of {n} indices: {e:?}",
-                    removed.len()
-                ),
-                e,
-            )
+        .map_err(|e| LinalgError::Factorization {
+            step: format!(
+                "Cholesky downdate removing {} of {n} indices",
+                removed.len()
+            ),
+            source: Box::new(e),
         })?;
         self.l = l;
         self.order = keep.iter().map(|&p| self.order[p]).collect();
@@ -182,12 +178,12 @@ impl SubsetLlt {
         solve_lower_triangular_in_place(self.l.as_ref(), x.as_mut(), Par::Seq);
         let s_nn = Mat::from_fn(a, a, |i, j| entry(added[i], added[j]));
         let schur = &s_nn - x.transpose() * &x;
-        let llt = schur.llt(Side::Lower).map_err(|e| {
-            LinalgError::caused_by(
-                format!("Cholesky of the Schur complement appending {a} to {n} indices: {e:?}"),
-                e,
-            )
-        })?;
+        let llt = schur
+            .llt(Side::Lower)
+            .map_err(|e| LinalgError::Factorization {
+                step: format!("Cholesky of the Schur complement appending {a} to {n} indices"),
+                source: Box::new(e),
+            })?;
         let l22 = llt.L();
         let mut l = Mat::<f64>::zeros(n + a, n + a);
         l.as_mut().submatrix_mut(0, 0, n, n).copy_from(&self.l);

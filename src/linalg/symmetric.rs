@@ -45,16 +45,17 @@ fn decompose(
 ) -> Result<(Vec<f64>, Option<Mat<f64>>), LinalgError> {
     let n = a.nrows();
     if a.ncols() != n {
-        return Err(LinalgError::new(format!(
-            "{what}: the matrix is {}×{}, not square",
-            n,
-            a.ncols()
-        )));
+        return Err(LinalgError::NotSquare {
+            what: what.to_string(),
+            rows: n,
+            cols: a.ncols(),
+        });
     }
     if a.col_iter().any(|c| c.iter().any(|v| !v.is_finite())) {
-        return Err(LinalgError::new(format!(
-            "{what}: the {n}×{n} matrix has a non-finite entry"
-        )));
+        return Err(LinalgError::NonFiniteEntry {
+            what: what.to_string(),
+            n,
+        });
     }
     let compute = if vectors {
         ComputeEigenvectors::Yes
@@ -77,7 +78,11 @@ fn decompose(
         MemStack::new(&mut mem),
         params().into(),
     )
-    .map_err(|e| LinalgError::new(format!("{what}: the {n}×{n} eigensolver failed: {e:?}")))?;
+    .map_err(|error| LinalgError::EigenNotConverged {
+        what: what.to_string(),
+        n,
+        error,
+    })?;
     Ok((s.column_vector().iter().copied().collect(), u))
 }
 
@@ -182,11 +187,27 @@ mod tests {
         let mut a = Mat::<f64>::identity(3, 3);
         a[(1, 0)] = f64::NAN;
         let e = symmetric_eigen(a.as_ref(), "the Gram matrix").unwrap_err();
-        assert!(e.message().contains("the Gram matrix") && e.message().contains("non-finite"));
+        assert!(
+            matches!(&e, LinalgError::NonFiniteEntry { what, n: 3 } if what == "the Gram matrix"),
+            "{e:?}"
+        );
+        assert_eq!(
+            e.to_string(),
+            "the Gram matrix: the 3×3 matrix has a non-finite entry"
+        );
         let b = Mat::<f64>::zeros(2, 3);
-        assert!(symmetric_eigenvalues(b.as_ref(), "x")
-            .unwrap_err()
-            .message()
-            .contains("not square"));
+        let e = symmetric_eigenvalues(b.as_ref(), "x").unwrap_err();
+        assert!(
+            matches!(
+                e,
+                LinalgError::NotSquare {
+                    rows: 2,
+                    cols: 3,
+                    ..
+                }
+            ),
+            "{e:?}"
+        );
+        assert!(e.to_string().contains("not square"));
     }
 }

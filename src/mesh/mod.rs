@@ -6,7 +6,7 @@
 //! Axes: x along the length, y normal to the sheets, z across the width (mm).
 
 use crate::case::Case;
-use crate::error::Error;
+use crate::error::{ElementError, Error};
 
 mod build;
 pub mod deck;
@@ -252,10 +252,12 @@ impl Material {
         if ok {
             Ok(())
         } else {
-            Err(Error::Element(format!(
-                "invalid material: E = {} N/mm², nu = {}, rho = {} t/mm³ (need E > 0, -1 < nu < 0.5, rho > 0)",
-                self.youngs_modulus, self.poisson_ratio, self.density
-            )))
+            Err(ElementError::Material {
+                youngs_modulus: self.youngs_modulus,
+                poisson_ratio: self.poisson_ratio,
+                density: self.density,
+            }
+            .into())
         }
     }
 }

@@ -59,7 +59,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::assembly::{DofDep, DofMap};
 use crate::case::{ContactSpec, LoadSpec};
-use crate::error::Error;
+use crate::error::{Error, ModelError};
 use crate::joint::JointOperator;
 use crate::joint::PairFrame;
 use crate::linalg::SymCsc;
@@ -894,11 +894,11 @@ pub fn write(model: &Model, dir: &Path) -> Result<Vec<PathBuf>, Error> {
                     (Some(r), _) => Some(r + 1),
                     (None, 0) => None,
                     (None, _) => {
-                        return Err(Error::Invalid(format!(
-                            "export-matrices: node {} DOF {c} depends on several DOF but is not \
-                             a rigid follower of the master node; the map cannot express it",
-                            geo.node_ids[i]
-                        )))
+                        return Err(ModelError::ExportDependentDof {
+                            node: geo.node_ids[i],
+                            dof: c,
+                        }
+                        .into())
                     }
                 };
             }
@@ -914,9 +914,7 @@ pub fn write(model: &Model, dir: &Path) -> Result<Vec<PathBuf>, Error> {
         .find(|&i| {
             !follower[i] && (0..6).all(|c| model.dof_map.nodes[i][c].as_free() == Some(master[c]))
         })
-        .ok_or_else(|| {
-            Error::Invalid("export-matrices: no node owns the six master DOF".to_string())
-        })?;
+        .ok_or_else(|| Error::Model(ModelError::ExportNoMasterNode))?;
     let cells = geo
         .cells
         .iter()

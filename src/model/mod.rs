@@ -25,7 +25,7 @@ use std::path::PathBuf;
 
 use crate::assembly::{assemble_structure, DofMap, Structure};
 use crate::case::{Case, ContactSpec, LoadSpec};
-use crate::error::Error;
+use crate::error::{Error, ModelError};
 use crate::joint::{JointOperator, PairFrame};
 use crate::linalg::cholesky as statics;
 use crate::linalg::eigen::{self as modes, Modes};
@@ -238,7 +238,11 @@ impl Model {
             .map(|p| {
                 let (a, b) = (mesh.nodes[p.lower], mesh.nodes[p.upper]);
                 PairFrame::along(p.lower, p.upper, [b[0] - a[0], b[1] - a[1], b[2] - a[2]])
-                    .ok_or_else(|| Error::Invalid(format!("{}: a degenerate CGAP", path.display())))
+                    .ok_or_else(|| {
+                        Error::Model(ModelError::DegenerateGap {
+                            file: path.to_path_buf(),
+                        })
+                    })
             })
             .collect::<Result<Vec<_>, _>>()?;
         let name = path
@@ -376,10 +380,14 @@ impl Model {
     /// The lowest `count` eigenmodes with the master node free or clamped.
     pub fn modes(&self, count: usize, interface: Interface) -> Result<Modes, Error> {
         match interface {
-            Interface::Free => modes::lowest_modes(&self.stiffness, &self.mass, count),
+            Interface::Free => Ok(modes::lowest_modes(&self.stiffness, &self.mass, count)?),
             Interface::Fixed => {
                 let m = self.dofs() - 6;
-                modes::lowest_modes(&self.stiffness.leading(m), &self.mass.leading(m), count)
+                Ok(modes::lowest_modes(
+                    &self.stiffness.leading(m),
+                    &self.mass.leading(m),
+                    count,
+                )?)
             }
         }
     }

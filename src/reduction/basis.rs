@@ -6,10 +6,11 @@ use faer::{Mat, MatRef};
 
 use super::pod::DEFAULT_THRESHOLD;
 use super::tvd::TvdOptions;
-use crate::error::Error;
+use crate::error::{Error, ReductionError};
 use crate::linalg::compensated::{split, two_product_sums};
 use crate::linalg::sparse::{sym_mul_vec_into, SymCsc};
 use crate::linalg::symmetric_eigen;
+use crate::linalg::LinalgError;
 use crate::model::Model;
 
 /// Default relative drop tolerance of [`final_basis`].
@@ -34,10 +35,7 @@ pub fn final_basis(
 ) -> Result<(Mat<f64>, usize), Error> {
     let n = m.n;
     if let Some(p) = parts.iter().find(|p| p.nrows() != n) {
-        return Err(Error::Invalid(format!(
-            "basis part has {} rows, the mass matrix is {n}×{n}",
-            p.nrows()
-        )));
+        return Err(ReductionError::PartRows { rows: p.nrows(), n }.into());
     }
     let mut q: Vec<Vec<f64>> = Vec::new();
     let mut mq: Vec<Vec<f64>> = Vec::new();
@@ -55,7 +53,10 @@ pub fn final_basis(
             sym_mul_vec_into(m, &v, &mut mv);
             let norm0 = dot(&v, &mv).max(0.0).sqrt();
             if !norm0.is_finite() {
-                return Err(Error::Invalid("basis column is not finite".into()));
+                return Err(ReductionError::NotFinite {
+                    what: "basis column is",
+                }
+                .into());
             }
             if norm0 == 0.0 {
                 dropped += 1;
@@ -191,11 +192,12 @@ pub struct Basis {
 /// form for the time integration (its largest ω bounds the reduced model's stiffness).
 pub fn modal_rotation(model: &Model, phi: Mat<f64>) -> Result<(Mat<f64>, Vec<f64>), Error> {
     if phi.nrows() != model.dofs() {
-        return Err(Error::Invalid(format!(
-            "basis has {} rows, the model {} DOF",
-            phi.nrows(),
-            model.dofs()
-        )));
+        return Err(ReductionError::Rows {
+            what: "basis has",
+            rows: phi.nrows(),
+            dofs: model.dofs(),
+        }
+        .into());
     }
     if phi.ncols() == 0 {
         return Ok((phi, Vec::new()));
@@ -205,9 +207,9 @@ pub fn modal_rotation(model: &Model, phi: Mat<f64>) -> Result<(Mat<f64>, Vec<f64
         symmetric_eigen(k.as_ref(), "reduced eigenproblem ΦᵀKΦ").map_err(Error::LinearAlgebra)?;
     let lambda = evd.values;
     if let Some(l) = lambda.iter().find(|l| !(l.is_finite() && **l > 0.0)) {
-        return Err(Error::LinearAlgebra(
-            format!("reduced stiffness ΦᵀKΦ is not positive definite (eigenvalue {l:e})").into(),
-        ));
+        return Err(Error::LinearAlgebra(LinalgError::ReducedStiffness {
+            eigenvalue: *l,
+        }));
     }
     Ok((&phi * &evd.vectors, lambda))
 }

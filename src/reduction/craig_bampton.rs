@@ -2,9 +2,10 @@
 
 use faer::Mat;
 
-use crate::error::Error;
+use crate::error::{Error, ReductionError};
 use crate::linalg::cholesky::SparseCholesky;
 use crate::linalg::eigen::lowest_modes_factored;
+use crate::linalg::LinalgError;
 use crate::model::Model;
 
 /// The Craig–Bampton basis `[Φ_S | Φ_V]` (n × (6 + ν)) of a model whose master node's six DOF
@@ -21,24 +22,26 @@ use crate::model::Model;
 pub fn craig_bampton(model: &Model, nu: usize) -> Result<Mat<f64>, Error> {
     let n = model.dofs();
     if n <= 6 {
-        return Err(Error::Invalid(format!(
-            "Craig–Bampton needs interior DOF: the model has only {n} DOF"
-        )));
+        return Err(ReductionError::NoInteriorDofs {
+            method: "Craig–Bampton",
+            dofs: n,
+        }
+        .into());
     }
     let m = n - 6;
     if nu > m {
-        return Err(Error::Invalid(format!(
-            "--nu {nu}: the model has only {m} interior DOF, so at most {m} fixed-interface \
-             modes"
-        )));
+        return Err(ReductionError::FixedInterfaceModes { nu, interior: m }.into());
     }
     let master = model.master_dofs();
     for (c, &d) in master.iter().enumerate() {
         if d != m + c {
-            return Err(Error::Invalid(format!(
-                "Craig–Bampton expects the master DOF last: master DOF {c} is independent DOF {d}, not {}",
-                m + c
-            )));
+            return Err(ReductionError::MasterNotLast {
+                method: "Craig–Bampton",
+                master: c,
+                dof: d,
+                expected: m + c,
+            }
+            .into());
         }
     }
     let k = &model.stiffness;
@@ -74,9 +77,9 @@ pub fn craig_bampton(model: &Model, nu: usize) -> Result<Mat<f64>, Error> {
         }
     }
     if phi.col_iter().any(|c| c.iter().any(|v| !v.is_finite())) {
-        return Err(Error::LinearAlgebra(
-            "Craig–Bampton basis is not finite".into(),
-        ));
+        return Err(Error::LinearAlgebra(LinalgError::not_finite(
+            "Craig–Bampton basis",
+        )));
     }
     Ok(phi)
 }

@@ -44,11 +44,12 @@ use std::time::Instant;
 use faer::{Mat, MatRef};
 use serde::{Deserialize, Serialize};
 
-use crate::error::Error;
+use crate::error::{Error, ReductionError};
 use crate::files;
 use crate::linalg::compensated::{solve_refined_steps, sym_mul_compensated};
 use crate::linalg::sparse::sym_mul_mat;
 use crate::linalg::symmetric_eigenvalues;
+use crate::linalg::LinalgError;
 use crate::linalg::{Modes, SparseCholesky, SymCsc};
 use crate::model::petsc;
 use crate::model::{Interface, Model};
@@ -168,10 +169,10 @@ pub fn prepare(model: &Model, nu: usize, dir: &Path) -> Result<NativeReference, 
     drop(base);
     seconds.rhs = t.elapsed().as_secs_f64();
     if rhs.ncols() == 0 {
-        return Err(Error::Invalid(format!(
-            "distributed: {} has no TVD right-hand sides (no joint pair is ever active)",
-            files::printable(&model.name)
-        )));
+        return Err(ReductionError::NoTvdRhs {
+            case: files::printable(&model.name).to_string(),
+        }
+        .into());
     }
 
     let t = Instant::now();
@@ -201,7 +202,7 @@ pub fn prepare(model: &Model, nu: usize, dir: &Path) -> Result<NativeReference, 
         files: job_files(),
     };
     let text = serde_json::to_string_pretty(&manifest)
-        .map_err(|e| Error::Invalid(format!("distributed: job manifest: {e}")))?;
+        .map_err(|source| ReductionError::JobManifest { source })?;
     files::write_atomic(&dir.join("job.json"), text)?;
     seconds.export = t.elapsed().as_secs_f64();
     Ok(NativeReference {
@@ -386,9 +387,10 @@ fn span_measure(
     for j in 0..nu {
         let norm = gram[(j, j)].sqrt();
         if !(norm.is_finite() && norm > 0.0) {
-            return Err(Error::LinearAlgebra(
-                format!("distributed: SLEPc mode {} has M-norm {norm:e}", j + 1).into(),
-            ));
+            return Err(Error::LinearAlgebra(LinalgError::ModeNorm {
+                what: format!("distributed: SLEPc mode {}", j + 1),
+                norm,
+            }));
         }
         phi_p.col_mut(j).iter_mut().for_each(|v| *v /= norm);
     }

@@ -113,7 +113,7 @@ use std::sync::{Arc, Mutex};
 
 use faer::{Mat, MatRef};
 
-use crate::error::Error;
+use crate::error::{Error, ReductionError};
 use crate::joint::law::PairLaw;
 use crate::joint::JointOperator;
 use crate::joint::{NORMAL, T1, T2};
@@ -185,9 +185,9 @@ impl JointFlexibility {
         let chol = SparseCholesky::new(&model.stiffness)?;
         let z = solve_refined(&model.stiffness, &chol, &rhs);
         if z.col_iter().any(|c| c.iter().any(|v| !v.is_finite())) {
-            return Err(Error::LinearAlgebra(
-                "joint flexibility K⁻¹ E_m is not finite".into(),
-            ));
+            return Err(Error::LinearAlgebra(LinalgError::not_finite(
+                "joint flexibility K⁻¹ E_m",
+            )));
         }
         let h = model.joint.reduce(z.as_ref());
         let c = Mat::from_fn(6, 6, |a, b| 0.5 * (z[(master[a], b)] + z[(master[b], a)]));
@@ -262,9 +262,9 @@ impl JointFlexibility {
                 })
                 .collect();
             if solved.iter().any(|c| c.iter().any(|v| !v.is_finite())) {
-                return Err(Error::LinearAlgebra(
-                    "joint flexibility K⁻¹ Bᵀ is not finite".into(),
-                ));
+                return Err(Error::LinearAlgebra(LinalgError::not_finite(
+                    "joint flexibility K⁻¹ Bᵀ",
+                )));
             }
             let mut cols = self.lock_columns();
             for (&r, col) in chunk.iter().zip(solved) {
@@ -429,22 +429,20 @@ impl JointFlexibility {
     /// carries Φ, of this model's DOF and pairs.
     ///
     /// # Errors
-    /// [`Error::Invalid`] saying which of these fails.
+    /// [`Error::Reduction`] saying which of these fails.
     pub(crate) fn basis_of<'r>(&self, rom: &'r ReducedSystem) -> Result<&'r Mat<f64>, Error> {
-        let phi = rom.phi.as_ref().ok_or_else(|| {
-            Error::Invalid(
-                "error estimate: the reduced model carries no basis Φ (read from a file)".into(),
-            )
-        })?;
+        let phi = rom
+            .phi
+            .as_ref()
+            .ok_or_else(|| Error::Reduction(ReductionError::EstimateNoBasis))?;
         if phi.nrows() != self.stiffness.n || rom.pairs() != self.pairs() {
-            return Err(Error::Invalid(format!(
-                "error estimate: basis {}×{} with {} pairs does not fit the model ({} DOF, {} pairs)",
-                phi.nrows(),
-                phi.ncols(),
-                rom.pairs(),
-                self.stiffness.n,
-                self.pairs()
-            )));
+            return Err(ReductionError::EstimateBasis {
+                basis: (phi.nrows(), phi.ncols()),
+                basis_pairs: rom.pairs(),
+                dofs: self.stiffness.n,
+                pairs: self.pairs(),
+            }
+            .into());
         }
         Ok(phi)
     }
@@ -494,9 +492,10 @@ impl Truncation {
             (w, Vec::new())
         };
         if let Some(o) = omega2.iter().find(|o| !(o.is_finite() && **o > 0.0)) {
-            return Err(Error::LinearAlgebra(
-                format!("truncation modes: eigenvalue {o:e} is not positive").into(),
-            ));
+            return Err(Error::LinearAlgebra(LinalgError::EigenvalueNotPositive {
+                what: "truncation modes",
+                value: *o,
+            }));
         }
         let master = model.master_dofs();
         let k_phi = sym_mul_mat(&model.stiffness, phi);
@@ -627,9 +626,7 @@ impl ErrorEstimator<'_> {
             || states.p.len() != outputs * 3 * w
             || states.s.len() != outputs * ns
         {
-            return Err(Error::Invalid(format!(
-                "error estimate: run states do not fit {outputs} outputs of r = {r}, w = {w}"
-            )));
+            return Err(ReductionError::EstimateStates { outputs, r, w }.into());
         }
         let qdd = self.accelerations(states)?;
         let load = Mat::from_fn(6, outputs, |d, j| self.rom.load.master_at(states.t[j])[d]);
@@ -650,9 +647,10 @@ impl ErrorEstimator<'_> {
         let mut corr_joint = Corrector::new(self.flex, law);
         let at = |j: usize| {
             move |e: Error| match e {
-                Error::LinearAlgebra(m) => Error::LinearAlgebra(
-                    format!("error estimate at t = {:e} s: {m}", states.t[j]).into(),
-                ),
+                Error::LinearAlgebra(source) => Error::LinearAlgebra(LinalgError::EstimateAt {
+                    time: states.t[j],
+                    source: Box::new(source),
+                }),
                 e => e,
             }
         };
@@ -766,9 +764,7 @@ impl ErrorEstimator<'_> {
             rom.joint_transpose_add(&neg_p, &mut rhs);
             rom.solve_m_in_place(&mut rhs);
             if let Some(v) = rhs.iter().find(|v| !v.is_finite()) {
-                return Err(Error::Invalid(format!(
-                    "error estimate: reduced acceleration at t = {t:e} s is not finite ({v})"
-                )));
+                return Err(ReductionError::EstimateAcceleration { t, value: *v }.into());
             }
             for (i, v) in rhs.iter().enumerate() {
                 acc[(i, j)] = *v;
@@ -852,13 +848,10 @@ impl<'a> Corrector<'a> {
                 d + k_n * 0.5 * (col(j)[i] + col(i)[j])
             })
             .map_err(|e| {
-                Error::LinearAlgebra(LinalgError::caused_by(
-                    format!(
-                        "pair-space contact matrix I + k_n F_AA ({} pairs) is not positive definite",
-                        set.len()
-                    ),
-                    e,
-                ))
+                Error::LinearAlgebra(LinalgError::ContactMatrix {
+                    pairs: set.len(),
+                    source: Box::new(e),
+                })
             })?;
         let order = self.factor.order();
         let mut g_a: Vec<f64> = order.iter().map(|&k| g_hat[k]).collect();
@@ -887,9 +880,11 @@ impl<'a> Corrector<'a> {
             let set: Vec<usize> = (0..w).filter(|&k| active[k]).collect();
             self.gaps(&set, &g_hat, &mut gaps)?;
             if let Some(k) = gaps.iter().position(|g| !g.is_finite()) {
-                return Err(Error::LinearAlgebra(
-                    format!("pair-space contact: gap of pair {k} is not finite").into(),
-                ));
+                return Err(Error::LinearAlgebra(LinalgError::GapNotFinite {
+                    context: "pair-space contact".to_string(),
+                    pair: k,
+                    value: None,
+                }));
             }
             let next = next_active_set(&active, &gaps);
             if next == active {
@@ -1021,9 +1016,7 @@ fn pgs_on(
             return Ok(c);
         }
     }
-    Err(Error::LinearAlgebra(
-        "pair-space contact: projected Gauss–Seidel did not converge in 100 000 sweeps".into(),
-    ))
+    Err(Error::LinearAlgebra(LinalgError::GaussSeidelNotConverged))
 }
 
 /// `‖a − b‖ / ‖b‖` over all entries (`None` if `b` is zero).

@@ -2,9 +2,10 @@
 
 use faer::{Mat, MatRef};
 
-use crate::error::Error;
+use crate::error::{Error, ReductionError};
 use crate::linalg::sparse::sym_mul_mat;
 use crate::linalg::symmetric_eigen;
+use crate::linalg::LinalgError;
 use crate::linalg::SymCsc;
 use crate::model::Model;
 
@@ -147,10 +148,11 @@ fn pod_dense_lambda_poms(
     let u = evd.vectors.as_ref();
     let lmax = s[p - 1];
     if !(lmax.is_finite() && lmax > 0.0) {
-        return Err(Error::LinearAlgebra(
-            format!("POD: largest eigenvalue of YᵀAY is {lmax:e} (zero or indefinite weight)")
-                .into(),
-        ));
+        return Err(Error::LinearAlgebra(LinalgError::NotPositive {
+            what: "POD: largest eigenvalue of YᵀAY",
+            value: lmax,
+            hint: " (zero or indefinite weight)",
+        }));
     }
     let order: Vec<usize> = (0..p).rev().collect(); // descending
     let kept: Vec<usize> = order
@@ -210,10 +212,7 @@ pub fn pod(y: MatRef<'_, f64>, weight: Option<&SymCsc>) -> Result<Pod, Error> {
     let p = y.ncols();
     if let Some(a) = weight {
         if a.n != n {
-            return Err(Error::Invalid(format!(
-                "POD weight is {0}×{0}, the vectors have {1} rows",
-                a.n, n
-            )));
+            return Err(ReductionError::PodWeight { n: a.n, rows: n }.into());
         }
     }
     if p == 0 {
@@ -226,7 +225,10 @@ pub fn pod(y: MatRef<'_, f64>, weight: Option<&SymCsc>) -> Result<Pod, Error> {
         });
     }
     if y.col_iter().any(|c| c.iter().any(|v| !v.is_finite())) {
-        return Err(Error::Invalid("POD: the vectors are not finite".into()));
+        return Err(ReductionError::NotFinite {
+            what: "POD: the vectors are",
+        }
+        .into());
     }
     // Orthonormal basis Q_T (p × ℓ) of the row space of Y, W = Y Q_T.
     let (w_mat, k) = row_space(y)?;
@@ -238,10 +240,11 @@ pub fn pod(y: MatRef<'_, f64>, weight: Option<&SymCsc>) -> Result<Pod, Error> {
     let x = evd.vectors.as_ref();
     let lmax = s[k - 1];
     if !(lmax.is_finite() && lmax > 0.0) {
-        return Err(Error::LinearAlgebra(
-            format!("POD: largest eigenvalue of YᵀAY is {lmax:e} (zero or indefinite weight)")
-                .into(),
-        ));
+        return Err(Error::LinearAlgebra(LinalgError::NotPositive {
+            what: "POD: largest eigenvalue of YᵀAY",
+            value: lmax,
+            hint: " (zero or indefinite weight)",
+        }));
     }
     let kept: Vec<usize> = (0..k)
         .rev()
@@ -304,12 +307,14 @@ fn pod_tvd_with(model: &Model, tvd: &Tvd, weighted: bool, want_poms: bool) -> Re
     let n = tvd.vectors.nrows();
     let (m, p) = (f.coefficients.nrows(), f.coefficients.ncols());
     if f.flexibility.nrows() != n || f.flexibility.ncols() != m || p != tvd.vectors.ncols() {
-        return Err(Error::Invalid(format!(
-            "TVD factor form is {}×{} times {m}×{p}, the vectors {n}×{}",
-            f.flexibility.nrows(),
-            f.flexibility.ncols(),
-            tvd.vectors.ncols()
-        )));
+        return Err(ReductionError::TvdFactorForm {
+            flexibility: (f.flexibility.nrows(), f.flexibility.ncols()),
+            m,
+            p,
+            n,
+            columns: tvd.vectors.ncols(),
+        }
+        .into());
     }
     if p == 0 || m == 0 {
         return pod(tvd.vectors.as_ref(), weight);
@@ -318,9 +323,10 @@ fn pod_tvd_with(model: &Model, tvd: &Tvd, weighted: bool, want_poms: bool) -> Re
         .col_iter()
         .any(|c| c.iter().any(|v| !v.is_finite()))
     {
-        return Err(Error::Invalid(
-            "POD: the TVD coefficients are not finite".into(),
-        ));
+        return Err(ReductionError::NotFinite {
+            what: "POD: the TVD coefficients are",
+        }
+        .into());
     }
     // A = Rᵀ C (weighted) or R_Z C (plain), m × p; `left` maps A's left singular vectors to POMs
     // for the plain route.
@@ -346,7 +352,10 @@ fn pod_tvd_with(model: &Model, tvd: &Tvd, weighted: bool, want_poms: bool) -> Re
         (&r * &f.coefficients, q)
     };
     let svd = a.thin_svd().map_err(|e| {
-        Error::LinearAlgebra(format!("POD: SVD of the TVD coefficients: {e:?}").into())
+        Error::LinearAlgebra(LinalgError::SvdNotConverged {
+            what: "POD: SVD of the TVD coefficients",
+            error: e,
+        })
     })?;
     let s = svd.S().column_vector();
     let k = s.nrows();
@@ -354,9 +363,11 @@ fn pod_tvd_with(model: &Model, tvd: &Tvd, weighted: bool, want_poms: bool) -> Re
     order.sort_by(|&x, &y| s[y].total_cmp(&s[x]));
     let smax = s[order[0]];
     if !(smax.is_finite() && smax > 0.0) {
-        return Err(Error::LinearAlgebra(
-            format!("POD: largest singular value of the TVD coefficients is {smax:e}").into(),
-        ));
+        return Err(Error::LinearAlgebra(LinalgError::NotPositive {
+            what: "POD: largest singular value of the TVD coefficients",
+            value: smax,
+            hint: "",
+        }));
     }
     let cut = sigma_zero(m, p) * smax;
     let kept: Vec<usize> = order.into_iter().filter(|&i| s[i] > cut).collect();

@@ -68,7 +68,7 @@ use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
 use faer::sparse::{SparseColMat, SymbolicSparseColMat};
 use faer::{Mat, MatRef};
 
-use crate::error::Error;
+use crate::error::{Error, ReductionError};
 use crate::joint::{JointOperator, NORMAL, T1, T2};
 use crate::linalg::cholesky::SparseCholesky;
 use crate::linalg::sparse::{sym_mul_mat, sym_mul_vec_into};
@@ -259,16 +259,15 @@ pub fn trial_vector_derivatives(
 ) -> Result<Tvd, Error> {
     let n = model.dofs();
     if base.nrows() != n {
-        return Err(Error::Invalid(format!(
-            "TVD base has {} rows, the model {n} DOF",
-            base.nrows()
-        )));
+        return Err(ReductionError::Rows {
+            what: "TVD base has",
+            rows: base.nrows(),
+            dofs: n,
+        }
+        .into());
     }
     if !(opts.tol >= 0.0 && opts.tol < 1.0) {
-        return Err(Error::Invalid(format!(
-            "TVD zero tolerance must be in [0, 1), got {}",
-            opts.tol
-        )));
+        return Err(ReductionError::TvdTolerance { tol: opts.tol }.into());
     }
     let run = TvdRun::new(model, base, opts);
     let nb = base.ncols();
@@ -330,10 +329,12 @@ pub fn static_right_hand_sides(
 ) -> Result<Mat<f64>, Error> {
     let n = model.dofs();
     if base.nrows() != n {
-        return Err(Error::Invalid(format!(
-            "TVD base has {} rows, the model {n} DOF",
-            base.nrows()
-        )));
+        return Err(ReductionError::Rows {
+            what: "TVD base has",
+            rows: base.nrows(),
+            dofs: n,
+        }
+        .into());
     }
     let run = TvdRun::new(model, base, opts);
     let cand = run.candidates(opts);
@@ -585,9 +586,11 @@ fn mode_eigenvalues(model: &Model, base: MatRef<'_, f64>) -> Result<Vec<f64>, Er
             let vm: f64 = v.iter().zip(&mv).map(|(a, b)| a * b).sum();
             let om2 = vk / vm;
             if !(om2.is_finite() && om2 > 0.0) {
-                return Err(Error::Invalid(format!(
-                    "TVD with inertia: base vector {i} has Rayleigh quotient {om2:e} (zero vector?)"
-                )));
+                return Err(ReductionError::TvdRayleighQuotient {
+                    vector: i,
+                    omega2: om2,
+                }
+                .into());
             }
             Ok(om2)
         })
@@ -670,13 +673,11 @@ fn scale_to_unit_energy(
             .map(|(x, y)| x * y)
             .sum();
         if !(e.is_finite() && e > 0.0) {
-            return Err(Error::LinearAlgebra(
-                format!(
-                    "TVD column {c} ({:?}) has strain energy {e:e}; K is not positive definite",
-                    index[c]
-                )
-                .into(),
-            ));
+            return Err(Error::LinearAlgebra(LinalgError::TvdStrainEnergy {
+                column: c,
+                index: (index[c].i, index[c].k, index[c].j),
+                energy: e,
+            }));
         }
         let s = e.sqrt();
         q.col_mut(a).iter_mut().for_each(|v| *v /= s);
@@ -705,20 +706,20 @@ fn shifted_solve(
         Some(s) => s.clone(),
         None => {
             let s = SymbolicLu::try_new(faer_a.symbolic()).map_err(|e| {
-                Error::LinearAlgebra(LinalgError::caused_by(
-                    format!("symbolic LU of K − Ω²M: {e:?}"),
-                    e,
-                ))
+                Error::LinearAlgebra(LinalgError::Symbolic {
+                    what: "LU of K − Ω²M".to_string(),
+                    source: Box::new(e),
+                })
             })?;
             *symbolic = Some(s.clone());
             s
         }
     };
     let lu = Lu::try_new_with_symbolic(sym, faer_a.as_ref()).map_err(|e| {
-        Error::LinearAlgebra(LinalgError::caused_by(
-            format!("LU of K − Ω²M for base vector {mode} (Ω² = {om2:e}): {e:?}"),
-            e,
-        ))
+        Error::LinearAlgebra(LinalgError::Factorization {
+            step: format!("LU of K − Ω²M for base vector {mode} (Ω² = {om2:e})"),
+            source: Box::new(e),
+        })
     })?;
     let mut z = rhs.clone();
     lu.solve_in_place(z.as_mut());
@@ -737,13 +738,11 @@ fn shifted_solve(
         };
     }
     if worst > 1e-10 {
-        return Err(Error::LinearAlgebra(
-            format!(
-            "TVD with inertia: (K − Ω²M) solve for base vector {mode} (Ω² = {om2:e}) has backward \
-             error {worst:.2e} > 1e-10 (Ω² is (nearly) a free-interface eigenvalue)"
-        )
-            .into(),
-        ));
+        return Err(Error::LinearAlgebra(LinalgError::TvdBackwardError {
+            mode,
+            omega2: om2,
+            backward: worst,
+        }));
     }
     Ok(z)
 }

@@ -18,7 +18,7 @@ use plotters::coord::ranged1d::{AsRangedCoord, ValueFormatter};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use crate::error::Error;
+use crate::error::{Error, FontError, ReportError};
 
 /// Font files tried, in order, when `JOINTROM_FONT` is not set.
 pub const FONT_CANDIDATES: &[&str] = &[
@@ -391,38 +391,32 @@ impl LineChart {
 /// Registers the chart font once per process (see the module docs); later calls return the
 /// first call's outcome.
 pub fn ensure_font() -> Result<(), Error> {
-    static LOADED: OnceLock<Result<(), String>> = OnceLock::new();
-    LOADED
+    static LOADED: OnceLock<Result<(), FontError>> = OnceLock::new();
+    Ok(LOADED
         .get_or_init(load_font)
         .clone()
-        .map_err(Error::Invalid)
+        .map_err(ReportError::Font)?)
 }
 
-fn load_font() -> Result<(), String> {
+fn load_font() -> Result<(), FontError> {
     let path = match std::env::var_os("JOINTROM_FONT") {
         Some(p) => PathBuf::from(p),
         None => FONT_CANDIDATES
             .iter()
             .map(PathBuf::from)
             .find(|p| p.is_file())
-            .ok_or_else(|| {
-                format!(
-                    "charts need a TrueType font: none of {} exists; install Debian's \
-                     fonts-dejavu-core or set JOINTROM_FONT to a .ttf file",
-                    FONT_CANDIDATES.join(", ")
-                )
+            .ok_or(FontError::Missing {
+                candidates: FONT_CANDIDATES,
             })?,
     };
-    let bytes = std::fs::read(&path)
-        .map_err(|e| format!("chart font {}: cannot read: {e}", path.display()))?;
+    let bytes = std::fs::read(&path).map_err(|e| FontError::Unreadable {
+        file: path.clone(),
+        reason: e.to_string(),
+    })?;
     // plotters keeps fonts for the whole process; the bytes are leaked once (OnceLock).
     let bytes: &'static [u8] = Box::leak(bytes.into_boxed_slice());
-    plotters::style::register_font(FAMILY, FontStyle::Normal, bytes).map_err(|_| {
-        format!(
-            "chart font {}: not a valid TrueType/OpenType font",
-            path.display()
-        )
-    })
+    plotters::style::register_font(FAMILY, FontStyle::Normal, bytes)
+        .map_err(|_| FontError::Invalid { file: path.clone() })
 }
 
 pub(crate) fn chart_error(path: &Path, reason: String) -> Error {

@@ -1,7 +1,7 @@
 //! A run's output curves as CSV (`transient --out DIR` writes `DIR/curves.csv`): one row per
 //! output time, units in the column names.
 
-use crate::error::Error;
+use crate::error::{Error, ReportError};
 use crate::integrate::Curves;
 
 /// The column names, with units.
@@ -21,7 +21,9 @@ pub const CURVE_COLUMNS: [&str; 9] = [
 /// every other value with 11.
 pub fn curves_csv(c: &Curves) -> Result<String, Error> {
     let mut w = csv::Writer::from_writer(Vec::new());
-    let fail = |e: csv::Error| Error::Invalid(format!("curves.csv: {e}"));
+    let fail = |e: csv::Error| ReportError::Curves {
+        source: Box::new(e),
+    };
     w.write_record(CURVE_COLUMNS).map_err(fail)?;
     for i in 0..c.t.len() {
         let values = [
@@ -38,8 +40,10 @@ pub fn curves_csv(c: &Curves) -> Result<String, Error> {
         row.extend(values.iter().map(|v| format!("{v:.10e}")));
         w.write_record(&row).map_err(fail)?;
     }
-    let bytes = w
-        .into_inner()
-        .map_err(|e| Error::Invalid(format!("curves.csv: {e}")))?;
-    String::from_utf8(bytes).map_err(|e| Error::Invalid(format!("curves.csv: {e}")))
+    let bytes = w.into_inner().map_err(|e| ReportError::Curves {
+        source: Box::new(e.into_error()),
+    })?;
+    Ok(String::from_utf8(bytes).map_err(|e| ReportError::Curves {
+        source: Box::new(e),
+    })?)
 }

@@ -13,7 +13,7 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
-use crate::error::Error;
+use crate::error::{Error, ReportError};
 use crate::report::chart::ensure_font;
 
 /// The font family registered by [`crate::report::chart::ensure_font`].
@@ -49,14 +49,13 @@ pub struct HeatMap {
 
 impl HeatMap {
     /// Checks the grid's shape.
-    fn check(&self) -> Result<(), String> {
+    fn check(&self) -> Result<(), ReportError> {
         if self.cells.len() != self.row_labels.len() {
-            return Err(format!(
-                "heat map \"{}\": {} rows of cells, {} row labels",
-                self.title,
-                self.cells.len(),
-                self.row_labels.len()
-            ));
+            return Err(ReportError::HeatMapRows {
+                title: self.title.clone(),
+                rows: self.cells.len(),
+                labels: self.row_labels.len(),
+            });
         }
         if let Some((i, r)) = self
             .cells
@@ -64,15 +63,17 @@ impl HeatMap {
             .enumerate()
             .find(|(_, r)| r.len() != self.col_labels.len())
         {
-            return Err(format!(
-                "heat map \"{}\": row {i} has {} cells, {} column labels",
-                self.title,
-                r.len(),
-                self.col_labels.len()
-            ));
+            return Err(ReportError::HeatMapRow {
+                title: self.title.clone(),
+                row: i,
+                cells: r.len(),
+                labels: self.col_labels.len(),
+            });
         }
         if self.cell_size.0 == 0 || self.cell_size.1 == 0 {
-            return Err(format!("heat map \"{}\": zero cell size", self.title));
+            return Err(ReportError::HeatMapCellSize {
+                title: self.title.clone(),
+            });
         }
         Ok(())
     }
@@ -97,7 +98,7 @@ impl HeatMap {
         let svg = stem.with_extension("svg");
         let png = stem.with_extension("png");
         ensure_font()?;
-        self.check().map_err(Error::Invalid)?;
+        self.check()?;
         let size = self.size();
         crate::files::write_atomic_with(&svg, |tmp| {
             self.draw(SVGBackend::new(tmp, size).into_drawing_area())

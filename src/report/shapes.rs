@@ -13,7 +13,7 @@ use std::path::{Path, PathBuf};
 use faer::{Mat, MatRef};
 use plotters::prelude::*;
 
-use crate::error::Error;
+use crate::error::{Error, ReportError};
 use crate::joint::NORMAL;
 use crate::model::Model;
 use crate::reduction::{craig_bampton, pod_tvd, trial_vector_derivatives, TvdOptions};
@@ -102,11 +102,12 @@ pub(crate) fn render_joint_modes(
     stem: &Path,
 ) -> Result<Vec<PathBuf>, Error> {
     if modes.nrows() != model.dofs() {
-        return Err(Error::Invalid(format!(
-            "joint-mode picture: modes have {} rows, the model {} DOF",
-            modes.nrows(),
-            model.dofs()
-        )));
+        return Err(ReportError::Rows {
+            what: "joint-mode picture: modes",
+            rows: modes.nrows(),
+            dofs: model.dofs(),
+        }
+        .into());
     }
     ensure_font()?;
     let w = model.joint.pairs();

@@ -19,7 +19,7 @@ use std::path::{Path, PathBuf};
 
 use faer::MatRef;
 
-use crate::error::Error;
+use crate::error::{Error, ReportError};
 use crate::model::{CellNodes, Model};
 
 /// VTK cell type of a 4-node quadrilateral.
@@ -123,9 +123,10 @@ fn check_name(name: &str) -> Result<(), Error> {
             .chars()
             .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-')
     {
-        return Err(Error::Invalid(format!(
-            "VTU shape name `{name}` must be non-empty ASCII letters, digits, `_` or `-`"
-        )));
+        return Err(ReportError::VtuName {
+            name: name.to_string(),
+        }
+        .into());
     }
     Ok(())
 }
@@ -138,19 +139,23 @@ fn expand_columns(
 ) -> Result<Vec<(String, Vec<f64>)>, Error> {
     check_name(prefix)?;
     if shapes.nrows() != model.dofs() {
-        return Err(Error::Invalid(format!(
-            "VTU: shapes have {} rows, the model {} DOF",
-            shapes.nrows(),
-            model.dofs()
-        )));
+        return Err(ReportError::Rows {
+            what: "VTU: shapes",
+            rows: shapes.nrows(),
+            dofs: model.dofs(),
+        }
+        .into());
     }
     (0..shapes.ncols())
         .map(|c| {
             let q: Vec<f64> = shapes.col(c).iter().copied().collect();
             if let Some(i) = q.iter().position(|v| !v.is_finite()) {
-                return Err(Error::Invalid(format!(
-                    "VTU: {prefix} column {c}, DOF {i} is not finite"
-                )));
+                return Err(ReportError::VtuNotFinite {
+                    prefix: prefix.to_string(),
+                    column: c,
+                    dof: i,
+                }
+                .into());
             }
             Ok((format!("{prefix}_{:02}", c + 1), model.dof_map.expand(&q)))
         })
@@ -181,11 +186,11 @@ pub fn write_series(
 ) -> Result<PathBuf, Error> {
     check_name(prefix)?;
     if times.len() != states.len() {
-        return Err(Error::Invalid(format!(
-            "VTU series: {} times but {} states",
-            times.len(),
-            states.len()
-        )));
+        return Err(ReportError::SeriesLength {
+            times: times.len(),
+            states: states.len(),
+        }
+        .into());
     }
     crate::files::create_dir(dir)?;
     let mut pvd = String::from(
@@ -193,16 +198,15 @@ pub fn write_series(
     );
     for (k, (t, q)) in times.iter().zip(states).enumerate() {
         if q.len() != model.dofs() {
-            return Err(Error::Invalid(format!(
-                "VTU series: state {k} has {} entries, the model {} DOF",
-                q.len(),
-                model.dofs()
-            )));
+            return Err(ReportError::SeriesState {
+                state: k,
+                len: q.len(),
+                dofs: model.dofs(),
+            }
+            .into());
         }
         if !t.is_finite() || q.iter().any(|v| !v.is_finite()) {
-            return Err(Error::Invalid(format!(
-                "VTU series: state {k} (t = {t} s) is not finite"
-            )));
+            return Err(ReportError::SeriesNotFinite { state: k, t: *t }.into());
         }
         let name = format!("{prefix}_{k:04}.vtu");
         let file = dir.join(&name);

@@ -11,6 +11,7 @@ use crate::joint::statics::{
     contact_static_reduced, contact_static_reduced_damped, ContactOptions, ContactState,
 };
 use crate::joint::NORMAL;
+use crate::linalg::LinalgError;
 use crate::model::Model;
 use crate::system::ReducedSystem;
 
@@ -77,9 +78,10 @@ pub fn reduced_contact_static_restarting(
         Ok(sol) => Ok((sol, None)),
         Err(first) => match reduced_contact_static_damped(model, rm, scale, opts) {
             Ok(sol) => Ok((sol, Some(first))),
-            Err(second) => Err(Error::LinearAlgebra(
-                format!("reduced contact statics failed: {first}; then, damped: {second}").into(),
-            )),
+            Err(second) => Err(Error::LinearAlgebra(LinalgError::ContactFallback {
+                first: Box::new(first),
+                second: Box::new(second),
+            })),
         },
     }
 }

@@ -26,6 +26,7 @@ use crate::case::LoadSpec;
 use crate::error::Error;
 use crate::joint::JointOperator;
 use crate::linalg::sparse::column_pattern;
+use crate::linalg::LinalgError;
 use crate::linalg::{LowRankCholesky, SparseCholesky, SymCsc};
 use crate::model::Model;
 
@@ -100,9 +101,11 @@ impl FullSystem {
         let pos = |i: usize, j: usize| -> Result<usize, Error> {
             let col = &row_idx[col_ptr[j]..col_ptr[j + 1]];
             col.binary_search(&i).map(|p| col_ptr[j] + p).map_err(|_| {
-                Error::LinearAlgebra(
-                    format!("entry ({i}, {j}) missing from the Newton pattern").into(),
-                )
+                Error::LinearAlgebra(LinalgError::MissingEntry {
+                    i,
+                    j,
+                    what: "Newton pattern",
+                })
             })
         };
         let mut k_pos = Vec::with_capacity(k.values.len());
@@ -237,8 +240,9 @@ impl SecondOrderSystem for FullSystem {
         self.clear_low_rank();
         self.kc_factored.copy_from_slice(kc);
         self.gamma_factored = gamma;
-        self.newton
-            .factor(&self.newton_values, "the Newton matrix M + γ²(K + BᵀK_cB)")
+        Ok(self
+            .newton
+            .factor(&self.newton_values, "the Newton matrix M + γ²(K + BᵀK_cB)")?)
     }
     fn newton_solve_in_place(&mut self, x: &mut [f64]) {
         self.low_rank.solve_in_place(&mut self.newton, x);

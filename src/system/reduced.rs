@@ -11,7 +11,7 @@ use faer::{Accum, Conj, Mat, MatMut, Par};
 
 use super::SecondOrderSystem;
 use crate::case::LoadSpec;
-use crate::error::Error;
+use crate::error::{Error, SystemError};
 use crate::joint::JointOperator;
 use crate::linalg::compensated::compensated_gram;
 use crate::linalg::kernels;
@@ -112,11 +112,11 @@ impl ReducedSystem {
         phi: Mat<f64>,
     ) -> Result<ReducedSystem, Error> {
         if phi.nrows() != k.n {
-            return Err(Error::Invalid(format!(
-                "basis has {} rows, the model {} DOF",
-                phi.nrows(),
-                k.n
-            )));
+            return Err(SystemError::BasisRows {
+                rows: phi.nrows(),
+                dofs: k.n,
+            }
+            .into());
         }
         let r = phi.ncols();
         let phi_master = Mat::from_fn(6, r, |d, c| phi[(master[d], c)]);
@@ -157,10 +157,11 @@ impl ReducedSystem {
         let r = k.nrows();
         if let Some(phi) = &phi {
             if phi.ncols() != r {
-                return Err(Error::Invalid(format!(
-                    "basis has {} columns, the reduced model dimension {r}",
-                    phi.ncols()
-                )));
+                return Err(SystemError::BasisColumns {
+                    columns: phi.ncols(),
+                    r,
+                }
+                .into());
             }
         }
         if k.ncols() != r
@@ -172,19 +173,15 @@ impl ReducedSystem {
             || phi_master.ncols() != r
             || column_size.len() != r
         {
-            return Err(Error::Invalid(format!(
-                "reduced model of dimension {r} has inconsistent K̃ ({}×{}), M̃ ({}×{}), BΦ ({}×{}, \
-                 3 rows per pair), master rows ({}×{}) or coordinate sizes ({})",
-                k.nrows(),
-                k.ncols(),
-                m.nrows(),
-                m.ncols(),
-                b_phi.nrows(),
-                b_phi.ncols(),
-                phi_master.nrows(),
-                phi_master.ncols(),
-                column_size.len()
-            )));
+            return Err(SystemError::Sizes {
+                r,
+                k: (k.nrows(), k.ncols()),
+                m: (m.nrows(), m.ncols()),
+                b_phi: (b_phi.nrows(), b_phi.ncols()),
+                master: (phi_master.nrows(), phi_master.ncols()),
+                coordinates: column_size.len(),
+            }
+            .into());
         }
         for (name, a) in [
             ("K̃", &k),
@@ -193,24 +190,21 @@ impl ReducedSystem {
             ("master rows", &phi_master),
         ] {
             if a.col_iter().any(|c| c.iter().any(|v| !v.is_finite())) {
-                return Err(Error::Invalid(format!(
-                    "reduced model: {name} has a non-finite entry"
-                )));
+                return Err(SystemError::NotFinite { name }.into());
             }
         }
         if let Some(c) = column_size
             .iter()
             .position(|s| !(s.is_finite() && *s > 0.0))
         {
-            return Err(Error::Invalid(format!(
-                "basis column {c} is zero or not finite"
-            )));
+            return Err(SystemError::ZeroColumn { column: c }.into());
         }
         if error_scale.field_dofs < r {
-            return Err(Error::Invalid(format!(
-                "reduced model of dimension {r} of a field with fewer DOF ({})",
-                error_scale.field_dofs
-            )));
+            return Err(SystemError::FieldTooSmall {
+                r,
+                field_dofs: error_scale.field_dofs,
+            }
+            .into());
         }
         let mut dev = 0.0f64;
         for i in 0..r {
@@ -232,10 +226,11 @@ impl ReducedSystem {
                 Default::default(),
             )
             .map_err(|e| {
-                Error::LinearAlgebra(LinalgError::caused_by(
-                    format!("reduced mass ({r}×{r}) not positive definite: {e:?}"),
-                    e,
-                ))
+                Error::LinearAlgebra(LinalgError::ReducedNotPositiveDefinite {
+                    matrix: "reduced mass",
+                    r,
+                    source: Box::new(e),
+                })
             })?;
         }
         let w3 = b_phi.nrows();
@@ -417,10 +412,11 @@ impl SecondOrderSystem for ReducedSystem {
             Default::default(),
         )
         .map_err(|e| {
-            Error::LinearAlgebra(LinalgError::caused_by(
-                format!("reduced Newton matrix ({r}×{r}) not positive definite: {e:?}"),
-                e,
-            ))
+            Error::LinearAlgebra(LinalgError::ReducedNotPositiveDefinite {
+                matrix: "reduced Newton matrix",
+                r,
+                source: Box::new(e),
+            })
         })?;
         self.newton_ok = true;
         Ok(())

@@ -2,7 +2,7 @@
 
 use faer::linalg::solvers::Solve;
 use faer::{Mat, Side};
-use jointrom::element::{Beam2, Material};
+use jointrom::element::{Beam2, ElementError, Material};
 use jointrom::Error;
 use rand::rngs::StdRng;
 use std::f64::consts::PI;
@@ -494,9 +494,12 @@ fn node_order_does_not_matter() {
     }
 }
 
-fn element_error(result: Result<Beam2, Error>) -> String {
+fn element_error(result: Result<Beam2, Error>) -> (ElementError, String) {
     match result {
-        Err(Error::Element(msg)) => msg,
+        Err(Error::Element(e)) => {
+            let msg = e.to_string();
+            (e, msg)
+        }
         Err(other) => panic!("expected Error::Element, got {other:?}"),
         Ok(_) => panic!("expected an error, got a beam"),
     }
@@ -506,14 +509,14 @@ fn element_error(result: Result<Beam2, Error>) -> String {
 fn bad_input_is_an_element_error() {
     let a = [1.0, 2.0, 3.0];
     let b = [1.0, 2.0, 3.5];
-    let msg = element_error(Beam2::circular(a, a, 5.0, STEEL));
-    assert!(msg.contains("length"), "{msg}");
-    let msg = element_error(Beam2::circular(a, [f64::NAN, 2.0, 3.0], 5.0, STEEL));
-    assert!(msg.contains("length"), "{msg}");
-    let msg = element_error(Beam2::circular(a, [f64::INFINITY, 2.0, 3.0], 5.0, STEEL));
-    assert!(msg.contains("length"), "{msg}");
+    for end in [a, [f64::NAN, 2.0, 3.0], [f64::INFINITY, 2.0, 3.0]] {
+        let (e, msg) = element_error(Beam2::circular(a, end, 5.0, STEEL));
+        assert!(matches!(e, ElementError::Beam2Length { .. }), "{e:?}");
+        assert!(msg.contains("length"), "{msg}");
+    }
     for d in [0.0, -5.0, f64::NAN, f64::INFINITY] {
-        let msg = element_error(Beam2::circular(a, b, d, STEEL));
+        let (e, msg) = element_error(Beam2::circular(a, b, d, STEEL));
+        assert!(matches!(e, ElementError::Beam2Diameter { .. }), "{e:?}");
         assert!(msg.contains("diameter"), "d = {d}: {msg}");
     }
     for material in [
@@ -534,14 +537,23 @@ fn bad_input_is_an_element_error() {
             ..STEEL
         },
     ] {
-        let msg = element_error(Beam2::circular(a, b, 5.0, material));
+        let (e, msg) = element_error(Beam2::circular(a, b, 5.0, material));
+        assert!(
+            matches!(&e, ElementError::Beam2Material { source, .. }
+                if matches!(**source, ElementError::Material { .. })),
+            "{e:?}"
+        );
         assert!(msg.contains("material"), "{material:?}: {msg}");
     }
     // Finite but absurd sizes whose matrices overflow.
-    let msg = element_error(Beam2::circular(a, b, 1e100, STEEL));
-    assert!(msg.contains("not representable"), "{msg}");
-    let msg = element_error(Beam2::circular([0.0; 3], [1e-310, 0.0, 0.0], 5.0, STEEL));
-    assert!(msg.contains("not representable"), "{msg}");
+    for (a, b, d) in [(a, b, 1e100), ([0.0; 3], [1e-310, 0.0, 0.0], 5.0)] {
+        let (e, msg) = element_error(Beam2::circular(a, b, d, STEEL));
+        assert!(
+            matches!(e, ElementError::Beam2NotRepresentable { .. }),
+            "{e:?}"
+        );
+        assert!(msg.contains("not representable"), "{msg}");
+    }
     // Very short is fine as long as it is representable.
     let k = Beam2::circular([0.0; 3], [1e-120, 0.0, 0.0], 5.0, STEEL)
         .unwrap()

@@ -6,6 +6,7 @@ use std::time::Instant;
 
 use faer::Mat;
 use jointrom::case::Case;
+use jointrom::error::JointError;
 use jointrom::joint::statics::{
     active_set_newton, contact_static_reduced, ActiveStart, ContactOptions, ContactSolution,
 };
@@ -340,12 +341,15 @@ fn bad_input_is_an_error() {
     for k_n in [0.0, -1.0, f64::NAN] {
         assert!(matches!(
             contact_static_reduced(k.as_ref(), b.as_ref(), &[1.0, 0.0], k_n, &opts),
-            Err(Error::Invalid(_))
+            Err(Error::Joint(JointError::NormalStiffness { .. }))
         ));
     }
     assert!(matches!(
         contact_static_reduced(k.as_ref(), b.as_ref(), &[1.0], 1.0, &opts),
-        Err(Error::Invalid(_))
+        Err(Error::Joint(JointError::ReducedStaticsSizes {
+            load: 1,
+            ..
+        }))
     ));
     let zero = ContactOptions {
         max_iterations: 0,
@@ -353,7 +357,7 @@ fn bad_input_is_an_error() {
     };
     assert!(matches!(
         contact_static_reduced(k.as_ref(), b.as_ref(), &[1.0, 0.0], 1.0, &zero),
-        Err(Error::Invalid(_))
+        Err(Error::Joint(JointError::NoIterations))
     ));
     let indefinite = Mat::from_fn(2, 2, |i, j| if i == j { -1.0 } else { 0.0 });
     assert!(matches!(

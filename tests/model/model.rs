@@ -211,7 +211,7 @@ fn factorization_errors_keep_faer_as_the_source() {
         values: vec![1.0, -1.0],
     };
     let err = match jointrom::linalg::SparseCholesky::new(&a) {
-        Err(e) => e,
+        Err(e) => jointrom::Error::from(e),
         Ok(_) => panic!("an indefinite matrix was factored"),
     };
     assert!(matches!(err, jointrom::Error::LinearAlgebra(_)), "{err}");

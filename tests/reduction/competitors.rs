@@ -9,6 +9,7 @@ use std::time::Instant;
 
 use faer::{Mat, MatRef};
 use jointrom::case::Case;
+use jointrom::error::ReductionError;
 use jointrom::joint::statics::{ContactOptions, ContactState};
 use jointrom::linalg::cholesky::SparseCholesky;
 use jointrom::linalg::SymCsc;
@@ -289,12 +290,20 @@ fn jim_bad_count_is_an_error() {
     let nn = jim_dofs(&model, JimSet::Normal).unwrap().len();
     let err = joint_interface_modes(&model, nn + 1, JimSet::Normal).unwrap_err();
     assert!(
-        matches!(err, Error::Invalid(ref s) if s.contains("normal")),
+        matches!(
+            err,
+            Error::Reduction(ReductionError::JimCount { set: "normal", count, available })
+                if count == nn + 1 && available == nn
+        ) && err.to_string().contains("normal"),
         "{err}"
     );
     let err = joint_interface_modes(&model, 3 * nn + 1, JimSet::Both).unwrap_err();
     assert!(
-        matches!(err, Error::Invalid(ref s) if s.contains("both")),
+        matches!(
+            err,
+            Error::Reduction(ReductionError::JimCount { set: "both", count, .. })
+                if count == 3 * nn + 1
+        ) && err.to_string().contains("both"),
         "{err}"
     );
     let opts = BasisOptions {

@@ -54,7 +54,7 @@ use sundials_sys::{
 use super::callbacks::{self, Failure, Shared};
 use super::owners::{CvodeMemory, LinearSolver, Matrix, NonlinearSolver, Owned};
 use super::{cvode_flag, cvode_flag_name, cvode_ls_flag_name, problem_ls, Context, SerialVector};
-use crate::error::{CallbackOutcome, Error};
+use crate::error::{CallbackOutcome, Error, IntegrationError};
 use crate::integrate::problem::{
     Iteration, Method, NewtonLinear, OdeOptions, OdeProblem, OdeStats, Stop,
 };
@@ -170,7 +170,7 @@ impl<P: OdeProblem> Cvode<P> {
     /// its own SUNDIALS context.
     ///
     /// # Errors
-    /// [`Error::Invalid`] naming the field for a bad option (`rtol`/`atol` negative or not
+    /// [`Error::Integration`] naming the field for a bad option (`rtol`/`atol` negative or not
     /// finite, `max_order` outside 1–5 (BDF) or 1–12 (Adams), `max_steps` 0, negative
     /// `max_step`/`init_step`, `stab_lim_det` with Adams, Newton with the problem's solver for
     /// a problem without one), a `y0` of the wrong length or with NaN/Inf, a zero dimension;
@@ -241,9 +241,11 @@ impl<P: OdeProblem> Cvode<P> {
             .enumerate()
             .find(|(_, s)| !(s.is_finite() && **s > 0.0))
         {
-            return Err(Error::Invalid(format!(
-                "the problem's absolute-tolerance scale[{i}] = {s} is not finite and > 0"
-            )));
+            return Err(IntegrationError::ToleranceScale {
+                index: i,
+                value: *s,
+            }
+            .into());
         }
         scale.iter_mut().for_each(|s| *s *= atol);
         Ok(Some(SerialVector::from_slice(context, &scale)?))
@@ -292,8 +294,10 @@ impl<P: OdeProblem> Cvode<P> {
     /// Functional iteration: attaches a fixed-point solver with Anderson depth `anderson`.
     fn attach_fixed_point(&mut self, context: &Context, anderson: usize) -> Result<(), Error> {
         let m = self.mem.as_raw();
-        let depth = c_int::try_from(anderson)
-            .map_err(|_| Error::Invalid(format!("iteration.anderson = {anderson} is too large")))?;
+        let depth = c_int::try_from(anderson).map_err(|_| IntegrationError::TooLarge {
+            what: "iteration.anderson",
+            value: anderson,
+        })?;
         // SAFETY: `y` is a live template vector and the context is live; the new solver
         // (or null) is owned by `nls` alone.
         let nls = unsafe {
@@ -392,8 +396,10 @@ impl<P: OdeProblem> Cvode<P> {
                 self.check_cv("CVodeSetStabLimDet", CVodeSetStabLimDet(m, 1))?;
             }
             if nroots > 0 {
-                let nr = c_int::try_from(nroots)
-                    .map_err(|_| Error::Invalid(format!("num_roots() = {nroots} is too large")))?;
+                let nr = c_int::try_from(nroots).map_err(|_| IntegrationError::TooLarge {
+                    what: "num_roots()",
+                    value: nroots,
+                })?;
                 self.check_cv(
                     "CVodeRootInit",
                     CVodeRootInit(m, nr, Some(callbacks::roots::<P>)),
@@ -415,13 +421,16 @@ impl<P: OdeProblem> Cvode<P> {
     /// [`Error::Callback`] if a callback failed (error, panic, persistent NaN/Inf), naming it,
     /// its last message and the CVODE flag; [`Error::Sundials`] naming `CVode`, the flag (e.g.
     /// `CV_TOO_MUCH_WORK`, `CV_CONV_FAILURE`, `CV_ERR_FAILURE`) and the time reached;
-    /// [`Error::Invalid`] for a non-finite `tout`. After an error `t`/`y` hold the last state
+    /// [`Error::Integration`] for a non-finite `tout`. After an error `t`/`y` hold the last state
     /// CVODE reached.
     pub fn solve_to(&mut self, tout: f64) -> Result<Stop, Error> {
         if !tout.is_finite() {
-            return Err(Error::Invalid(format!(
-                "solve_to: tout = {tout} is not finite"
-            )));
+            return Err(IntegrationError::TimeNotFinite {
+                function: "solve_to",
+                name: "tout",
+                value: tout,
+            }
+            .into());
         }
         if let Some(failure) = self.poisoned_failure() {
             return Err(callback_error(failure, CallbackOutcome::NotRun));
@@ -526,7 +535,7 @@ impl<P: OdeProblem> Cvode<P> {
     /// functions are kept. Statistics stay cumulative. Clears the poisoning left by a panic.
     ///
     /// # Errors
-    /// [`Error::Invalid`] for a `y` of the wrong length or with NaN/Inf, or a non-finite `t`;
+    /// [`Error::Integration`] for a `y` of the wrong length or with NaN/Inf, or a non-finite `t`;
     /// [`Error::Sundials`] naming `CVodeReInit`.
     pub fn reinit(&mut self, t: f64, y: &[f64]) -> Result<(), Error> {
         check_state("reinit", t, y, self.shared.get().n)?;
@@ -549,13 +558,16 @@ impl<P: OdeProblem> Cvode<P> {
     /// `Stop::Reached(tstop)` when it gets there first; CVODE then forgets the stop time.
     ///
     /// # Errors
-    /// [`Error::Invalid`] for a non-finite `tstop`; [`Error::Sundials`] naming
+    /// [`Error::Integration`] for a non-finite `tstop`; [`Error::Sundials`] naming
     /// `CVodeSetStopTime` (e.g. `tstop` behind the current time).
     pub fn set_stop_time(&mut self, tstop: f64) -> Result<(), Error> {
         if !tstop.is_finite() {
-            return Err(Error::Invalid(format!(
-                "set_stop_time: tstop = {tstop} is not finite"
-            )));
+            return Err(IntegrationError::TimeNotFinite {
+                function: "set_stop_time",
+                name: "tstop",
+                value: tstop,
+            }
+            .into());
         }
         // SAFETY: memory live and owned by `self`.
         let flag = unsafe { CVodeSetStopTime(self.mem.as_raw(), tstop) };
@@ -570,14 +582,16 @@ impl<P: OdeProblem> Cvode<P> {
     /// (module docs), far tighter than the paper's 1e-10 s.
     ///
     /// # Errors
-    /// [`Error::Invalid`] if `directions` does not have `num_roots()` entries of −1, 0, +1;
+    /// [`Error::Integration`] if `directions` does not have `num_roots()` entries of −1, 0, +1;
     /// [`Error::Sundials`] naming `CVodeSetRootDirection`.
     pub fn set_root_direction(&mut self, directions: &[i32]) -> Result<(), Error> {
         let nroots = self.shared.get().nroots;
         if directions.len() != nroots || directions.iter().any(|d| d.abs() > 1) {
-            return Err(Error::Invalid(format!(
-                "set_root_direction: need {nroots} entries of -1, 0, +1, got {directions:?}"
-            )));
+            return Err(IntegrationError::RootDirections {
+                roots: nroots,
+                directions: directions.to_vec(),
+            }
+            .into());
         }
         if nroots == 0 {
             return Ok(());
@@ -764,21 +778,30 @@ fn callback_error(f: Failure, outcome: CallbackOutcome) -> Error {
 }
 
 /// Checks a state: finite `t`, `y` of length `n` with finite entries.
-fn check_state(what: &str, t: f64, y: &[f64], n: usize) -> Result<(), Error> {
+fn check_state(what: &'static str, t: f64, y: &[f64], n: usize) -> Result<(), Error> {
     if !t.is_finite() {
-        return Err(Error::Invalid(format!("{what}: t = {t} is not finite")));
+        return Err(IntegrationError::TimeNotFinite {
+            function: what,
+            name: "t",
+            value: t,
+        }
+        .into());
     }
     if y.len() != n {
-        return Err(Error::Invalid(format!(
-            "{what}: y has {} entries, the problem's dimension is {n}",
-            y.len()
-        )));
+        return Err(IntegrationError::StateLength {
+            function: what,
+            len: y.len(),
+            n,
+        }
+        .into());
     }
     if let Some(i) = y.iter().position(|v| !v.is_finite()) {
-        return Err(Error::Invalid(format!(
-            "{what}: y[{i}] = {} is not finite",
-            y[i]
-        )));
+        return Err(IntegrationError::StateNotFinite {
+            function: what,
+            index: i,
+            value: y[i],
+        }
+        .into());
     }
     Ok(())
 }
@@ -787,15 +810,16 @@ fn check_state(what: &str, t: f64, y: &[f64], n: usize) -> Result<(), Error> {
 fn validate<P: OdeProblem>(problem: &P, t0: f64, y0: &[f64], o: &OdeOptions) -> Result<(), Error> {
     let n = problem.dim();
     if n == 0 {
-        return Err(Error::Invalid(
-            "Cvode::new: the problem has dimension 0".into(),
-        ));
+        return Err(IntegrationError::EmptyProblem.into());
     }
     check_state("Cvode::new", t0, y0, n)?;
-    let bad = |field: &str, value: String, need: &str| {
-        Err(Error::Invalid(format!(
-            "OdeOptions.{field} = {value}: must be {need}"
-        )))
+    let bad = |field: &'static str, value: String, need: &str| -> Result<(), Error> {
+        Err(IntegrationError::Option {
+            field,
+            value,
+            need: need.to_string(),
+        }
+        .into())
     };
     if !(o.rtol.is_finite() && o.rtol >= 0.0) {
         return bad("rtol", o.rtol.to_string(), "finite and ≥ 0");

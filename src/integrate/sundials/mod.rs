@@ -43,16 +43,15 @@ mod context;
 pub mod cvode;
 mod fast_ops;
 mod ffi;
-mod flag;
 mod owners;
 mod problem_ls;
 mod vector;
 
 use std::ffi::{c_char, CStr};
 
+pub use crate::error::CvodeFlag;
 pub use context::Context;
 pub use cvode::Cvode;
-pub use flag::CvodeFlag;
 pub use vector::SerialVector;
 
 use crate::Error;

@@ -8,7 +8,7 @@ use sundials_sys::{
 };
 
 use super::{sundials_error, Context, CvodeFlag};
-use crate::Error;
+use crate::error::{Error, IntegrationError};
 
 /// A serial SUNDIALS vector (`N_VNew_Serial`) owning its `f64` data, destroyed (`N_VDestroy`) on
 /// drop. Read and write it as a slice; it keeps its [`Context`] alive.
@@ -23,12 +23,11 @@ impl SerialVector {
     /// A vector of `len` zeros in `context`.
     ///
     /// # Errors
-    /// [`Error::Invalid`] if `len` does not fit SUNDIALS's 64-bit index type;
+    /// [`Error::Integration`] if `len` does not fit SUNDIALS's 64-bit index type;
     /// [`Error::Sundials`] naming `N_VNew_Serial` if the allocation failed.
     pub fn zeros(context: &Context, len: usize) -> Result<Self, Error> {
-        let n = sunindextype::try_from(len).map_err(|_| {
-            Error::Invalid(format!("vector length {len} exceeds SUNDIALS's index type"))
-        })?;
+        let n = sunindextype::try_from(len)
+            .map_err(|_| Error::Integration(IntegrationError::VectorLength { len }))?;
         // SAFETY: the context pointer is valid while `context` lives, and the vector keeps a
         // clone of it. N_VNew_Serial returns a new vector owning `n` doubles, or null.
         let raw = unsafe { N_VNew_Serial(n, context.as_raw()) };

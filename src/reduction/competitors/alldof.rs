@@ -30,6 +30,7 @@ use crate::error::Error;
 use crate::joint::NORMAL;
 use crate::linalg::cholesky::SparseCholesky;
 use crate::linalg::compensated::solve_refined;
+use crate::linalg::LinalgError;
 use crate::model::Model;
 
 use super::jim::interior_size;
@@ -56,9 +57,10 @@ pub fn alldof_vectors(model: &Model) -> Result<Mat<f64>, Error> {
         x = solve_refined(&kii_mat, &kii, &x);
     }
     if x.col_iter().any(|c| c.iter().any(|v| !v.is_finite())) {
-        return Err(Error::LinearAlgebra(
-            "all-joint-DOF constraint modes are not finite".into(),
-        ));
+        return Err(Error::LinearAlgebra(LinalgError::NotFinite {
+            what: "all-joint-DOF constraint modes".to_string(),
+            plural: true,
+        }));
     }
     let n = model.dofs();
     Ok(Mat::from_fn(

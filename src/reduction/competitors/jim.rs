@@ -60,7 +60,7 @@ use faer::linalg::triangular_solve::{
 };
 use faer::{Mat, Par, Side};
 
-use crate::error::Error;
+use crate::error::{Error, ReductionError};
 use crate::linalg::cholesky::SparseCholesky;
 use crate::linalg::symmetric_eigen;
 use crate::linalg::LinalgError;
@@ -108,20 +108,20 @@ pub fn jim_dofs(model: &Model, set: JimSet) -> Result<Vec<usize>, Error> {
             JimSet::InPlane => &in_plane,
             JimSet::Both => &[a, in_plane[0], in_plane[1]],
         };
-        let deps = model.dof_map.nodes.get(node).ok_or_else(|| {
-            Error::Invalid(format!(
-                "joint pair names node {node}, which does not exist"
-            ))
-        })?;
+        let deps = model
+            .dof_map
+            .nodes
+            .get(node)
+            .ok_or_else(|| Error::Reduction(ReductionError::UnknownJointNode { node }))?;
         for &d in dirs {
             match deps[d].as_free() {
                 Some(i) if i < m => out.push(i),
                 _ => {
-                    return Err(Error::Invalid(format!(
-                        "Joint Interface Modes: joint node {node}, direction {} is not an \
-                         independent interior DOF (clamped, tied or the master node)",
-                        ["x", "y", "z"][d]
-                    )))
+                    return Err(ReductionError::JimDependentDof {
+                        node,
+                        axis: ["x", "y", "z"][d],
+                    }
+                    .into())
                 }
             }
         }
@@ -130,20 +130,25 @@ pub fn jim_dofs(model: &Model, set: JimSet) -> Result<Vec<usize>, Error> {
 }
 
 /// The interior size m = n − 6, checking that the master DOF are the last six.
-pub(crate) fn interior_size(model: &Model, what: &str) -> Result<usize, Error> {
+pub(crate) fn interior_size(model: &Model, what: &'static str) -> Result<usize, Error> {
     let n = model.dofs();
     if n <= 6 {
-        return Err(Error::Invalid(format!(
-            "{what} needs interior DOF: the model has only {n} DOF"
-        )));
+        return Err(ReductionError::NoInteriorDofs {
+            method: what,
+            dofs: n,
+        }
+        .into());
     }
     let m = n - 6;
     for (c, &d) in model.master_dofs().iter().enumerate() {
         if d != m + c {
-            return Err(Error::Invalid(format!(
-                "{what} expects the master DOF last: master DOF {c} is independent DOF {d}, not {}",
-                m + c
-            )));
+            return Err(ReductionError::MasterNotLast {
+                method: what,
+                master: c,
+                dof: d,
+                expected: m + c,
+            }
+            .into());
         }
     }
     Ok(m)
@@ -167,12 +172,11 @@ fn condensed_modes(
     let g = xs.transpose() * &mx;
     let g = Mat::from_fn(p, p, |a, b| 0.5 * (g[(a, b)] + g[(b, a)]));
     let llt = f.llt(Side::Lower).map_err(|e| {
-        Error::LinearAlgebra(LinalgError::caused_by(
-            format!(
-            "Joint Interface Modes: the {p}×{p} joint flexibility is not positive definite: {e:?}"
-        ),
-            e,
-        ))
+        Error::LinearAlgebra(LinalgError::NotPositiveDefinite {
+            what: format!("Joint Interface Modes: the {p}×{p} joint flexibility"),
+            hint: "",
+            source: Box::new(e),
+        })
     })?;
     let l = llt.L();
     // C = L⁻¹ G L⁻ᵀ: Y = L⁻¹ G, then C = L⁻¹ Yᵀ.
@@ -202,10 +206,11 @@ fn condensed_modes(
             let ugu: f64 = (0..p).map(|a| ui[a] * gu[a]).sum();
             let ufu: f64 = (0..p).map(|a| ui[a] * fu[a]).sum();
             if !(ugu > 0.0 && ufu > 0.0) {
-                return Err(Error::LinearAlgebra(
-                    format!("Joint Interface Modes: mode {k} has uᵀGu = {ugu:e}, uᵀFu = {ufu:e}")
-                        .into(),
-                ));
+                return Err(Error::LinearAlgebra(LinalgError::JimProducts {
+                    mode: k,
+                    ugu,
+                    ufu,
+                }));
             }
             lambda.push(ufu / ugu);
             let inv = 1.0 / ugu.sqrt();
@@ -239,10 +244,12 @@ pub fn joint_interface_modes(
         JimSet::Both => normal.len() + in_plane.len(),
     };
     if count > available {
-        return Err(Error::Invalid(format!(
-            "{count} Joint Interface Modes requested, the {} set has {available} joint DOF",
-            set.name()
-        )));
+        return Err(ReductionError::JimCount {
+            count,
+            set: set.name(),
+            available,
+        }
+        .into());
     }
     if count == 0 {
         return Ok(JointInterfaceModes {
@@ -270,9 +277,10 @@ pub fn joint_interface_modes(
     let kii = SparseCholesky::new(&model.stiffness.leading(m))?;
     kii.solve_in_place(&mut x);
     if x.col_iter().any(|c| c.iter().any(|v| !v.is_finite())) {
-        return Err(Error::LinearAlgebra(
-            "Joint Interface Modes: static responses are not finite".into(),
-        ));
+        return Err(Error::LinearAlgebra(LinalgError::NotFinite {
+            what: "Joint Interface Modes: static responses".to_string(),
+            plural: true,
+        }));
     }
     let mut parts: Vec<(JimSet, Vec<f64>, Mat<f64>, usize)> = Vec::new();
     let mut start = 0;
@@ -294,15 +302,11 @@ pub fn joint_interface_modes(
     picks.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
     picks.truncate(count);
     if let Some(&(_, s, k)) = picks.iter().find(|p| !p.0.is_finite()) {
-        return Err(Error::LinearAlgebra(
-            format!(
-                "Joint Interface Mode {} of the {} set has a numerically infinite frequency \
-             (condensed mass eigenvalue ≤ 1e-12 of the largest): request fewer than {count}",
-                k + 1,
-                parts[s].0.name()
-            )
-            .into(),
-        ));
+        return Err(Error::LinearAlgebra(LinalgError::JimInfiniteFrequency {
+            mode: k + 1,
+            set: parts[s].0.name(),
+            count,
+        }));
     }
     let mut vectors = Mat::<f64>::zeros(n, count);
     let mut mphi = vec![0.0; n];
@@ -322,9 +326,10 @@ pub fn joint_interface_modes(
             .sum::<f64>()
             .sqrt();
         if !(norm.is_finite() && norm > 0.0) {
-            return Err(Error::LinearAlgebra(
-                format!("Joint Interface Mode {c} has M-norm {norm:e}").into(),
-            ));
+            return Err(Error::LinearAlgebra(LinalgError::ModeNorm {
+                what: format!("Joint Interface Mode {c}"),
+                norm,
+            }));
         }
         full.iter_mut().for_each(|v| *v /= norm);
         for r in 0..m {

@@ -16,7 +16,7 @@
 
 use faer::MatRef;
 
-use crate::error::Error;
+use crate::error::{Error, ReductionError};
 use crate::linalg::SymCsc;
 use crate::model::Model;
 
@@ -29,17 +29,17 @@ use crate::reduction::pod::{pod, Pod};
 /// wrong size or an all-zero snapshot set. See the module docs.
 pub fn snapshot_pod(snapshots: MatRef<'_, f64>, weight: Option<&SymCsc>) -> Result<Pod, Error> {
     if snapshots.ncols() == 0 {
-        return Err(Error::Invalid(
-            "snapshot POD: no snapshots (0 columns)".into(),
-        ));
+        return Err(ReductionError::NoSnapshots.into());
     }
     if let Some((r, c)) = (0..snapshots.ncols())
         .flat_map(|c| (0..snapshots.nrows()).map(move |r| (r, c)))
         .find(|&(r, c)| !snapshots[(r, c)].is_finite())
     {
-        return Err(Error::Invalid(format!(
-            "snapshot POD: snapshot {c}, DOF {r} is not finite"
-        )));
+        return Err(ReductionError::SnapshotNotFinite {
+            snapshot: c,
+            dof: r,
+        }
+        .into());
     }
     pod(snapshots, weight)
 }
@@ -56,11 +56,12 @@ pub fn snapshot_basis(
     opts: &BasisOptions,
 ) -> Result<Basis, Error> {
     if snapshots.nrows() != model.dofs() {
-        return Err(Error::Invalid(format!(
-            "snapshots have {} rows, the model {} DOF",
-            snapshots.nrows(),
-            model.dofs()
-        )));
+        return Err(ReductionError::Rows {
+            what: "snapshots have",
+            rows: snapshots.nrows(),
+            dofs: model.dofs(),
+        }
+        .into());
     }
     let p = snapshot_pod(snapshots, weight)?;
     let g = opts

@@ -11,7 +11,7 @@ use zip::write::SimpleFileOptions;
 use zip::{CompressionMethod, ZipWriter};
 
 use super::{guid, model_description, model_identifier, PLATFORM, ROM_RESOURCE};
-use crate::error::Error;
+use crate::error::{Error, ReportError};
 use crate::rom::file::RomFile;
 
 /// What [`write_fmu`] wrote.
@@ -36,8 +36,9 @@ fn archive(rom: &RomFile, binary: &[u8]) -> Result<(Vec<u8>, FmuPackage), Error>
     let rom_json = serde_json::to_string_pretty(rom).expect("the reduced model serialises");
     let id = model_identifier(&rom.case);
     let description = model_description(rom, rom_json.as_bytes());
-    let zip_err = |what: &str, e: zip::result::ZipError| {
-        Error::Invalid(format!("writing the FMU archive ({what}): {e}"))
+    let zip_err = |what: &str, source: zip::result::ZipError| ReportError::FmuArchive {
+        what: what.to_string(),
+        source,
     };
     let file = SimpleFileOptions::default()
         .compression_method(CompressionMethod::Deflated)
@@ -70,16 +71,15 @@ fn archive(rom: &RomFile, binary: &[u8]) -> Result<(Vec<u8>, FmuPackage), Error>
 /// Writes the FMU of `rom` with the FMU binary at `binary` (`libjointrom_fmu.so`) to `out`.
 ///
 /// # Errors
-/// [`Error::Io`] naming the binary if it cannot be read, [`Error::Invalid`] if it is not a
+/// [`Error::Io`] naming the binary if it cannot be read, [`Error::Report`] if it is not a
 /// 64-bit ELF shared object, errors writing `out` (naming it).
 pub fn write_fmu(rom: &RomFile, binary: &Path, out: &Path) -> Result<FmuPackage, Error> {
     let so = crate::files::read_bytes(binary)?;
     if !looks_like_elf64(&so) {
-        return Err(Error::Invalid(format!(
-            "the FMU binary {} is not a 64-bit ELF shared object (expected the \
-             libjointrom_fmu.so built by `cargo build --release -p jointrom-fmu`)",
-            binary.display()
-        )));
+        return Err(ReportError::FmuBinary {
+            binary: binary.to_path_buf(),
+        }
+        .into());
     }
     let (bytes, info) = archive(rom, &so)?;
     crate::files::write_atomic(out, bytes)?;

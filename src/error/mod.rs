@@ -1,9 +1,22 @@
 //! The crate's error type: one enum, a variant per layer, each naming what was wrong and where.
+//! The layers' own typed reasons live here too, so that every layer can use them and this
+//! module imports nothing from the layers but [`LinalgError`]: [`ElementError`] (elements and
+//! materials), the request errors of `request.rs` ([`ModelError`], [`JointError`],
+//! [`SystemError`], [`ReductionError`], [`IntegrationError`], [`ReportError`]), and SUNDIALS'
+//! return flag [`CvodeFlag`].
 
 use std::path::PathBuf;
 
-pub use crate::integrate::sundials::CvodeFlag;
+mod cvode_flag;
+mod element;
+mod request;
+
 pub use crate::linalg::LinalgError;
+pub use cvode_flag::CvodeFlag;
+pub use element::{ElementError, WeldLayerProblem};
+pub use request::{
+    FontError, IntegrationError, JointError, ModelError, ReductionError, ReportError, SystemError,
+};
 
 /// Everything that can go wrong in jointrom. Bad input is an error, never a panic.
 #[derive(Debug, thiserror::Error)]
@@ -59,11 +72,36 @@ pub enum Error {
     },
     /// An element could not be built (degenerate geometry, bad material).
     #[error("element: {0}")]
-    Element(String),
-    /// A linear-algebra failure: singular or indefinite matrix, failed factorization.
+    Element(#[from] ElementError),
+    /// A linear-algebra failure: singular or indefinite matrix, failed factorization, a
+    /// numerical check that failed. `From<LinalgError>` puts requests the matrices cannot serve
+    /// ([`LinalgError::is_request`]) in [`Error::MatrixRequest`] instead.
     #[error("linear algebra: {0}")]
     LinearAlgebra(#[source] LinalgError),
-    /// A request that does not fit the model (too many modes, unknown DOF, ...).
+    /// A request the matrices cannot serve (a mode count out of range, mismatched patterns).
+    #[error("invalid request: {0}")]
+    MatrixRequest(#[source] LinalgError),
+    /// A model request that does not fit (an export the map cannot express, a degenerate gap).
+    #[error("invalid request: {0}")]
+    Model(#[from] ModelError),
+    /// A joint or contact-statics request that does not fit (bad options, sizes, nodes).
+    #[error("invalid request: {0}")]
+    Joint(#[from] JointError),
+    /// A reduced model that does not fit its basis or model.
+    #[error("invalid request: {0}")]
+    System(#[from] SystemError),
+    /// A reduction request that does not fit the model (sizes, counts, missing DOF).
+    #[error("invalid request: {0}")]
+    Reduction(#[from] ReductionError),
+    /// A time-integration request that does not fit (times, states, options).
+    #[error("invalid request: {0}")]
+    Integration(#[from] IntegrationError),
+    /// A report that cannot be written as asked (shapes, series, archives, charts).
+    #[error("invalid request: {0}")]
+    Report(#[from] ReportError),
+    /// Being phased out: a request that does not fit the model, in words; only the modules
+    /// being moved still use it, and will use the typed variants above.
+    #[doc(hidden)]
     #[error("invalid request: {0}")]
     Invalid(String),
     /// A failure reported by SUNDIALS: the C function, the flag's name and the time reached
@@ -93,6 +131,16 @@ pub enum Error {
          (chattering switch); run with events off"
     )]
     Chatter { roots: usize, time: f64 },
+}
+
+impl From<LinalgError> for Error {
+    fn from(e: LinalgError) -> Error {
+        if e.is_request() {
+            Error::MatrixRequest(e)
+        } else {
+            Error::LinearAlgebra(e)
+        }
+    }
 }
 
 /// What the integrator did about a failed callback.
