@@ -125,6 +125,9 @@ pub enum ReductionError {
         rows: usize,
         dofs: usize,
     },
+    /// The secant TVD asked for together with the tangential or inertia variant.
+    #[error("secant TVD: only the static normal-stiffness TVD have a secant form (no tangential, no inertia)")]
+    SecantOptions,
     /// A basis part of `rows` rows for an `n` × `n` mass matrix.
     #[error("basis part has {rows} rows, the mass matrix is {n}×{n}")]
     PartRows { rows: usize, n: usize },

@@ -8,7 +8,7 @@ use super::basis::{final_basis, modal_rotation, Basis, BasisOptions};
 use super::competitors::{alldof_vectors, jim_vectors};
 use super::craig_bampton::craig_bampton;
 use super::pod::{pod_tvd, pod_tvd_ratios};
-use super::tvd::trial_vector_derivatives;
+use super::tvd::{trial_vector_derivatives, TvdOptions};
 use crate::error::Error;
 use crate::model::Model;
 
@@ -23,6 +23,10 @@ pub enum BasisKind {
     /// TVD joint modes from the plain (Euclidean) POD (eqs. 20–22).
     #[value(name = "tvd-plain")]
     TvdPlain,
+    /// Secant TVD (`(K + ∂K)⁻¹ ∂K φ_i`, [`super::tvd`], "The secant TVD") with the K-weighted
+    /// POD: Algorithm 2 with line 19 replaced; opt-in.
+    #[value(name = "tvd-secant")]
+    TvdSecant,
     /// No joint modes: Craig–Bampton with ν + g fixed-interface modes instead (the paper's
     /// comparison, Figure 7).
     #[value(name = "modes")]
@@ -41,22 +45,25 @@ pub enum BasisKind {
 
 impl BasisKind {
     /// Every kind, in the order of [`BasisKind::NAMES`].
-    pub const ALL: [BasisKind; 5] = [
+    pub const ALL: [BasisKind; 6] = [
         BasisKind::Tvd,
         BasisKind::TvdPlain,
+        BasisKind::TvdSecant,
         BasisKind::Modes,
         BasisKind::Jim,
         BasisKind::AllDof,
     ];
 
-    /// The accepted names: `tvd`, `tvd-plain`, `modes`, `jim`, `alldof`.
-    pub const NAMES: [&'static str; 5] = ["tvd", "tvd-plain", "modes", "jim", "alldof"];
+    /// The accepted names: `tvd`, `tvd-plain`, `tvd-secant`, `modes`, `jim`, `alldof`.
+    pub const NAMES: [&'static str; 6] =
+        ["tvd", "tvd-plain", "tvd-secant", "modes", "jim", "alldof"];
 
     /// The kind's name (as accepted by [`BasisKind::from_name`] and the CLI's `--basis`).
     pub fn name(self) -> &'static str {
         match self {
             BasisKind::Tvd => "tvd",
             BasisKind::TvdPlain => "tvd-plain",
+            BasisKind::TvdSecant => "tvd-secant",
             BasisKind::Modes => "modes",
             BasisKind::Jim => "jim",
             BasisKind::AllDof => "alldof",
@@ -121,14 +128,18 @@ fn build(
     other_pod: bool,
 ) -> Result<(Basis, Option<Vec<f64>>), Error> {
     let need_tvd = match kind {
-        BasisKind::Tvd | BasisKind::TvdPlain => true,
+        BasisKind::Tvd | BasisKind::TvdPlain | BasisKind::TvdSecant => true,
         BasisKind::Modes | BasisKind::Jim => opts.g.is_none(),
         BasisKind::AllDof => false,
     };
     let cb = craig_bampton(model, opts.nu)?;
     let mut other_w = None;
     let (w, g, tvd_total, tvd_nonzero, joint_modes) = if need_tvd {
-        let tvd = trial_vector_derivatives(model, cb.as_ref(), &opts.tvd)?;
+        let tvd_opts = TvdOptions {
+            secant: opts.tvd.secant || kind == BasisKind::TvdSecant,
+            ..opts.tvd
+        };
+        let tvd = trial_vector_derivatives(model, cb.as_ref(), &tvd_opts)?;
         let p = pod_tvd(model, &tvd, kind != BasisKind::TvdPlain)?;
         if other_pod {
             other_w = Some(pod_tvd_ratios(model, &tvd, kind == BasisKind::TvdPlain)?);
@@ -174,7 +185,7 @@ fn build(
                 final_basis(&[cb.as_ref(), psi.as_ref()], &model.mass, opts.drop_tol)?;
             (phi, dropped, psi.ncols())
         }
-        BasisKind::Tvd | BasisKind::TvdPlain => {
+        BasisKind::Tvd | BasisKind::TvdPlain | BasisKind::TvdSecant => {
             let (phi, dropped) = final_basis(
                 &[cb.as_ref(), joint_modes.as_ref()],
                 &model.mass,

@@ -52,6 +52,26 @@
 //! eigenvalues below the Gram route's round-off (measured in `docs/validation/static-convergence.md`, section
 //! `reduction::tvd`).
 //!
+//! # The secant TVD (opt-in, [`TvdOptions::secant`])
+//! A tangent TVD `K⁻¹ (∂K/∂q_{k,j}) φ_i` weighs pair z by the gap the linear base opens there,
+//! `k_n (B_n φ_i)_z`: the first-order change of φ_i when the penalty of the active set A is
+//! switched on. Where the penalty is stiff against the sheet (`k_n G_zz ≫ 1` on the pair-space
+//! flexibility `G = B_n K⁻¹ B_nᵀ`), the first order overshoots by orders of magnitude, and pairs
+//! that the welds hold nearly shut get tiny weights and enter only the last POD modes although
+//! they carry load. The exact change of the shape when that contact stiffness is switched on is
+//! the secant `φ_{i,k,j} = (K + ∂K/∂q_{k,j})⁻¹ (∂K/∂q_{k,j}) φ_i` — what a finite-difference
+//! evaluation of `∂φ_i/∂q_j` returns for a penalty law (the paper's Section 2.3). With
+//! `∂K = k_n B_Aᵀ B_A` the Woodbury identity keeps the factor form:
+//!
+//! ```text
+//! φ_{i,k,j} = Z c,   c_A = (I/k_n + G_AA)⁻¹ (B_n φ_i)_A,   c = 0 off A,   Z = K⁻¹ B_nᵀ
+//! ```
+//!
+//! one small dense SPD solve of size |A| per active set (normal rows only; the tangential and
+//! inertia variants have no secant form here). Everything downstream — K-normalization, the
+//! POD, w(g) — is the tangent TVD's, on these coefficients. G needs the flexibility of every
+//! normal row (n × w solves) once, also where the compression below applies.
+//!
 //! # Compressed flexibility (many pairs)
 //! Z has one column per joint row: n × m, dense. A refined 10⁵-DOF friction bar has m ≈ 6 000
 //! pairs, so Z alone would be 5 GB and m solves, while the p ≤ 2(v+s)² = 512 TVD only need the
@@ -100,6 +120,8 @@ pub struct TvdOptions {
     /// `(K − Ω_i² M) φ_{i,k,j} = ∂K/∂q_{k,j} φ_i` with φ_i's own eigenvalue Ω_i² (rad/s)².
     /// `false` (default): the static eq. (16) for every vector, the paper's Algorithm 2.
     pub inertia: bool,
+    /// The secant TVD of the module docs instead of the tangent ones (normal rows, static only).
+    pub secant: bool,
 }
 
 impl Default for TvdOptions {
@@ -109,6 +131,7 @@ impl Default for TvdOptions {
             zero_gap_active: true,
             tangential: false,
             inertia: false,
+            secant: false,
         }
     }
 }
@@ -269,10 +292,16 @@ pub fn trial_vector_derivatives(
     if !(opts.tol >= 0.0 && opts.tol < 1.0) {
         return Err(ReductionError::TvdTolerance { tol: opts.tol }.into());
     }
+    if opts.secant && (opts.tangential || opts.inertia) {
+        return Err(ReductionError::SecantOptions.into());
+    }
     let run = TvdRun::new(model, base, opts);
     let nb = base.ncols();
     let total = 2 * nb * nb;
-    let cand = run.candidates(opts);
+    let mut cand = run.candidates(opts);
+    if opts.secant {
+        run.secant_coefficients(&mut cand)?;
+    }
     let cols = cand.index.len();
     let omega2 = if opts.inertia {
         mode_eigenvalues(model, base)?
@@ -448,6 +477,49 @@ impl<'a> TvdRun<'a> {
             out.active.push(act);
         }
         out
+    }
+
+    /// Replaces the tangent pseudoforces `k_n (B_n φ_i)_A` of every kept candidate by the secant
+    /// coefficients `(I/k_n + G_AA)⁻¹ (B_n φ_i)_A` (module docs, "The secant TVD"), with
+    /// `G = B_n K⁻¹ B_nᵀ` solved once; one Cholesky per active set.
+    fn secant_coefficients(&self, cand: &mut Candidates) -> Result<(), Error> {
+        let (model, used) = (self.model, &self.used);
+        let m = used.len();
+        let kn = model.contact.normal_stiffness;
+        let bt = joint_rows_transposed(&model.joint, used, None, model.dofs());
+        let chol = SparseCholesky::new(&model.stiffness)?;
+        let z = solve_refined_steps_owned(&model.stiffness, &chol, bt, 1);
+        let g = symmetric(&rows_times(&model.joint, used, z.as_ref()));
+        let mut c = 0;
+        while c < cand.index.len() {
+            let TvdIndex { k, j, .. } = cand.index[c];
+            let end = (c..cand.index.len())
+                .find(|&e| cand.index[e].j != j || cand.index[e].k != k)
+                .unwrap_or(cand.index.len());
+            let act = &cand.active[j][usize::from(k > 0)];
+            let a: Vec<usize> = (0..m).filter(|&r| act[used[r] / 3]).collect();
+            let ma = Mat::from_fn(a.len(), a.len(), |x, y| {
+                g[(a[x], a[y])] + if x == y { 1.0 / kn } else { 0.0 }
+            });
+            let llt = ma.llt(faer::Side::Lower).map_err(|e| {
+                Error::LinearAlgebra(LinalgError::NotPositiveDefinite {
+                    what: format!("secant TVD: I/k_n + G_AA of {} pairs", a.len()),
+                    hint: "",
+                    source: Box::new(e),
+                })
+            })?;
+            let rhs = Mat::from_fn(a.len(), end - c, |x, y| cand.col(c + y, m)[a[x]] / kn);
+            let sol = llt.solve(&rhs);
+            for y in 0..end - c {
+                let col = &mut cand.coef[(c + y) * m..(c + y + 1) * m];
+                col.iter_mut().for_each(|v| *v = 0.0);
+                for (x, &r) in a.iter().enumerate() {
+                    col[r] = sol[(x, y)];
+                }
+            }
+            c = end;
+        }
+        Ok(())
     }
 
     /// The right-hand sides of the static columns `static_cols`: `(Q, R, B_uᵀ Q)` with
@@ -870,6 +942,60 @@ mod tests {
             assert!(rel < 1e-6, "λ_{i}: {} vs {l}", fast.lambda[i]);
         }
         assert!(fast.choose_g(0.999) == gram.choose_g(0.999));
+    }
+
+    /// The secant TVD solve `(K + ∂K_{k,j}) φ = ∂K_{k,j} φ_i` directly (a dense Cholesky of
+    /// `K + k_n Σ_{z∈A} b_zᵀ b_z` formed from the sparse K and the joint rows), before their
+    /// K-normalization.
+    #[test]
+    fn secant_tvd_solve_the_switched_on_contact() {
+        let model = Model::from_case_name("friction_bar").unwrap();
+        let base = craig_bampton(&model, 10).unwrap();
+        let opts = TvdOptions {
+            secant: true,
+            ..TvdOptions::default()
+        };
+        let tvd = trial_vector_derivatives(&model, base.as_ref(), &opts).unwrap();
+        let (n, kn) = (model.dofs(), model.contact.normal_stiffness);
+        let k = &model.stiffness;
+        for c in [0, 17, 100, 255, tvd.nonzero() - 1] {
+            let TvdIndex { k: sign, j, .. } = tvd.index[c];
+            let act = &tvd.active[j][usize::from(sign > 0)];
+            let mut a = Mat::<f64>::zeros(n, n);
+            for col in 0..n {
+                for p in k.col_ptr[col]..k.col_ptr[col + 1] {
+                    a[(k.row_idx[p], col)] += k.values[p];
+                }
+            }
+            for z in (0..model.joint.pairs()).filter(|&z| act[z]) {
+                let row: Vec<(usize, f64)> = model.joint.row(3 * z + NORMAL).collect();
+                for &(x, vx) in &row {
+                    for &(y, vy) in &row {
+                        a[(x, y)] += kn * vx * vy;
+                    }
+                }
+            }
+            let f = pseudoforce(&model, base.as_ref(), &tvd, c);
+            let rhs = Mat::from_fn(n, 1, |r, _| f[r]);
+            let x = a.llt(faer::Side::Lower).unwrap().solve(&rhs);
+            let x = col(x.as_ref(), 0);
+            let s = tvd.k_norms[c];
+            let v = col(tvd.vectors.as_ref(), c);
+            let dev = x
+                .iter()
+                .zip(&v)
+                .fold(0.0f64, |m, (a, b)| m.max((a - s * b).abs()));
+            assert!(
+                dev <= 1e-7 * inf(&x),
+                "column {c}: {dev:e} vs {:e}",
+                inf(&x)
+            );
+        }
+        let both = TvdOptions {
+            tangential: true,
+            ..opts
+        };
+        assert!(trial_vector_derivatives(&model, base.as_ref(), &both).is_err());
     }
 
     /// Columns `cols` (and the last) of a static TVD solve `K φ = f` with the independently

@@ -104,7 +104,7 @@ impl ModelName {
 /// command's arguments) and the one place they are checked ([`ModelFlags::spec`]).
 #[derive(Clone, Debug, Default, clap::Args)]
 pub struct ModelFlags {
-    /// The model: full (the FE model), a reduced basis (tvd, tvd-plain, modes, jim, alldof), pod
+    /// The model: full (the FE model), a reduced basis (tvd, tvd-plain, tvd-secant, modes, jim, alldof), pod
     /// (POD of the displacement snapshots of a full-FE training run, paper Section 5.2),
     /// file:PATH (a reduced model written by `jointrom export`), or adaptive (Craig–Bampton
     /// plus the attachment modes of the pairs the error estimate selects: give --tolerance).

@@ -568,7 +568,10 @@ fn basis_kind_names() {
         assert_eq!(BasisKind::from_name(k.name()).unwrap(), k);
     }
     let names: Vec<&str> = BasisKind::ALL.iter().map(|k| k.name()).collect();
-    assert_eq!(names, ["tvd", "tvd-plain", "modes", "jim", "alldof"]);
+    assert_eq!(
+        names,
+        ["tvd", "tvd-plain", "tvd-secant", "modes", "jim", "alldof"]
+    );
     let err = BasisKind::from_name("pod").unwrap_err();
     let msg = err.to_string();
     assert!(matches!(err, Error::Invalid(_)));
