@@ -20,6 +20,8 @@
 //!   normal stiffness `k_n` only) — the paper's method;
 //! - `tvd-plain`: the plain POD (eqs. 20–22) of the same TVD;
 //! - `tvd-kt`: K-weighted POD of the TVD with `k_n` and `k_t` (Algorithm 2, line 10);
+//! - `tvd-secant`: K-weighted POD of the secant TVD `(K + ∂K)⁻¹ ∂K φ_i` (Algorithm 2 with line
+//!   19 replaced; [`crate::reduction::tvd`], "The secant TVD");
 //! - `modes`: ν + g fixed-interface normal modes instead of joint modes (the paper's Fig. 7
 //!   comparison).
 //!
@@ -482,6 +484,12 @@ fn tvd_variants() -> Vec<TvdVariant> {
             name: "tvd-kt",
             label: "TVD with k_n + k_t, K-weighted POD",
             tvd: knkt,
+            weighted: true,
+        },
+        TvdVariant {
+            name: "tvd-secant",
+            label: "secant TVD, K-weighted POD",
+            tvd: TvdOptions { secant: true, ..kn },
             weighted: true,
         },
     ]
