@@ -127,9 +127,10 @@ fn sparse(py: Python<'_>, a: &SymCsc) -> PyResult<Py<PyAny>> {
 pub fn vector_arg(v: &Bound<'_, PyAny>, what: &str, n: usize) -> PyResult<Vec<f64>> {
     let values: Vec<f64> = if let Ok(a) = v.cast::<PyArrayDyn<f64>>() {
         if a.ndim() != 1 {
+            let dims: Vec<String> = a.shape().iter().map(|d| d.to_string()).collect();
             return Err(input(format!(
-                "{what} must be a vector of {n} numbers, got an array of shape {:?}",
-                a.shape()
+                "{what} must be a vector of {n} numbers, got an array of shape ({})",
+                dims.join(", ")
             )));
         }
         a.to_vec()?
@@ -327,7 +328,9 @@ impl PyModel {
         let end = opts.end_time.unwrap_or(model.end_time);
         let run = worker::run(py, progress, end, |hook| {
             let opts = args.options(Some(hook))?;
-            jointrom::rom::run_model(&model, &ModelSpec::Full, &opts, &RunSettings::default())
+            crate::run::timed(|| {
+                jointrom::rom::run_model(&model, &ModelSpec::Full, &opts, &RunSettings::default())
+            })
         })?;
         RunResult::new(py, model.name.clone(), "full".into(), run, &opts)
     }

@@ -237,7 +237,8 @@ impl Rom {
         let opts = args.options(None).py_err()?;
         let end = self.end_time(&opts);
         let run = worker::run(py, progress, end, |hook| {
-            self.run(&args.options(Some(hook))?)
+            let opts = args.options(Some(hook))?;
+            crate::run::timed(|| self.run(&opts))
         })?;
         let case = match (&self.model, &self.file) {
             (Some(m), _) => m.name.clone(),

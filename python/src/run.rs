@@ -137,16 +137,20 @@ pub struct RunResult {
     /// Located events (roots).
     #[pyo3(get)]
     events: u64,
+    /// Wall time of the whole call inside jointrom, s: the run, its error estimate and
+    /// integration check (the rest of a call's time is the Python binding's).
+    #[pyo3(get)]
+    total_s: f64,
 }
 
 impl RunResult {
-    /// The result of `o`, a run of the model named `model` of case `case` with `opts`; the
-    /// curves are moved into numpy arrays.
+    /// The result of `o`, a run of the model named `model` of case `case` with `opts` that
+    /// took `total_s` inside jointrom; the curves are moved into numpy arrays.
     pub fn new(
         py: Python<'_>,
         case: String,
         model: String,
-        mut o: ModelRun,
+        (mut o, total_s): (ModelRun, f64),
         opts: &TransientOptions,
     ) -> PyResult<RunResult> {
         let c = std::mem::take(&mut o.run.curves);
@@ -179,6 +183,7 @@ impl RunResult {
             cpu_s: o.run.cpu_s,
             offline_s: o.offline_s,
             events: o.run.events,
+            total_s,
         })
     }
 }
@@ -218,4 +223,10 @@ impl RunResult {
     pub fn set_offline(&mut self, offline_s: Option<f64>) {
         self.offline_s = offline_s;
     }
+}
+
+/// `f()` and its wall time, s.
+pub fn timed<T>(f: impl FnOnce() -> Result<T, Error>) -> Result<(T, f64), Error> {
+    let t0 = std::time::Instant::now();
+    f().map(|v| (v, t0.elapsed().as_secs_f64()))
 }
