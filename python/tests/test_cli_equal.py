@@ -83,10 +83,23 @@ def test_info_modes_static_equal_cli(cli, bar):
     assert np.array_equal(bar.static(linear=True)["master_displacement"], lin["master_displacement"])
 
 
+def dense(a, n):
+    """A scipy.sparse matrix, or the (data, indices, indptr, shape) tuple without scipy."""
+    if isinstance(a, tuple):
+        data, indices, indptr, shape = a
+        assert shape == (n, n)
+        out = np.zeros(shape)
+        for j in range(n):
+            out[indices[indptr[j] : indptr[j + 1]], j] = data[indptr[j] : indptr[j + 1]]
+        return out
+    return a.toarray()
+
+
 def test_matrices(bar, bar_tvd):
-    k = bar.stiffness()
-    m = bar.mass()
     n = bar.dofs
+    k = dense(bar.stiffness(), n)
+    m = dense(bar.mass(), n)
+    assert np.array_equal(k, k.T) and np.array_equal(m, m.T)
     assert k.shape == (n, n) and m.shape == (n, n)
     phi = bar_tvd.phi
     # The reduced matrices are the projections Φᵀ K Φ, Φᵀ M Φ.
