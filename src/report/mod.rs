@@ -9,6 +9,7 @@ pub mod curves;
 pub mod fmu;
 pub mod heatmap;
 pub mod html;
+pub mod info;
 pub mod main_job;
 pub mod shapes;
 pub mod stability;

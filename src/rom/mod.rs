@@ -39,6 +39,6 @@ pub mod training;
 pub use build::{build_rom, BuiltRom};
 pub use compare::{relative_l2, JointCurves, ReferenceCurves, ReferenceErrors};
 pub use estimate::{run_estimated, RunEstimate};
-pub use run::{run_model, Frames, ModelRun, RunSettings};
+pub use run::{run_model, run_rom, Frames, ModelRun, RunSettings};
 pub use spec::{ModelFlags, ModelSpec};
 pub use tolerance::{tolerance_model, ToleranceModel, ToleranceOptions};

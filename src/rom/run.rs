@@ -239,7 +239,22 @@ fn run_reduced(
     opts: &TransientOptions,
     every: Option<usize>,
 ) -> Result<ModelRun, Error> {
-    let rom = ReducedSystem::new(model, phi)?;
+    run_rom(model, ReducedSystem::new(model, phi)?, g, opts, every)
+}
+
+/// The run of a reduced model `rom` of `model` (built with its basis Φ, g added vectors; e.g.
+/// [`super::build_rom`]'s), with its error estimate: what [`run_model`] does after building a
+/// basis, for callers that keep a built reduced model and run it more than once.
+///
+/// # Errors
+/// A reduced model without its basis or not of `model`, a run that does not finish.
+pub fn run_rom(
+    model: &Model,
+    rom: ReducedSystem,
+    g: usize,
+    opts: &TransientOptions,
+    every: Option<usize>,
+) -> Result<ModelRun, Error> {
     let basis_size = rom.dim();
     let phi = rom.phi.clone();
     let flex = JointFlexibility::new(model)?;

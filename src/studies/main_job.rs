@@ -331,6 +331,7 @@ fn transient_options(
         budget_s: Some(budget_s),
         record: false,
         profile: false,
+        hook: None,
     }
 }
 

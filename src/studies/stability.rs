@@ -610,6 +610,7 @@ impl Pass<'_> {
                 budget_s: Some(opts.reference_budget_s),
                 record: false,
                 profile: false,
+                hook: None,
             };
             let o = system_run(self.model, prep, &spec);
             self.progress(&format!(
@@ -679,6 +680,7 @@ impl Pass<'_> {
                             budget_s: Some(opts.budget_s),
                             record: false,
                             profile: false,
+                            hook: None,
                         };
                         let o = system_run(self.model, prep, &spec);
                         let cell = Cell {

@@ -22,7 +22,7 @@ use crate::system::{Scene, SecondOrderSystem};
 mod options;
 mod outcome;
 
-pub use options::TransientOptions;
+pub use options::{RunHook, TransientOptions};
 pub use outcome::{
     Curves, EnergyCheck, Profile, Run, RunStatus, Trajectory, ENERGY_BALANCE_TOLERANCE,
 };
@@ -133,6 +133,7 @@ struct Deadline<P> {
     budget_s: f64,
     exceeded: bool,
     profile: Option<Profile>,
+    hook: Option<RunHook>,
 }
 
 /// `f()` timed into `slot` (calls, seconds) when profiling.
@@ -160,6 +161,10 @@ impl<P: OdeProblem> OdeProblem for Deadline<P> {
                     self.budget_s
                 )));
             }
+        }
+        if self.hook.as_ref().is_some_and(|h| !(h.0)(t)) {
+            self.exceeded = true;
+            return Err(CallbackError::Fatal("stopped by the caller".into()));
         }
         let mut p = self.profile.take();
         let on = p.is_some();
@@ -276,6 +281,7 @@ impl<S: SecondOrderSystem> Driver<S> {
             budget_s: opts.budget_s.unwrap_or(f64::INFINITY),
             exceeded: false,
             profile: opts.profile.then(Profile::default),
+            hook: opts.hook.clone(),
         };
         let cv = Cvode::new(problem, 0.0, &y0, &opts.ode)?;
         Ok(Driver {

@@ -1,5 +1,7 @@
 //! The options of a run.
 
+use std::sync::Arc;
+
 use serde::Serialize;
 
 use crate::integrate::mechanical::{ProblemOptions, DEFAULT_MAX_ORDER};
@@ -33,6 +35,28 @@ pub struct TransientOptions {
     /// default.
     #[serde(skip)]
     pub profile: bool,
+    /// Called with the time reached (s) at every right-hand side; returning `false` stops the
+    /// run as if its wall-clock budget had run out. For embedding callers (progress, Ctrl-C);
+    /// `None` by default. It sees the run, it does not change it.
+    #[serde(skip)]
+    pub hook: Option<RunHook>,
+}
+
+/// A caller's hook into a running integration: `f(t)` → keep going.
+#[derive(Clone)]
+pub struct RunHook(pub Arc<dyn Fn(f64) -> bool + Send + Sync>);
+
+impl std::fmt::Debug for RunHook {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("RunHook")
+    }
+}
+
+impl PartialEq for RunHook {
+    /// The same hook (one `Arc`).
+    fn eq(&self, other: &RunHook) -> bool {
+        Arc::ptr_eq(&self.0, &other.0)
+    }
 }
 
 impl Default for TransientOptions {
@@ -48,6 +72,7 @@ impl Default for TransientOptions {
             budget_s: None,
             record: false,
             profile: false,
+            hook: None,
         }
     }
 }
