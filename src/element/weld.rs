@@ -151,7 +151,7 @@ impl Weld {
     /// geometry relative to the weld centre, to 1e-9 mm, and the same material) reuses that
     /// weld's condensed matrices — within the scene (the friction bar's two welds are one
     /// condensation), across scenes built by this process (a cache bounded at 512 MB) and across
-    /// commands (the disk cache of [`super::weld_cache`]).
+    /// commands (the disk cache of `element::weld_cache`).
     pub fn build_all(
         welds: &[WeldElem],
         nodes: &[[f64; 3]],
