@@ -2,8 +2,8 @@
 //! The layers' own typed reasons live here too, so that every layer can use them and this
 //! module imports nothing from the layers but [`LinalgError`]: [`ElementError`] (elements and
 //! materials), the request errors of `request.rs` ([`ModelError`], [`JointError`],
-//! [`SystemError`], [`ReductionError`], [`IntegrationError`], [`ReportError`]), and SUNDIALS'
-//! return flag [`CvodeFlag`].
+//! [`SystemError`], [`ReductionError`], [`IntegrationError`], [`ReportError`], [`FlagError`],
+//! [`RomError`], [`StudyError`]), and SUNDIALS' return flag [`CvodeFlag`].
 
 use std::path::PathBuf;
 
@@ -15,7 +15,8 @@ pub use crate::linalg::LinalgError;
 pub use cvode_flag::CvodeFlag;
 pub use element::{ElementError, WeldLayerProblem};
 pub use request::{
-    FontError, IntegrationError, JointError, ModelError, ReductionError, ReportError, SystemError,
+    FlagError, FontError, IntegrationError, JointError, ModelError, ReductionError,
+    ReferenceProblem, ReportError, RomError, StudyError, SystemError,
 };
 
 /// Everything that can go wrong in jointrom. Bad input is an error, never a panic.
@@ -99,11 +100,16 @@ pub enum Error {
     /// A report that cannot be written as asked (shapes, series, archives, charts).
     #[error("invalid request: {0}")]
     Report(#[from] ReportError),
-    /// Being phased out: a request that does not fit the model, in words; only the modules
-    /// being moved still use it, and will use the typed variants above.
-    #[doc(hidden)]
+    /// A command-line flag with a value it cannot take.
     #[error("invalid request: {0}")]
-    Invalid(String),
+    Flag(#[from] FlagError),
+    /// A model choice or reduced-model request that does not fit (flags that conflict, a
+    /// tolerance out of range, a reference file, a reduced model of another case).
+    #[error("invalid request: {0}")]
+    Rom(#[from] RomError),
+    /// A study request that does not fit, or a study that cannot go on.
+    #[error("invalid request: {0}")]
+    Study(#[from] StudyError),
     /// A failure reported by SUNDIALS: the C function, the flag's name and the time reached
     /// (NaN outside a time integration, e.g. when creating a context).
     #[error("SUNDIALS: {function} returned {flag}{}", time_suffix(*time))]

@@ -241,6 +241,39 @@ pub enum ReductionError {
     /// The reduced acceleration at `t` (s) is not finite (`value`).
     #[error("error estimate: reduced acceleration at t = {t:e} s is not finite ({value})")]
     EstimateAcceleration { t: f64, value: f64 },
+    /// A basis name that is none of the `valid` ones.
+    #[error("unknown basis `{name}`: expected one of {}", valid.join(", "))]
+    UnknownBasis {
+        name: String,
+        valid: &'static [&'static str],
+    },
+    /// The basis kind `kind` has no TVD POD.
+    #[error("basis `{kind}` has no TVD POD: expected tvd or tvd-plain")]
+    NoTvdPod { kind: &'static str },
+    /// `--g g` beyond the `available` modes of the TVD's POD on `model` (printable).
+    #[error("--g {g}: the POD of the TVD has only {available} modes on {model}")]
+    PodModes {
+        g: usize,
+        available: usize,
+        model: String,
+    },
+    /// The distributed PETSc program `program` does not exist (`var`: the variable naming it).
+    #[error(
+        "--program: the PETSc program {} does not exist; build it with `scripts/dist.sh build` \
+         (needs `apt-get install -y slepc-dev openmpi-bin`), or name it with --program or ${var}",
+        program.display()
+    )]
+    DistributedProgram { program: PathBuf, var: &'static str },
+    /// `mpirun -n ranks program` ended with `status`; `stderr` is the tail of its error output
+    /// (printable).
+    #[error("{mpirun} -n {ranks} {}: {status}\n{stderr}", program.display())]
+    DistributedFailed {
+        mpirun: String,
+        ranks: usize,
+        program: PathBuf,
+        status: String,
+        stderr: String,
+    },
 }
 
 /// A time-integration request that does not fit (the `integrate` layer).
@@ -301,6 +334,29 @@ pub enum IntegrationError {
         value: String,
         need: String,
     },
+    /// A time `what` (e.g. `end_time`) that is not finite and positive (`value`, s).
+    #[error("{what} must be finite and positive, got {value} s")]
+    NotPositive { what: &'static str, value: f64 },
+    /// A problem scale `name` (e.g. `slip_scale`) that is not finite and positive.
+    #[error("{name} must be finite and positive, got {value}")]
+    ScaleNotPositive { name: &'static str, value: f64 },
+    /// A load scale that is not finite.
+    #[error("the load scale must be finite, got {scale}")]
+    LoadScale { scale: f64 },
+    /// A master load component (`Fx` … `Mz`) that is not finite.
+    #[error("the master load component {component} must be finite, got {value}")]
+    LoadComponent { component: &'static str, value: f64 },
+    /// `end / output_step` gives `outputs` output points, more than the `max` a run keeps.
+    #[error(
+        "end time {end:e} s / output step {output_step:e} s = {outputs:e} output points, more \
+         than the {max:e} a run keeps: raise --output-step or lower --end-time"
+    )]
+    TooManyOutputs {
+        end: f64,
+        output_step: f64,
+        outputs: f64,
+        max: f64,
+    },
 }
 
 /// A report that cannot be written as asked (the `report` layer).
@@ -352,6 +408,32 @@ pub enum ReportError {
         binary.display()
     )]
     FmuBinary { binary: PathBuf },
+    /// The variable `var` names `path`, which is not a file (`file`: the FMU binary's name).
+    #[error(
+        "{var}={} is not a file (point it at the {file} built by `cargo build --release -p \
+         jointrom-fmu`, or unset it)",
+        path.display()
+    )]
+    FmuBinaryEnv {
+        var: &'static str,
+        path: PathBuf,
+        file: &'static str,
+    },
+    /// The running executable could not be located to find the FMU binary `file` beside it.
+    #[error("--fmu: cannot locate this executable to find {file} beside it ({source}); set {var}")]
+    FmuNoExecutable {
+        file: &'static str,
+        var: &'static str,
+        #[source]
+        source: std::io::Error,
+    },
+    /// The FMU binary `path` beside the executable does not exist.
+    #[error(
+        "--fmu: the FMU binary {} does not exist: build it with `cargo build --release -p \
+         jointrom-fmu` (it lands beside the jointrom executable), or set {var} to it",
+        path.display()
+    )]
+    FmuBinaryMissing { path: PathBuf, var: &'static str },
     /// `curves.csv` could not be formatted: the CSV writer's error (or the text's UTF-8 check).
     #[error("curves.csv: {source}")]
     Curves {
@@ -398,4 +480,252 @@ pub enum FontError {
     /// The font `file` is not a TrueType/OpenType font.
     #[error("chart font {}: not a valid TrueType/OpenType font", file.display())]
     Invalid { file: PathBuf },
+}
+
+/// A command-line flag with a value it cannot take (the CLI and the library checks that name
+/// a flag). `flag` is the flag's name without the leading `--`.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum FlagError {
+    /// A value that must be finite and positive.
+    #[error("--{flag} must be finite and positive, got {value}")]
+    NotPositive { flag: &'static str, value: f64 },
+    /// A value that must be finite.
+    #[error("--{flag} must be finite, got {value}")]
+    NotFinite { flag: &'static str, value: f64 },
+    /// A value outside what the flag accepts: `need` says what it accepts, `got` is the value
+    /// as shown (quoted where the flag's text is).
+    #[error("--{flag} must be {need}, got {got}")]
+    Range {
+        flag: &'static str,
+        need: &'static str,
+        got: String,
+    },
+    /// A count below `min`.
+    #[error("--{flag} must be at least {min}")]
+    AtLeast { flag: &'static str, min: usize },
+    /// A value (as shown) the flag does not take: `need` says which it takes.
+    #[error("--{flag} {value}: {need}")]
+    Value {
+        flag: &'static str,
+        value: String,
+        need: &'static str,
+    },
+    /// An unknown name of a `what` (e.g. `model`) among the `valid` ones.
+    #[error("--{flag}: unknown {what} {value:?}; valid: {valid}")]
+    Unknown {
+        flag: &'static str,
+        what: &'static str,
+        value: String,
+        valid: &'static str,
+    },
+    /// An unknown basis kind among the `valid` names.
+    #[error("--{flag} {value:?}: unknown basis kind; valid: {}", valid.join(", "))]
+    UnknownBasis {
+        flag: &'static str,
+        value: String,
+        valid: &'static [&'static str],
+    },
+    /// A basis name the reduction does not know.
+    #[error("--{flag}: invalid request: {source}")]
+    Basis {
+        flag: &'static str,
+        #[source]
+        source: ReductionError,
+    },
+    /// A switch that is neither `on` nor `off`.
+    #[error("--{flag}: expected on or off, got {value:?}")]
+    OnOff { flag: &'static str, value: String },
+    /// No rank count, or a zero one.
+    #[error("--ranks: give one or more positive rank counts, e.g. 1,2")]
+    Ranks,
+}
+
+/// A model choice or reduced-model request that does not fit (the `rom` layer).
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum RomError {
+    /// `--model` and `--basis` both given.
+    #[error("--model and --basis both name the model: give one of them")]
+    ModelAndBasis,
+    /// `--model` names no model.
+    #[error("--model: invalid request: {source} (or full, pod)")]
+    ModelName {
+        #[source]
+        source: ReductionError,
+    },
+    /// `--tolerance` and `--g` both given.
+    #[error("--tolerance and --g both size the model: give one of them")]
+    ToleranceAndG,
+    /// `--tolerance` beside a model it does not build (`model`: the flag naming it).
+    #[error(
+        "--tolerance builds its own model (--model adaptive); it does not apply to {model} (use \
+         --g to size that one)"
+    )]
+    ToleranceModel { model: String },
+    /// `--g` without a reduced model.
+    #[error("--g needs --basis (or --model)")]
+    GWithoutBasis,
+    /// `--g` with `--model full`.
+    #[error("--g applies to reduced models, not --model full")]
+    GOnFull,
+    /// `--g` or `--train-end` with a reduced model read from a file.
+    #[error("--g and --train-end do not apply to --model file:PATH")]
+    FileSizing,
+    /// `--model adaptive` without `--tolerance`.
+    #[error("--model adaptive is chosen by --tolerance TOL: give the tolerance")]
+    AdaptiveWithoutTolerance,
+    /// `--train-end` with a model other than POD.
+    #[error("--train-end applies to --model pod only")]
+    TrainEndNotPod,
+    /// `--low-rank` with a reduced model.
+    #[error("--low-rank applies to --model full (the reduced model refactors its dense matrix)")]
+    LowRankReduced,
+    /// `--linear` with a reduced model.
+    #[error(
+        "--linear and a reduced model do not combine: a reduced model solves the contact statics \
+         (drop --linear, or --basis/--model/--tolerance)"
+    )]
+    LinearReduced,
+    /// `--vtu` with a reduced model read from a file (no basis Φ).
+    #[error(
+        "--vtu needs the basis Φ, which an exported reduced model does not carry; run the basis \
+         by name instead (e.g. --model tvd)"
+    )]
+    VtuFromFile,
+    /// `command` cannot use the model `model`; it takes `takes`.
+    #[error("{command} does not take --model {model}: it takes {takes}")]
+    Unsupported {
+        command: String,
+        model: String,
+        takes: &'static str,
+    },
+    /// A tolerance that is not a relative error in (0, 1).
+    #[error("--tolerance must be a relative error in (0, 1), got {tolerance}")]
+    Tolerance { tolerance: f64 },
+    /// Fewer than two POD snapshots.
+    #[error("--snapshots must be at least 2, got {snapshots}")]
+    Snapshots { snapshots: usize },
+    /// `--strict`: the best model's estimated |f_c| error misses `--tolerance`.
+    #[error(
+        "--strict: the estimated |f_c| error {estimate:e} of the best model exceeds --tolerance \
+         {tolerance:e} (the result above is that model's)"
+    )]
+    Strict { estimate: f64, tolerance: f64 },
+    /// A reference curves file (`file`, as shown) that cannot be used.
+    #[error("reference {file}: {problem}")]
+    Reference {
+        file: String,
+        problem: ReferenceProblem,
+    },
+    /// The reduced model of `file` was exported from the case `exported_from` (printable), not
+    /// from the one given: `differs` says what differs.
+    #[error(
+        "{}: this reduced model was exported from `{exported_from}`, not from the CASE given \
+         ({differs}): give the case it was exported from",
+        file.display()
+    )]
+    SourceMismatch {
+        file: PathBuf,
+        exported_from: String,
+        differs: String,
+    },
+    /// No error estimate: the run ended early with `status`.
+    #[error("no error estimate: the run ended early ({status})")]
+    EstimateEarlyEnd { status: String },
+}
+
+/// What is wrong with a reference curves file.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum ReferenceProblem {
+    /// The CSV reader failed.
+    #[error("{0}")]
+    Csv(#[source] csv::Error),
+    /// The JSON did not parse.
+    #[error("{0}")]
+    Json(#[source] serde_json::Error),
+    /// The CSV header has no column `name`.
+    #[error("no column `{name}` in the header")]
+    NoColumn { name: &'static str },
+    /// A CSV cell (printable) that is not a finite number, on line `line`.
+    #[error("line {line}: `{cell}` is not a finite number")]
+    NotFinite { line: usize, cell: String },
+    /// The JSON has no array `name`.
+    #[error("no array `{name}`")]
+    NoArray { name: &'static str },
+    /// The JSON array `name` holds a value that is not a finite number.
+    #[error("`{name}` holds a value that is not a number")]
+    NotNumber { name: &'static str },
+    /// The curves have different lengths.
+    #[error("the curves have different lengths")]
+    Lengths,
+    /// Fewer than two outputs.
+    #[error("{outputs} outputs; at least 2 are needed")]
+    TooFew { outputs: usize },
+    /// The time at output `output` (s) does not exceed the one before.
+    #[error("times do not increase at output {output}: {t} s after {previous} s")]
+    NotIncreasing {
+        output: usize,
+        t: f64,
+        previous: f64,
+    },
+}
+
+/// A study request that does not fit, or a study that cannot go on (the `studies` layer).
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum StudyError {
+    /// `--g g` beyond the `available` enrichment vectors of the basis `basis` on `model`.
+    #[error("--g {g}: basis `{basis}` has only {available} enrichment vectors on {model}")]
+    Enrichment {
+        g: usize,
+        basis: &'static str,
+        available: usize,
+        model: String,
+    },
+    /// A POD threshold outside (0, 1].
+    #[error("threshold must be in (0, 1], got {threshold}")]
+    Threshold { threshold: f64 },
+    /// The full model of `model` has no pair in contact under the load.
+    #[error(
+        "{model}: the full model has no pair in contact under this load (‖f_c‖ = 0), so there is \
+         no contact force to converge to; try --scale -1"
+    )]
+    NoContact { model: String },
+    /// The convergence study gave no K-weighted TVD energy curve.
+    #[error("the study has no K-weighted TVD energy curve")]
+    NoTvdEnergy,
+    /// The full FE reference run failed at `t` (s) with `status` and `message`.
+    #[error("the full FE reference run failed at t = {t} s ({status}): {message}")]
+    ReferenceFailed {
+        t: f64,
+        status: String,
+        message: String,
+    },
+    /// A stability map option that must be finite and positive.
+    #[error("{option} must be finite and positive, got {value}")]
+    NotPositive { option: String, value: f64 },
+    /// A stability map reference factor below 1.
+    #[error("reference_factor must be ≥ 1, got {factor}")]
+    ReferenceFactor { factor: f64 },
+    /// A stability map BDF order outside 1–5.
+    #[error("max_orders: BDF order must be 1–5, got {order}")]
+    MaxOrder { order: usize },
+    /// A stability map without steps.
+    #[error("max_steps must be positive")]
+    MaxSteps,
+    /// A stability map axis without values.
+    #[error("every sweep axis needs at least one value")]
+    EmptyAxis,
+    /// Sweep variants failed: their names (printable) of `total`.
+    #[error(
+        "{} of {total} sweep variants failed: {}",
+        failed.len(),
+        failed.iter().map(|n| format!("`{n}`")).collect::<Vec<_>>().join(", ")
+    )]
+    SweepFailed { failed: Vec<String>, total: usize },
+    /// The JSON document of the study could not be written.
+    #[error("JSON output: {0}")]
+    JsonOutput(#[source] serde_json::Error),
 }

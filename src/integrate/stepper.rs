@@ -119,7 +119,8 @@ impl<S: SecondOrderSystem> Stepper<S> {
     /// current time (module docs); setting the same load again changes nothing.
     ///
     /// # Errors
-    /// [`Error::Invalid`] naming the value if one is not finite (the load in force is kept).
+    /// [`IntegrationError::LoadScale`] or [`IntegrationError::LoadComponent`] naming the value
+    /// if one is not finite (the load in force is kept).
     pub fn set_load(&mut self, scale: f64, master: [f64; 6]) -> Result<(), Error> {
         let (old_scale, old_master) = self.cv.problem().load();
         // Bit patterns: −0.0 and 0.0 are the same load; a NaN is refused below.

@@ -9,7 +9,7 @@ use super::competitors::{alldof_vectors, jim_vectors};
 use super::craig_bampton::craig_bampton;
 use super::pod::{pod_tvd, pod_tvd_ratios};
 use super::tvd::{trial_vector_derivatives, TvdOptions};
-use crate::error::Error;
+use crate::error::{Error, ReductionError};
 use crate::model::Model;
 
 /// Which enrichment of the Craig–Bampton basis [`build_basis`] uses. The one table of the basis
@@ -70,17 +70,15 @@ impl BasisKind {
         }
     }
 
-    /// Parses a name of [`BasisKind::NAMES`] (exact, lower case); anything else is an
-    /// [`Error::Invalid`] listing the accepted names.
-    pub fn from_name(name: &str) -> Result<BasisKind, Error> {
+    /// Parses a name of [`BasisKind::NAMES`] (exact, lower case); anything else is a
+    /// [`ReductionError::UnknownBasis`] listing the accepted names.
+    pub fn from_name(name: &str) -> Result<BasisKind, ReductionError> {
         BasisKind::ALL
             .into_iter()
             .find(|k| k.name() == name)
-            .ok_or_else(|| {
-                Error::Invalid(format!(
-                    "unknown basis `{name}`: expected one of {}",
-                    BasisKind::NAMES.join(", ")
-                ))
+            .ok_or_else(|| ReductionError::UnknownBasis {
+                name: name.to_string(),
+                valid: &BasisKind::NAMES,
             })
     }
 }
@@ -111,10 +109,7 @@ pub fn build_tvd_basis_both_pods(
     opts: &BasisOptions,
 ) -> Result<(Basis, Vec<f64>), Error> {
     if !matches!(kind, BasisKind::Tvd | BasisKind::TvdPlain) {
-        return Err(Error::Invalid(format!(
-            "basis `{}` has no TVD POD: expected tvd or tvd-plain",
-            kind.name()
-        )));
+        return Err(ReductionError::NoTvdPod { kind: kind.name() }.into());
     }
     let (basis, other) = build(model, kind, opts, true)?;
     Ok((basis, other.unwrap_or_default()))
@@ -148,10 +143,12 @@ fn build(
         let available = p.lambda.len();
         let g = match opts.g {
             Some(g) if g > available => {
-                return Err(Error::Invalid(format!(
-                    "--g {g}: the POD of the TVD has only {available} modes on {}",
-                    crate::files::printable(&model.name)
-                )))
+                return Err(ReductionError::PodModes {
+                    g,
+                    available,
+                    model: crate::files::printable(&model.name).to_string(),
+                }
+                .into())
             }
             Some(g) => g,
             None => p.choose_g(opts.threshold).min(available),

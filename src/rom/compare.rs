@@ -20,7 +20,7 @@ use std::path::Path;
 
 use serde::Serialize;
 
-use crate::error::Error;
+use crate::error::{Error, ReferenceProblem, RomError};
 use crate::integrate::Curves;
 
 /// The four curves every comparison of runs is about — ‖f_c‖(t), ‖f_R‖(t) and the master's
@@ -90,9 +90,9 @@ impl JointCurves {
     /// Reads a reference file: JSON if its name ends in `.json`, else CSV (module docs).
     ///
     /// # Errors
-    /// [`Error::Invalid`] naming the file (and the line of a CSV) for a missing column, a value
-    /// that is not a finite number, curves of different lengths, fewer than two outputs or
-    /// times that do not increase.
+    /// [`RomError::Reference`] naming the file (and the line of a CSV) for a missing column, a
+    /// value that is not a finite number, curves of different lengths, fewer than two outputs
+    /// or times that do not increase.
     pub fn read(path: &Path) -> Result<JointCurves, Error> {
         let text = crate::files::read_text(path)?;
         let what = path.display().to_string();
@@ -105,21 +105,30 @@ impl JointCurves {
 
     /// Parses the CSV form; `what` names the source in errors.
     pub fn parse_csv(text: &str, what: &str) -> Result<JointCurves, Error> {
-        let bad = |m: String| Error::Invalid(format!("reference {what}: {m}"));
+        let bad = |problem: ReferenceProblem| -> Error {
+            RomError::Reference {
+                file: what.to_string(),
+                problem,
+            }
+            .into()
+        };
         let mut r = csv::ReaderBuilder::new()
             .trim(csv::Trim::All)
             .from_reader(text.as_bytes());
-        let header = r.headers().map_err(|e| bad(e.to_string()))?.clone();
+        let header = r
+            .headers()
+            .map_err(|e| bad(ReferenceProblem::Csv(e)))?
+            .clone();
         let mut index = [0usize; 4];
         for (slot, name) in index.iter_mut().zip(COLUMNS) {
             *slot = header
                 .iter()
                 .position(|h| h == name)
-                .ok_or_else(|| bad(format!("no column `{name}` in the header")))?;
+                .ok_or_else(|| bad(ReferenceProblem::NoColumn { name }))?;
         }
         let mut cols: [Vec<f64>; 4] = Default::default();
         for (row, rec) in r.records().enumerate() {
-            let rec = rec.map_err(|e| bad(e.to_string()))?;
+            let rec = rec.map_err(|e| bad(ReferenceProblem::Csv(e)))?;
             for (col, &i) in cols.iter_mut().zip(&index) {
                 let cell = rec.get(i).unwrap_or("");
                 let v = cell
@@ -127,11 +136,10 @@ impl JointCurves {
                     .ok()
                     .filter(|v| v.is_finite())
                     .ok_or_else(|| {
-                        bad(format!(
-                            "line {}: `{}` is not a finite number",
-                            row + 2,
-                            crate::files::printable(cell)
-                        ))
+                        bad(ReferenceProblem::NotFinite {
+                            line: row + 2,
+                            cell: crate::files::printable(cell).to_string(),
+                        })
                     })?;
                 col.push(v);
             }
@@ -142,17 +150,24 @@ impl JointCurves {
 
     /// Parses the compact JSON form (`cases/reference/compact.py`).
     pub fn parse_json(text: &str, what: &str) -> Result<JointCurves, Error> {
-        let bad = |m: String| Error::Invalid(format!("reference {what}: {m}"));
-        let v: serde_json::Value = serde_json::from_str(text).map_err(|e| bad(e.to_string()))?;
-        let arr = |name: &str| -> Result<Vec<f64>, Error> {
+        let bad = |problem: ReferenceProblem| -> Error {
+            RomError::Reference {
+                file: what.to_string(),
+                problem,
+            }
+            .into()
+        };
+        let v: serde_json::Value =
+            serde_json::from_str(text).map_err(|e| bad(ReferenceProblem::Json(e)))?;
+        let arr = |name: &'static str| -> Result<Vec<f64>, Error> {
             v[name]
                 .as_array()
-                .ok_or_else(|| bad(format!("no array `{name}`")))?
+                .ok_or_else(|| bad(ReferenceProblem::NoArray { name }))?
                 .iter()
                 .map(|x| {
                     x.as_f64()
                         .filter(|x| x.is_finite())
-                        .ok_or_else(|| bad(format!("`{name}` holds a value that is not a number")))
+                        .ok_or_else(|| bad(ReferenceProblem::NotNumber { name }))
                 })
                 .collect()
         };
@@ -172,24 +187,29 @@ impl JointCurves {
         master_uy: Vec<f64>,
         what: &str,
     ) -> Result<JointCurves, Error> {
-        let bad = |m: String| Error::Invalid(format!("reference {what}: {m}"));
+        let bad = |problem: ReferenceProblem| -> Error {
+            RomError::Reference {
+                file: what.to_string(),
+                problem,
+            }
+            .into()
+        };
         let n = t.len();
         if [&contact_force_norm, &friction_force_norm, &master_uy]
             .iter()
             .any(|c| c.len() != n)
         {
-            return Err(bad("the curves have different lengths".into()));
+            return Err(bad(ReferenceProblem::Lengths));
         }
         if n < 2 {
-            return Err(bad(format!("{n} outputs; at least 2 are needed")));
+            return Err(bad(ReferenceProblem::TooFew { outputs: n }));
         }
         if let Some(i) = t.windows(2).position(|w| w[1] <= w[0]) {
-            return Err(bad(format!(
-                "times do not increase at output {}: {} s after {} s",
-                i + 1,
-                t[i + 1],
-                t[i]
-            )));
+            return Err(bad(ReferenceProblem::NotIncreasing {
+                output: i + 1,
+                t: t[i + 1],
+                previous: t[i],
+            }));
         }
         Ok(JointCurves {
             t,

@@ -24,7 +24,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 use serde::Serialize;
 
-use crate::error::Error;
+use crate::error::{Error, RomError};
 use crate::integrate::{integrate, ProblemOptions, Run, TransientOptions};
 use crate::joint::law::PairLaw;
 use crate::model::Model;
@@ -240,10 +240,10 @@ pub fn run_estimated(
                 s: &tr.s,
             },
         ),
-        _ => Err(Error::Invalid(format!(
-            "no error estimate: the run ended early ({})",
-            run.status
-        ))),
+        _ => Err(RomError::EstimateEarlyEnd {
+            status: run.status.to_string(),
+        }
+        .into()),
     };
     let estimate = estimate.and_then(|detail| {
         let integration = match check {

@@ -49,7 +49,7 @@ use faer::Mat;
 use serde::{Deserialize, Serialize};
 
 use crate::case::{ContactSpec, MasterLoadSpec, RampSpec};
-use crate::error::Error;
+use crate::error::{Error, RomError};
 use crate::joint::law::DEFAULT_TAU;
 use crate::linalg::symmetric_eigenvalues;
 use crate::model::Model;
@@ -202,7 +202,7 @@ impl RomFile {
     /// file labelled with another model's name would be mislabelled.
     ///
     /// # Errors
-    /// [`Error::Invalid`] naming both models and what differs.
+    /// [`RomError::SourceMismatch`] naming both models and what differs.
     pub fn check_source(&self, model: &Model, path: &Path) -> Result<(), Error> {
         let differs = match &self.source_digest {
             Some(d) if *d != model_digest(model) => Some("its K and M differ".to_string()),
@@ -221,12 +221,12 @@ impl RomFile {
             None => None,
         };
         match differs {
-            Some(why) => Err(Error::Invalid(format!(
-                "{}: this reduced model was exported from `{}`, not from the CASE given ({why}): \
-                 give the case it was exported from",
-                path.display(),
-                crate::files::printable(&self.case),
-            ))),
+            Some(differs) => Err(RomError::SourceMismatch {
+                file: path.to_path_buf(),
+                exported_from: crate::files::printable(&self.case).to_string(),
+                differs,
+            }
+            .into()),
             None => Ok(()),
         }
     }

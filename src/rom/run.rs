@@ -6,7 +6,7 @@
 use std::path::Path;
 use std::time::Instant;
 
-use crate::error::Error;
+use crate::error::{Error, RomError};
 use crate::integrate::{self as driver, integrate, Run, TransientOptions};
 use crate::model::Model;
 use crate::reduction::{build_basis, BasisOptions, JointFlexibility};
@@ -80,10 +80,7 @@ pub fn run_model(
     settings: &RunSettings,
 ) -> Result<ModelRun, Error> {
     if settings.low_rank.is_some() && spec.is_reduced() {
-        return Err(Error::Invalid(
-            "--low-rank applies to --model full (the reduced model refactors its dense matrix)"
-                .into(),
-        ));
+        return Err(RomError::LowRankReduced.into());
     }
     let every = settings.keep_every;
     match spec {
@@ -205,11 +202,7 @@ fn run_file(
     every: Option<usize>,
 ) -> Result<ModelRun, Error> {
     if every.is_some() {
-        return Err(Error::Invalid(
-            "--vtu needs the basis Φ, which an exported reduced model does not carry; \
-             run the basis by name instead (e.g. --model tvd)"
-                .into(),
-        ));
+        return Err(RomError::VtuFromFile.into());
     }
     let f = RomFile::read(path)?;
     f.check_source(model, path)?;

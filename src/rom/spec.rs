@@ -7,7 +7,7 @@
 
 use std::path::PathBuf;
 
-use crate::error::Error;
+use crate::error::{Error, RomError};
 use crate::reduction::BasisKind;
 
 /// Which model to build and run.
@@ -93,8 +93,7 @@ impl ModelName {
                 ModelName::File(PathBuf::from(&name["file:".len()..]))
             }
             _ => ModelName::Basis(
-                BasisKind::from_name(name)
-                    .map_err(|e| Error::Invalid(format!("--model: {e} (or full, pod)")))?,
+                BasisKind::from_name(name).map_err(|source| RomError::ModelName { source })?,
             ),
         })
     }
@@ -147,11 +146,7 @@ impl ModelFlags {
     /// on the full model or a file — each naming the flags.
     pub fn spec(&self, default: ModelSpec) -> Result<ModelSpec, Error> {
         let name = match (&self.model, self.basis) {
-            (Some(_), Some(_)) => {
-                return Err(Error::Invalid(
-                    "--model and --basis both name the model: give one of them".into(),
-                ))
-            }
+            (Some(_), Some(_)) => return Err(RomError::ModelAndBasis.into()),
             (Some(m), None) => Some(ModelName::parse(m)?),
             (None, Some(kind)) => Some(ModelName::Basis(kind)),
             (None, None) => None,
@@ -166,34 +161,27 @@ impl ModelFlags {
             return match name {
                 None | Some(ModelName::Adaptive) => {
                     if self.g.is_some() {
-                        return Err(Error::Invalid(
-                            "--tolerance and --g both size the model: give one of them".into(),
-                        ));
+                        return Err(RomError::ToleranceAndG.into());
                     }
                     super::tolerance::check_tolerance(tolerance)?;
                     Ok(ModelSpec::Tolerance { tolerance, nu })
                 }
-                Some(_) => Err(Error::Invalid(format!(
-                    "--tolerance builds its own model (--model adaptive); it does not apply to {} \
-                     (use --g to size that one)",
-                    named.unwrap_or_default()
-                ))),
+                Some(_) => Err(RomError::ToleranceModel {
+                    model: named.unwrap_or_default(),
+                }
+                .into()),
             };
         }
         let g = self.g;
         Ok(match name {
             None => match default {
-                ModelSpec::Full if g.is_some() => {
-                    return Err(Error::Invalid("--g needs --basis (or --model)".into()))
-                }
+                ModelSpec::Full if g.is_some() => return Err(RomError::GWithoutBasis.into()),
                 ModelSpec::Basis { kind, .. } => ModelSpec::Basis { kind, g, nu },
                 other => other,
             },
             Some(ModelName::Full) => {
                 if g.is_some() {
-                    return Err(Error::Invalid(
-                        "--g applies to reduced models, not --model full".into(),
-                    ));
+                    return Err(RomError::GOnFull.into());
                 }
                 ModelSpec::Full
             }
@@ -204,16 +192,10 @@ impl ModelFlags {
                 train_end: None,
                 snapshots: DEFAULT_SNAPSHOTS,
             },
-            Some(ModelName::Adaptive) => {
-                return Err(Error::Invalid(
-                    "--model adaptive is chosen by --tolerance TOL: give the tolerance".into(),
-                ))
-            }
+            Some(ModelName::Adaptive) => return Err(RomError::AdaptiveWithoutTolerance.into()),
             Some(ModelName::File(path)) => {
                 if g.is_some() {
-                    return Err(Error::Invalid(
-                        "--g and --train-end do not apply to --model file:PATH".into(),
-                    ));
+                    return Err(RomError::FileSizing.into());
                 }
                 ModelSpec::File(path)
             }
@@ -223,11 +205,13 @@ impl ModelFlags {
 
 /// An error for a command that cannot use the model `spec` names: `command` is the command's
 /// name, `what` says what it takes instead.
-pub fn unsupported(command: &str, spec: &ModelSpec, what: &str) -> Error {
-    Error::Invalid(format!(
-        "{command} does not take --model {}: it takes {what}",
-        spec.name()
-    ))
+pub fn unsupported(command: &str, spec: &ModelSpec, what: &'static str) -> Error {
+    RomError::Unsupported {
+        command: command.to_string(),
+        model: spec.name(),
+        takes: what,
+    }
+    .into()
 }
 
 #[cfg(test)]

@@ -6,7 +6,7 @@
 
 use faer::Mat;
 
-use crate::error::Error;
+use crate::error::{Error, FlagError};
 use crate::joint::statics::{
     contact_static_reduced, contact_static_reduced_damped, ContactOptions, ContactState,
 };
@@ -18,9 +18,11 @@ use crate::system::ReducedSystem;
 /// The case's master load `[Fx, Fy, Fz (N), Mx, My, Mz (N·mm)]` times `scale`.
 pub fn scaled_load(model: &Model, scale: f64) -> Result<[f64; 6], Error> {
     if !scale.is_finite() {
-        return Err(Error::Invalid(format!(
-            "--scale must be finite, got {scale}"
-        )));
+        return Err(FlagError::NotFinite {
+            flag: "scale",
+            value: scale,
+        }
+        .into());
     }
     Ok(model.master_load().map(|v| v * scale))
 }

@@ -66,7 +66,7 @@ use std::time::Instant;
 
 use serde::Serialize;
 
-use crate::error::Error;
+use crate::error::{Error, RomError};
 use crate::integrate::{Run, TransientOptions};
 use crate::joint::statics::ContactOptions;
 use crate::model::Model;
@@ -213,7 +213,7 @@ pub struct ToleranceChoice {
 /// error meets `opts.tolerance` (module docs).
 ///
 /// # Errors
-/// A tolerance outside (0, 1) or not finite ([`Error::Invalid`] naming it), a failing basis, a
+/// A tolerance outside (0, 1) or not finite ([`RomError::Tolerance`] naming it), a failing basis, a
 /// run that does not finish or an estimate that cannot be made.
 pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<ToleranceModel, Error> {
     let tol = opts.tolerance;
@@ -442,8 +442,6 @@ pub fn check_tolerance(tol: f64) -> Result<(), Error> {
     if tol.is_finite() && tol > 0.0 && tol < 1.0 {
         Ok(())
     } else {
-        Err(Error::Invalid(format!(
-            "--tolerance must be a relative error in (0, 1), got {tol}"
-        )))
+        Err(RomError::Tolerance { tolerance: tol }.into())
     }
 }

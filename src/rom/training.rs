@@ -4,7 +4,7 @@
 
 use serde::Serialize;
 
-use crate::error::Error;
+use crate::error::{Error, RomError};
 use crate::integrate::{integrate, TransientOptions};
 use crate::model::Model;
 use crate::reduction::{snapshot_basis, Basis, BasisOptions};
@@ -41,9 +41,7 @@ pub fn train_snapshot_basis(
     basis: &BasisOptions,
 ) -> Result<(Basis, Training), Error> {
     if snapshots < 2 {
-        return Err(Error::Invalid(format!(
-            "--snapshots must be at least 2, got {snapshots}"
-        )));
+        return Err(RomError::Snapshots { snapshots }.into());
     }
     let train_opts = TransientOptions {
         end_time: Some(train_end),

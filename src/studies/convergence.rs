@@ -68,7 +68,7 @@ use std::time::Instant;
 use faer::{Mat, MatRef};
 use serde::Serialize;
 
-use crate::error::Error;
+use crate::error::{Error, FlagError, ReductionError, StudyError};
 use crate::joint::statics::{ContactOptions, ContactState};
 use crate::model::{contact_static_full, Interface, Model};
 use crate::reduction::{
@@ -114,12 +114,13 @@ pub fn basis_static(
     let build_s = t0.elapsed().as_secs_f64();
     if let Some(g) = opts.g {
         if basis.g < g {
-            return Err(Error::Invalid(format!(
-                "--g {g}: basis `{}` has only {} enrichment vectors on {}",
-                kind.name(),
-                basis.g,
-                model.name
-            )));
+            return Err(StudyError::Enrichment {
+                g,
+                basis: kind.name(),
+                available: basis.g,
+                model: model.name.clone(),
+            }
+            .into());
         }
     }
     let t1 = Instant::now();
@@ -174,16 +175,20 @@ pub fn basis_summary(
     opts: &BasisOptions,
 ) -> Result<BasisSummary, Error> {
     if !matches!(kind, BasisKind::Tvd | BasisKind::TvdPlain) {
-        return Err(Error::Invalid(format!(
-            "--kind {}: must be tvd or tvd-plain",
-            kind.name()
-        )));
+        return Err(FlagError::Value {
+            flag: "kind",
+            value: kind.name().to_string(),
+            need: "must be tvd or tvd-plain",
+        }
+        .into());
     }
     if !(opts.threshold > 0.0 && opts.threshold <= 1.0) {
-        return Err(Error::Invalid(format!(
-            "--threshold must be in (0, 1], got {}",
-            opts.threshold
-        )));
+        return Err(FlagError::Range {
+            flag: "threshold",
+            need: "in (0, 1]",
+            got: opts.threshold.to_string(),
+        }
+        .into());
     }
     let t0 = Instant::now();
     // The other POD's energy curve comes from the same TVD.
@@ -191,10 +196,12 @@ pub fn basis_summary(
     let build_s = t0.elapsed().as_secs_f64();
     if let Some(g) = opts.g {
         if basis.g < g {
-            return Err(Error::Invalid(format!(
-                "--g {g}: the POD of the TVD has only {} modes on {}",
-                basis.g, model.name
-            )));
+            return Err(ReductionError::PodModes {
+                g,
+                available: basis.g,
+                model: model.name.clone(),
+            }
+            .into());
         }
     }
     let (w, w_plain) = if kind == BasisKind::Tvd {
@@ -500,10 +507,10 @@ pub fn run_study(model: &Model, opts: &StudyOptions) -> Result<Study, Error> {
     let t_all = Instant::now();
     let load = scaled_load(model, opts.scale)?;
     if !(opts.threshold > 0.0 && opts.threshold <= 1.0) {
-        return Err(Error::Invalid(format!(
-            "threshold must be in (0, 1], got {}",
-            opts.threshold
-        )));
+        return Err(StudyError::Threshold {
+            threshold: opts.threshold,
+        }
+        .into());
     }
     let t0 = Instant::now();
     let full = contact_static_full(model, load, &opts.contact)?;
@@ -514,11 +521,10 @@ pub fn run_study(model: &Model, opts: &StudyOptions) -> Result<Study, Error> {
         solve_s: t0.elapsed().as_secs_f64(),
     };
     if full_ref.contact_force_norm.is_nan() || full_ref.contact_force_norm <= 0.0 {
-        return Err(Error::Invalid(format!(
-            "{}: the full model has no pair in contact under this load (‖f_c‖ = 0), so there is \
-             no contact force to converge to; try --scale -1",
-            model.name
-        )));
+        return Err(StudyError::NoContact {
+            model: model.name.clone(),
+        }
+        .into());
     }
 
     let t0 = Instant::now();

@@ -40,7 +40,7 @@ use std::time::Instant;
 
 use serde::Serialize;
 
-use crate::error::Error;
+use crate::error::{Error, StudyError};
 use crate::integrate::problem::{Iteration, OdeOptions, OdeStats};
 use crate::integrate::{integrate, ProblemOptions, Run, RunStatus, Scene, TransientOptions};
 use crate::model::Model;
@@ -431,8 +431,7 @@ pub fn run_main_job(
     };
     let st = study::run_study(model, &study_opts)?;
     let energy = |name: &str| st.energy.iter().find(|e| e.name == name);
-    let tvd_energy = energy("tvd")
-        .ok_or_else(|| Error::Invalid("the study has no K-weighted TVD energy curve".into()))?;
+    let tvd_energy = energy("tvd").ok_or(StudyError::NoTvdEnergy)?;
     let g_chosen = tvd_energy.g_threshold;
     let w = tvd_energy.w.clone();
     let w_plain = energy("tvd-plain").map(|e| e.w.clone()).unwrap_or_default();
@@ -540,12 +539,12 @@ fn full_runs(
         Err(e) => Run::failed(e),
     });
     if !full.ok() {
-        return Err(Error::Invalid(format!(
-            "the full FE reference run failed at t = {} s ({}): {}",
-            full.t_reached,
-            full.status,
-            full.message.clone().unwrap_or_default()
-        )));
+        return Err(StudyError::ReferenceFailed {
+            t: full.t_reached,
+            status: full.status.to_string(),
+            message: full.message.clone().unwrap_or_default(),
+        }
+        .into());
     }
     let mut runs = vec![record("full", None, model.dofs(), false, build_full, full)];
     bar.inc(1);

@@ -118,9 +118,13 @@ impl ModelKind {
             .into_iter()
             .find(|k| k.name() == s)
             .ok_or_else(|| {
-                Error::Invalid(format!(
-                    "--models: unknown model {s:?}; valid: full, rom-g0, rom"
-                ))
+                crate::error::FlagError::Unknown {
+                    flag: "models",
+                    what: "model",
+                    value: s.to_string(),
+                    valid: "full, rom-g0, rom",
+                }
+                .into()
             })
     }
 }
@@ -151,9 +155,13 @@ impl IterKind {
         match s {
             "functional" => Ok(IterKind::Functional),
             "newton" => Ok(IterKind::Newton),
-            _ => Err(Error::Invalid(format!(
-                "--iterations: unknown iteration {s:?}; valid: functional, newton"
-            ))),
+            _ => Err(crate::error::FlagError::Unknown {
+                flag: "iterations",
+                what: "iteration",
+                value: s.to_string(),
+                valid: "functional, newton",
+            }
+            .into()),
         }
     }
 
@@ -403,9 +411,10 @@ fn check_options(o: &SweepOptions) -> Result<(), Error> {
         if v.is_finite() && v > 0.0 {
             Ok(())
         } else {
-            Err(Error::Invalid(format!(
-                "{name} must be finite and positive, got {v}"
-            )))
+            Err(Error::Study(crate::error::StudyError::NotPositive {
+                option: name.to_string(),
+                value: v,
+            }))
         }
     };
     pos("end_time", o.end_time)?;
@@ -417,21 +426,19 @@ fn check_options(o: &SweepOptions) -> Result<(), Error> {
     pos("budget_s", o.budget_s)?;
     pos("reference_budget_s", o.reference_budget_s)?;
     if !(o.reference_factor.is_finite() && o.reference_factor >= 1.0) {
-        return Err(Error::Invalid(format!(
-            "reference_factor must be ≥ 1, got {}",
-            o.reference_factor
-        )));
+        return Err(crate::error::StudyError::ReferenceFactor {
+            factor: o.reference_factor,
+        }
+        .into());
     }
     for &k in &o.normal_stiffness {
         pos("normal_stiffness", k)?;
     }
     if let Some(m) = o.max_orders.iter().find(|m| !(1..=5).contains(*m)) {
-        return Err(Error::Invalid(format!(
-            "max_orders: BDF order must be 1–5, got {m}"
-        )));
+        return Err(crate::error::StudyError::MaxOrder { order: *m }.into());
     }
     if o.max_steps == 0 {
-        return Err(Error::Invalid("max_steps must be positive".into()));
+        return Err(crate::error::StudyError::MaxSteps.into());
     }
     if o.models.is_empty()
         || o.iterations.is_empty()
@@ -440,9 +447,7 @@ fn check_options(o: &SweepOptions) -> Result<(), Error> {
         || o.events.is_empty()
         || o.max_orders.is_empty()
     {
-        return Err(Error::Invalid(
-            "every sweep axis needs at least one value".into(),
-        ));
+        return Err(crate::error::StudyError::EmptyAxis.into());
     }
     Ok(())
 }

@@ -573,8 +573,12 @@ fn basis_kind_names() {
         ["tvd", "tvd-plain", "tvd-secant", "modes", "jim", "alldof"]
     );
     let err = BasisKind::from_name("pod").unwrap_err();
-    let msg = err.to_string();
-    assert!(matches!(err, Error::Invalid(_)));
+    assert!(
+        matches!(&err, ReductionError::UnknownBasis { name, .. } if name == "pod"),
+        "{err:?}"
+    );
+    let msg = Error::from(err).to_string();
+    assert!(msg.starts_with("invalid request: unknown basis"), "{msg}");
     for n in names {
         assert!(msg.contains(n), "{msg}");
     }

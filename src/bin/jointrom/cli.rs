@@ -4,6 +4,7 @@
 use clap::error::{ContextKind, ContextValue, ErrorKind};
 use clap::{Parser, Subcommand};
 
+use jointrom::error::FlagError;
 use jointrom::reduction::BasisKind;
 use jointrom::studies::stability::{IterKind, ModelKind};
 use jointrom::Error;
@@ -120,27 +121,47 @@ fn has_value(args: &[String], flag: &str) -> bool {
 
 /// Today's error for `value` given to `flag` of `subcommand`.
 fn value_error(subcommand: &str, flag: &str, v: &str) -> Option<Error> {
-    let invalid = |s: String| Some(Error::Invalid(s));
-    match (subcommand, flag) {
-        ("static", "--basis") => invalid(format!(
-            "--basis {v:?}: unknown basis kind; valid: {}",
-            BasisKind::NAMES.join(", ")
-        )),
-        ("sweep" | "export" | "transient", "--basis") => BasisKind::from_name(v)
-            .err()
-            .and_then(|e| invalid(format!("--basis: {e}"))),
-        ("basis", "--kind") => invalid(format!("--kind {v:?}: valid: tvd, tvd-plain")),
-        ("transient", "--iteration") => invalid(format!(
-            "--iteration must be `newton` or `functional`, got `{v}`"
-        )),
-        ("transient", "--friction" | "--events" | "--stab-lim-det") => {
-            invalid(format!("{flag} must be `on` or `off`, got `{v}`"))
-        }
-        ("stability", "--models") => ModelKind::parse(v).err(),
-        ("stability", "--iterations") => IterKind::parse(v).err(),
-        ("stability", "--friction" | "--events") => {
-            invalid(format!("{flag}: expected on or off, got {v:?}"))
-        }
-        _ => None,
-    }
+    let value = v.to_string();
+    let e = match (subcommand, flag) {
+        ("static", "--basis") => FlagError::UnknownBasis {
+            flag: "basis",
+            value,
+            valid: &BasisKind::NAMES,
+        },
+        ("sweep" | "export" | "transient", "--basis") => FlagError::Basis {
+            flag: "basis",
+            source: BasisKind::from_name(v).err()?,
+        },
+        ("basis", "--kind") => FlagError::Value {
+            flag: "kind",
+            value: format!("{v:?}"),
+            need: "valid: tvd, tvd-plain",
+        },
+        ("transient", "--iteration") => FlagError::Range {
+            flag: "iteration",
+            need: "`newton` or `functional`",
+            got: format!("`{v}`"),
+        },
+        ("transient", "--friction" | "--events" | "--stab-lim-det") => FlagError::Range {
+            flag: switch(flag)?,
+            need: "`on` or `off`",
+            got: format!("`{v}`"),
+        },
+        ("stability", "--models") => return ModelKind::parse(v).err(),
+        ("stability", "--iterations") => return IterKind::parse(v).err(),
+        ("stability", "--friction" | "--events") => FlagError::OnOff {
+            flag: switch(flag)?,
+            value,
+        },
+        _ => return None,
+    };
+    Some(e.into())
+}
+
+/// The name of the on/off switch `flag` (`--friction`, `--events`, `--stab-lim-det`).
+fn switch(flag: &str) -> Option<&'static str> {
+    let name = flag.strip_prefix("--")?;
+    ["friction", "events", "stab-lim-det"]
+        .into_iter()
+        .find(|&s| s == name)
 }

@@ -3,6 +3,7 @@
 use std::path::Path;
 use std::sync::Mutex;
 
+use jointrom::error::FlagError;
 use jointrom::{Error, Model};
 use serde_json::Value;
 
@@ -36,13 +37,11 @@ pub fn print_master_displacement(u: impl Fn(usize) -> f64) {
 }
 
 /// `v` if finite and positive, else an error naming `--flag`.
-pub fn positive(flag: &str, v: f64) -> Result<f64, Error> {
+pub fn positive(flag: &'static str, v: f64) -> Result<f64, Error> {
     if v.is_finite() && v > 0.0 {
         Ok(v)
     } else {
-        Err(Error::Invalid(format!(
-            "--{flag} must be finite and positive, got {v}"
-        )))
+        Err(FlagError::NotPositive { flag, value: v }.into())
     }
 }
 

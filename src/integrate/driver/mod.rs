@@ -43,10 +43,13 @@ pub fn output_count(end: f64, output_step: f64) -> Result<usize, Error> {
     let n = (end / output_step - 1e-9).ceil().max(1.0);
     // NaN (0/0) fails the comparison too.
     if n.is_nan() || n > MAX_OUTPUTS {
-        return Err(Error::Invalid(format!(
-            "end time {end:e} s / output step {output_step:e} s = {n:e} output points, more than \
-             the {MAX_OUTPUTS:e} a run keeps: raise --output-step or lower --end-time"
-        )));
+        return Err(crate::error::IntegrationError::TooManyOutputs {
+            end,
+            output_step,
+            outputs: n,
+            max: MAX_OUTPUTS,
+        }
+        .into());
     }
     Ok(n as usize)
 }
@@ -114,9 +117,9 @@ pub fn integrate<S: SecondOrderSystem>(
 /// [`integrate`] without an observer, as a `Result`: the run if it finished, else its error.
 ///
 /// # Errors
-/// [`Error::Invalid`] for a non-positive or non-finite `output_step`/`end_time` or `tau`; any
-/// integrator error ([`Error::Sundials`] with the flag and time reached, callback errors, a
-/// chattering switch).
+/// [`crate::error::IntegrationError`] for a non-positive or non-finite `output_step`/`end_time`
+/// or `tau`; any integrator error ([`Error::Sundials`] with the flag and time reached, callback
+/// errors, a chattering switch).
 pub fn run<S: SecondOrderSystem>(
     system: S,
     scene: &Scene,
@@ -245,22 +248,27 @@ impl<S: SecondOrderSystem> Driver<S> {
     fn new(system: S, scene: &Scene, opts: &TransientOptions) -> Result<Driver<S>, Error> {
         let end = opts.end_time.unwrap_or(scene.end_time);
         if !(end.is_finite() && end > 0.0) {
-            return Err(Error::Invalid(format!(
-                "end_time must be finite and positive, got {end} s"
-            )));
+            return Err(crate::error::IntegrationError::NotPositive {
+                what: "end_time",
+                value: end,
+            }
+            .into());
         }
         if !(opts.output_step.is_finite() && opts.output_step > 0.0) {
-            return Err(Error::Invalid(format!(
-                "output_step must be finite and positive, got {} s",
-                opts.output_step
-            )));
+            return Err(crate::error::IntegrationError::NotPositive {
+                what: "output_step",
+                value: opts.output_step,
+            }
+            .into());
         }
         output_count(end, opts.output_step)?;
         if let Some(b) = opts.budget_s {
             if !(b.is_finite() && b > 0.0) {
-                return Err(Error::Invalid(format!(
-                    "the wall-clock budget must be finite and positive, got {b} s"
-                )));
+                return Err(crate::error::IntegrationError::NotPositive {
+                    what: "the wall-clock budget",
+                    value: b,
+                }
+                .into());
             }
         }
         let mut ode = MechanicalOde::new(system, &scene.contact, &opts.problem)?;
@@ -313,10 +321,7 @@ impl<S: SecondOrderSystem> Driver<S> {
             let s = self.cv.problem_mut().inner.sample(t, &y);
             self.curves.push(&s);
             if let Some(what) = non_finite(&s) {
-                failure = Some(Error::Invalid(format!(
-                    "the run's {what} is not finite at t = {t} s (an overflow: check k_n, k_t \
-                     and the load)"
-                )));
+                failure = Some(crate::error::IntegrationError::OutputNotFinite { what, t }.into());
                 break;
             }
             if let Some(tr) = &mut self.trajectory {

@@ -146,7 +146,7 @@
 //! field, [`OdeProblem::atol_scale`]).
 
 use crate::case::ContactSpec;
-use crate::error::Error;
+use crate::error::{Error, IntegrationError};
 use crate::integrate::problem::{CallbackError, OdeProblem};
 use crate::joint::law::{evaluate_pairs, PairLaw, PairState, DEFAULT_TAU};
 use crate::system::SecondOrderSystem;
@@ -306,10 +306,11 @@ impl<S: SecondOrderSystem> MechanicalOde<S> {
     ) -> Result<MechanicalOde<S>, Error> {
         let c = contact;
         if !(opts.tau.is_finite() && opts.tau > 0.0) {
-            return Err(Error::Invalid(format!(
-                "tau (slip relaxation time) must be finite and positive, got {} s",
-                opts.tau
-            )));
+            return Err(IntegrationError::NotPositive {
+                what: "tau (slip relaxation time)",
+                value: opts.tau,
+            }
+            .into());
         }
         for (name, v) in [
             ("slip_scale", opts.slip_scale),
@@ -317,9 +318,7 @@ impl<S: SecondOrderSystem> MechanicalOde<S> {
             ("velocity_scale", opts.velocity_scale),
         ] {
             if !(v.is_finite() && v > 0.0) {
-                return Err(Error::Invalid(format!(
-                    "{name} must be finite and positive, got {v}"
-                )));
+                return Err(IntegrationError::ScaleNotPositive { name, value: v }.into());
             }
         }
         let law = PairLaw {
@@ -373,19 +372,19 @@ impl<S: SecondOrderSystem> MechanicalOde<S> {
     /// after one ([`crate::integrate::Stepper`] does).
     ///
     /// # Errors
-    /// [`Error::Invalid`] naming the component if `scale` or a load component is not finite.
+    /// [`IntegrationError::LoadScale`] or [`IntegrationError::LoadComponent`] naming the
+    /// component if `scale` or a load component is not finite.
     pub fn set_load(&mut self, scale: f64, master: [f64; 6]) -> Result<(), Error> {
         if !scale.is_finite() {
-            return Err(Error::Invalid(format!(
-                "the load scale must be finite, got {scale}"
-            )));
+            return Err(IntegrationError::LoadScale { scale }.into());
         }
         const NAMES: [&str; 6] = ["Fx", "Fy", "Fz", "Mx", "My", "Mz"];
         if let Some(d) = master.iter().position(|v| !v.is_finite()) {
-            return Err(Error::Invalid(format!(
-                "the master load component {} must be finite, got {}",
-                NAMES[d], master[d]
-            )));
+            return Err(IntegrationError::LoadComponent {
+                component: NAMES[d],
+                value: master[d],
+            }
+            .into());
         }
         if scale == 1.0 && master.iter().all(|&v| v == 0.0) {
             self.load_hook = None;

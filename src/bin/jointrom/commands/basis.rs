@@ -2,6 +2,7 @@
 
 use clap::Args;
 
+use jointrom::error::FlagError;
 use jointrom::reduction::{BasisKind, BasisOptions};
 use jointrom::studies::convergence as study;
 use jointrom::Error;
@@ -31,10 +32,12 @@ pub struct BasisArgs {
 
 pub fn run(a: BasisArgs) -> Result<(), Error> {
     if !matches!(a.kind, BasisKind::Tvd | BasisKind::TvdPlain) {
-        return Err(Error::Invalid(format!(
-            "--kind {}: must be tvd or tvd-plain",
-            a.kind.name()
-        )));
+        return Err(FlagError::Value {
+            flag: "kind",
+            value: a.kind.name().to_string(),
+            need: "must be tvd or tvd-plain",
+        }
+        .into());
     }
     let model = crate::common::load_model(&a.case)?;
     let opts = BasisOptions {

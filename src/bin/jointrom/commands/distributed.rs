@@ -9,6 +9,7 @@ use std::process::Command;
 use clap::Args;
 use serde_json::json;
 
+use jointrom::error::{FlagError, ReductionError};
 use jointrom::reduction::distributed::{self, Comparison, NativeReference};
 use jointrom::Error;
 
@@ -56,12 +57,11 @@ fn program(a: &DistributedArgs) -> Result<PathBuf, Error> {
         .or_else(|| std::env::var_os(PROGRAM_VAR).map(PathBuf::from))
         .unwrap_or_else(|| PathBuf::from(DEFAULT_PROGRAM));
     if !p.is_file() {
-        return Err(Error::Invalid(format!(
-            "--program: the PETSc program {} does not exist; build it with `scripts/dist.sh build` \
-             (needs `apt-get install -y slepc-dev openmpi-bin`), or name it with --program or \
-             ${PROGRAM_VAR}",
-            p.display()
-        )));
+        return Err(ReductionError::DistributedProgram {
+            program: p,
+            var: PROGRAM_VAR,
+        }
+        .into());
     }
     Ok(p)
 }
@@ -100,28 +100,29 @@ fn run_ranks(a: &DistributedArgs, prog: &Path, job: &Path, ranks: usize) -> Resu
             .filter(|l| !l.contains("Configure options"))
             .take(12)
             .collect();
-        return Err(Error::Invalid(format!(
-            "{} -n {ranks} {}: {}\n{}",
-            a.mpirun,
-            prog.display(),
-            output.status,
-            jointrom::files::printable(&tail.join("\n"))
-        )));
+        return Err(ReductionError::DistributedFailed {
+            mpirun: a.mpirun.clone(),
+            ranks,
+            program: prog.to_path_buf(),
+            status: output.status.to_string(),
+            stderr: jointrom::files::printable(&tail.join("\n")).to_string(),
+        }
+        .into());
     }
     Ok(())
 }
 
 pub fn run(a: DistributedArgs) -> Result<(), Error> {
     if a.ranks.is_empty() || a.ranks.contains(&0) {
-        return Err(Error::Invalid(
-            "--ranks: give one or more positive rank counts, e.g. 1,2".into(),
-        ));
+        return Err(FlagError::Ranks.into());
     }
     if !(a.tol > 0.0 && a.tol < 1.0) {
-        return Err(Error::Invalid(format!(
-            "--tol {}: must lie in (0, 1)",
-            a.tol
-        )));
+        return Err(FlagError::Value {
+            flag: "tol",
+            value: a.tol.to_string(),
+            need: "must lie in (0, 1)",
+        }
+        .into());
     }
     let prog = program(&a)?;
     let model = crate::common::load_model(&a.case)?;

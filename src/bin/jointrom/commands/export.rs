@@ -5,6 +5,7 @@ use std::path::{Path, PathBuf};
 
 use clap::Args;
 
+use jointrom::error::ReportError;
 use jointrom::integrate::TransientOptions;
 use jointrom::reduction::BasisKind;
 use jointrom::rom::file as export;
@@ -37,30 +38,30 @@ fn fmu_binary() -> Result<PathBuf, Error> {
     if let Some(p) = std::env::var_os(BINARY_ENV) {
         let p = PathBuf::from(p);
         if !p.is_file() {
-            return Err(Error::Invalid(format!(
-                "{BINARY_ENV}={} is not a file (point it at the {BINARY_FILE} built by `cargo \
-                 build --release -p jointrom-fmu`, or unset it)",
-                p.display()
-            )));
+            return Err(ReportError::FmuBinaryEnv {
+                var: BINARY_ENV,
+                path: p,
+                file: BINARY_FILE,
+            }
+            .into());
         }
         return Ok(p);
     }
-    let exe = std::env::current_exe().map_err(|e| {
-        Error::Invalid(format!(
-            "--fmu: cannot locate this executable to find {BINARY_FILE} beside it ({e}); set \
-             {BINARY_ENV}"
-        ))
+    let exe = std::env::current_exe().map_err(|source| ReportError::FmuNoExecutable {
+        file: BINARY_FILE,
+        var: BINARY_ENV,
+        source,
     })?;
     let dir = exe.parent().unwrap_or(Path::new("."));
     let p = dir.join(BINARY_FILE);
     if p.is_file() {
         Ok(p)
     } else {
-        Err(Error::Invalid(format!(
-            "--fmu: the FMU binary {} does not exist: build it with `cargo build --release -p \
-             jointrom-fmu` (it lands beside the jointrom executable), or set {BINARY_ENV} to it",
-            p.display()
-        )))
+        Err(ReportError::FmuBinaryMissing {
+            path: p,
+            var: BINARY_ENV,
+        }
+        .into())
     }
 }
 

@@ -6,6 +6,7 @@ use std::path::PathBuf;
 
 use clap::Args;
 
+use jointrom::error::StudyError;
 use jointrom::report::stability::stability_study;
 use jointrom::studies::stability::SweepOptions;
 use jointrom::Error;
@@ -126,8 +127,7 @@ pub fn run(a: StabilityArgs) -> Result<(), Error> {
     let v = stability_study(&a.case, &a.out, !a.no_charts, &opts)?;
     println!(
         "{}",
-        serde_json::to_string_pretty(&v)
-            .map_err(|e| Error::Invalid(format!("JSON output: {e}")))?
+        serde_json::to_string_pretty(&v).map_err(StudyError::JsonOutput)?
     );
     Ok(())
 }

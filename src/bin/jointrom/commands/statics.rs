@@ -3,6 +3,7 @@
 use clap::Args;
 use serde_json::{json, Value};
 
+use jointrom::error::{FlagError, RomError};
 use jointrom::joint::statics as contact;
 use jointrom::reduction::{BasisKind, BasisOptions, JointFlexibility};
 use jointrom::rom::spec::unsupported;
@@ -40,17 +41,15 @@ pub struct StaticArgs {
 pub fn run(a: StaticArgs) -> Result<(), Error> {
     let scale = a.scale;
     if !scale.is_finite() {
-        return Err(Error::Invalid(format!(
-            "--scale must be finite, got {scale}"
-        )));
+        return Err(FlagError::NotFinite {
+            flag: "scale",
+            value: scale,
+        }
+        .into());
     }
     let spec = a.model.spec(ModelSpec::Full)?;
     if a.linear && spec.is_reduced() {
-        return Err(Error::Invalid(
-            "--linear and a reduced model do not combine: a reduced model solves the contact \
-             statics (drop --linear, or --basis/--model/--tolerance)"
-                .into(),
-        ));
+        return Err(RomError::LinearReduced.into());
     }
     let model = crate::common::load_model(&a.case)?;
     match spec {

@@ -7,6 +7,7 @@ use clap::Args;
 use serde_json::json;
 
 use crate::common::{positive, print_json};
+use jointrom::error::StudyError;
 use jointrom::integrate::TransientOptions;
 use jointrom::reduction::BasisKind;
 use jointrom::rom::{build_rom, ModelFlags, ModelSpec};
@@ -98,15 +99,14 @@ pub fn run(a: SweepArgs) -> Result<(), Error> {
         .runs
         .iter()
         .filter(|r| r.status != "ok")
-        .map(|r| format!("`{}`", jointrom::files::printable(&r.variant.name)))
+        .map(|r| jointrom::files::printable(&r.variant.name).to_string())
         .collect();
     if !failed.is_empty() {
-        return Err(Error::Invalid(format!(
-            "{} of {} sweep variants failed: {}",
-            failed.len(),
-            res.runs.len(),
-            failed.join(", ")
-        )));
+        return Err(StudyError::SweepFailed {
+            failed,
+            total: res.runs.len(),
+        }
+        .into());
     }
     Ok(())
 }

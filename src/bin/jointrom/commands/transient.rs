@@ -7,6 +7,7 @@ use std::time::Instant;
 use clap::Args;
 use serde_json::{json, Value};
 
+use jointrom::error::{FlagError, RomError};
 use jointrom::integrate::{Curves, TransientOptions};
 use jointrom::reduction::BasisKind;
 use jointrom::rom::compare::{ReferenceCurves, ReferenceErrors};
@@ -219,16 +220,16 @@ pub fn run(a: TransientArgs) -> Result<(), Error> {
     }
     let met = o.tolerance.as_ref().is_none_or(|t| t.met);
     if a.strict && !met {
-        return Err(Error::Invalid(format!(
-            "--strict: the estimated |f_c| error {:e} of the best model exceeds --tolerance {:e} \
-             (the result above is that model's)",
-            o.estimate
+        return Err(RomError::Strict {
+            estimate: o
+                .estimate
                 .as_ref()
                 .and_then(|e| e.as_ref().ok())
                 .and_then(|e| e.total.contact_force)
                 .unwrap_or(f64::NAN),
-            a.model.tolerance.unwrap_or(f64::NAN)
-        )));
+            tolerance: a.model.tolerance.unwrap_or(f64::NAN),
+        }
+        .into());
     }
     Ok(())
 }
@@ -250,9 +251,12 @@ fn transient_options(a: &TransientArgs) -> Result<TransientOptions, Error> {
     }
     if let Some(k) = a.max_order {
         if !(1..=5).contains(&k) {
-            return Err(Error::Invalid(format!(
-                "--max-order must be 1..=5 (BDF), got {k}"
-            )));
+            return Err(FlagError::Range {
+                flag: "max-order",
+                need: "1..=5 (BDF)",
+                got: k.to_string(),
+            }
+            .into());
         }
         o.ode.max_order = k;
     }
@@ -267,18 +271,24 @@ fn transient_options(a: &TransientArgs) -> Result<TransientOptions, Error> {
             match r.parse::<f64>() {
                 Ok(m) if m.is_finite() && m >= 0.0 => Some(m),
                 _ => {
-                    return Err(Error::Invalid(format!(
-                        "--refresh must be `off` or a margin in mm (finite, >= 0), got `{r}`"
-                    )))
+                    return Err(FlagError::Range {
+                        flag: "refresh",
+                        need: "`off` or a margin in mm (finite, >= 0)",
+                        got: format!("`{r}`"),
+                    }
+                    .into())
                 }
             }
         };
     }
     if let Some(g) = a.step_growth {
         if !(g.is_finite() && g >= 1.0) {
-            return Err(Error::Invalid(format!(
-                "--step-growth must be finite and >= 1, got {g}"
-            )));
+            return Err(FlagError::Range {
+                flag: "step-growth",
+                need: "finite and >= 1",
+                got: g.to_string(),
+            }
+            .into());
         }
         o.ode.step_growth = g;
     }
@@ -301,9 +311,11 @@ fn vtu_every(
 ) -> Result<Option<usize>, Error> {
     match &a.vtu {
         None => Ok(None),
-        Some(_) if a.vtu_frames == 0 => {
-            Err(Error::Invalid("--vtu-frames must be at least 1".into()))
+        Some(_) if a.vtu_frames == 0 => Err(FlagError::AtLeast {
+            flag: "vtu-frames",
+            min: 1,
         }
+        .into()),
         Some(_) => {
             let end = opts.end_time.unwrap_or(model.end_time);
             let outputs = (end / opts.output_step).ceil().max(1.0) as usize + 1;
@@ -330,11 +342,7 @@ fn model_spec(a: &TransientArgs) -> Result<ModelSpec, Error> {
             *train_end = a.train_end.map(|t| positive("train-end", t)).transpose()?;
             *snapshots = a.snapshots;
         }
-        _ if a.train_end.is_some() => {
-            return Err(Error::Invalid(
-                "--train-end applies to --model pod only".into(),
-            ))
-        }
+        _ if a.train_end.is_some() => return Err(RomError::TrainEndNotPod.into()),
         _ => {}
     }
     Ok(spec)
