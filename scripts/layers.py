@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Checks the dependency rule of ARCHITECTURE.md: every module of src/ uses only its own folder and
 the folders above it in the pipeline, and no two modules import each other in a circle.
-src/error.rs (the crate-wide error that wraps every layer's failures) stands outside the rule.
+src/error/ (the crate-wide error that wraps every layer's failures) stands outside the rule.
 The binary (src/bin/jointrom/) has its own rule: main -> cli -> commands/* -> the shared modules
 (args, common, summary); a command never uses another command or cli, the shared modules use no
 command, and nothing in the binary forms a circle.
