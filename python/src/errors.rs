@@ -48,9 +48,20 @@ pub fn to_py(e: jointrom::Error) -> PyErr {
     let msg = e.to_string();
     match e {
         E::Io { .. } | E::Write { .. } => IoError::new_err(msg),
-        E::Case { .. } | E::Document { .. } | E::Deck { .. } | E::Element(_) | E::Invalid(_) => {
-            InputError::new_err(msg)
-        }
+        E::Case { .. }
+        | E::Document { .. }
+        | E::Deck { .. }
+        | E::Element(_)
+        | E::MatrixRequest(_)
+        | E::Model(_)
+        | E::Joint(_)
+        | E::System(_)
+        | E::Reduction(_)
+        | E::Integration(_)
+        | E::Report(_)
+        | E::Flag(_)
+        | E::Rom(_)
+        | E::Study(_) => InputError::new_err(msg),
         E::LinearAlgebra(_) | E::Sundials { .. } | E::Callback { .. } | E::Chatter { .. } => {
             SolverError::new_err(msg)
         }

@@ -356,7 +356,11 @@ impl PyModel {
         max_wall: f64,
         progress: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Rom> {
-        let kind = basis.map(BasisKind::from_name).transpose().py_err()?;
+        let kind = basis
+            .map(BasisKind::from_name)
+            .transpose()
+            .map_err(jointrom::Error::from)
+            .py_err()?;
         let flags = ModelFlags {
             model: None,
             basis: kind,

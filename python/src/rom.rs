@@ -53,9 +53,7 @@ impl Rom {
         match (&self.file, &self.model) {
             (Some((f, _)), _) => Ok(f.clone()),
             (None, Some(model)) => RomFile::new(model, &self.system, self.info.clone()),
-            (None, None) => Err(jointrom::Error::Invalid(
-                "a reduced model without its model or file".into(),
-            )),
+            (None, None) => Err(jointrom::error::RomError::Detached.into()),
         }
     }
 
@@ -110,9 +108,7 @@ impl Rom {
                     }
                 })
             }
-            (None, _, None) => Err(jointrom::Error::Invalid(
-                "a reduced model without its model or file".into(),
-            )),
+            (None, _, None) => Err(jointrom::error::RomError::Detached.into()),
         }
     }
 

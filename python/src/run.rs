@@ -2,6 +2,7 @@
 //! the keyword arguments of `Model.transient`, `Rom.transient` and `Model.reduce`, checked as
 //! the CLI checks its flags (the messages name the flags).
 
+use jointrom::error::FlagError;
 use jointrom::integrate::{RunHook, TransientOptions};
 use jointrom::rom::ModelRun;
 use jointrom::studies::stability::IterKind;
@@ -26,13 +27,11 @@ pub struct RunArgs {
 }
 
 /// `v` if finite and positive, else the CLI's error naming `--flag`.
-fn positive(flag: &str, v: f64) -> Result<f64, Error> {
+fn positive(flag: &'static str, v: f64) -> Result<f64, Error> {
     if v.is_finite() && v > 0.0 {
         Ok(v)
     } else {
-        Err(Error::Invalid(format!(
-            "--{flag} must be finite and positive, got {v}"
-        )))
+        Err(FlagError::NotPositive { flag, value: v }.into())
     }
 }
 
@@ -51,9 +50,12 @@ impl RunArgs {
         }
         if let Some(k) = self.max_order {
             if !(1..=5).contains(&k) {
-                return Err(Error::Invalid(format!(
-                    "--max-order must be 1..=5 (BDF), got {k}"
-                )));
+                return Err(FlagError::Range {
+                    flag: "max-order",
+                    need: "1..=5 (BDF)",
+                    got: k.to_string(),
+                }
+                .into());
             }
             o.ode.max_order = k;
         }

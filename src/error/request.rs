@@ -630,6 +630,9 @@ pub enum RomError {
         exported_from: String,
         differs: String,
     },
+    /// A reduced model that carries neither its model nor its file.
+    #[error("a reduced model without its model or file")]
+    Detached,
     /// No error estimate: the run ended early with `status`.
     #[error("no error estimate: the run ended early ({status})")]
     EstimateEarlyEnd { status: String },
