@@ -13,7 +13,8 @@ pub(crate) mod sundials;
 
 pub use crate::system::Scene;
 pub use driver::{
-    integrate, run, thread_cpu_s, Curves, Profile, Run, RunStatus, Trajectory, TransientOptions,
+    integrate, run, thread_cpu_s, Curves, Profile, Run, RunStatus, Stall, Trajectory,
+    TransientOptions,
 };
 pub use mechanical::{EnergySample, MechanicalOde, ProblemOptions};
 pub use stepper::Stepper;

@@ -226,6 +226,11 @@ impl Sheets<'_> {
                 ));
             }
         }
+        for &s in stack {
+            let g = &grids[s];
+            nugget::check_points(weld.diameter, g.step[0].min(g.step[1]))
+                .map_err(|reason| ctx.err(format!("welds[{w}].diameter"), reason))?;
+        }
         let clip = Rect::common(stack.iter().map(|&s| &grids[s]));
         let inside = |p: [f64; 2]| clip.contains(p);
         let layers = stack
@@ -318,6 +323,27 @@ impl Sheets<'_> {
             let nodes = (i0..=i1)
                 .flat_map(|i| (k0..=k1).map(move |k| g.index(i, k)))
                 .collect();
+            // The fine grid's size, counted in floating point before anything is allocated (a
+            // sheet spanning 1e308 mm or a `local_mesh` of 1e-300 mm would overflow an index).
+            let lines_of = |lines: &[f64]| -> f64 {
+                1.0 + lines
+                    .windows(2)
+                    .map(|pair| ((pair[1] - pair[0]) / size - 1e-9).ceil().max(1.0))
+                    .sum::<f64>()
+            };
+            let planned = lines_of(&xs) * lines_of(&zs);
+            if !(planned <= MAX_PATCH_NODES as f64) {
+                return Err(ctx.err(
+                    path.as_str(),
+                    format!(
+                        "{size} mm shells over the {} × {} mm around the nugget on sheet `{}` \
+                         would be {planned:.3e} nodes (at most {MAX_PATCH_NODES} per sheet)",
+                        xs[xs.len() - 1] - xs[0],
+                        zs[zs.len() - 1] - zs[0],
+                        g.name
+                    ),
+                ));
+            }
             let fine = |lines: &[f64]| -> Vec<f64> {
                 let mut out = vec![lines[0]];
                 for pair in lines.windows(2) {
@@ -351,6 +377,8 @@ impl Sheets<'_> {
                 h: size,
                 interpolation: &interpolation,
             };
+            nugget::check_points(weld.diameter, size)
+                .map_err(|reason| ctx.err(path.as_str(), reason))?;
             nugget.push(nugget::sample(centre, weld.diameter, &inside, &view));
             offset += count;
             layers.push(PatchLayer {
