@@ -150,7 +150,7 @@ pub(crate) fn check_sheets(case: &Case, ctx: &Ctx) -> Result<(), Error> {
         let [nx, nz] = sheet.elements;
         for (a, (axis, span)) in [("x", sheet.x), ("z", sheet.z)].into_iter().enumerate() {
             let side = (span[1] - span[0]) / sheet.elements[a] as f64;
-            if !(side <= MAX_ELEMENT_SIDE) {
+            if side.is_nan() || side > MAX_ELEMENT_SIDE {
                 return Err(ctx.err(
                     format!("{p}.{axis}"),
                     format!(

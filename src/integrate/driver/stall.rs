@@ -136,7 +136,7 @@ impl StallWatch {
         let w = self.window;
         let cpu = now.cpu - w.cpu;
         // NaN (no thread clock) never reaches the window's length: no chatter stop.
-        if !(cpu >= WINDOW_CPU_S) {
+        if cpu.is_nan() || cpu < WINDOW_CPU_S {
             return None;
         }
         self.window = now;

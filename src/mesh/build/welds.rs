@@ -367,7 +367,7 @@ impl Sheets<'_> {
                     .sum::<f64>()
             };
             let planned = lines_of(&xs) * lines_of(&zs);
-            if !(planned <= MAX_PATCH_NODES as f64) {
+            if planned.is_nan() || planned > MAX_PATCH_NODES as f64 {
                 return Err(ctx.err(
                     path.as_str(),
                     format!(
