@@ -19,7 +19,7 @@
 //!   the pairs the estimate selects), transient and static.
 //! - [`statics`]: contact statics of a reduced model.
 //! - [`training`]: the POD of a full-FE training run (the paper's Section 5.2 competitor).
-//! - [`file`]: the reduced model as a versioned JSON file (`jointrom-rom`).
+//! - [`mod@file`]: the reduced model as a versioned JSON file (`jointrom-rom`).
 //! - [`compare`]: curves against curves — the relative L2 error every estimate and reference
 //!   check uses, and stored reference curves.
 //!

@@ -305,7 +305,7 @@ pub struct ConvergenceSeries {
     /// Where the series gets within 1e-2 and 1e-4.
     pub within: Vec<Within>,
     /// g where the active-set Newton method failed (cycled) and the damped one
-    /// ([`reduced_contact_static_damped`]) solved it.
+    /// ([`reduced_contact_static_damped`](crate::rom::statics::reduced_contact_static_damped)) solved it.
     pub restarts: Vec<Failure>,
     /// g where both failed: the values are NaN (`null` in JSON) there.
     pub failures: Vec<Failure>,
