@@ -1608,7 +1608,7 @@ fn sizes_and_crawls(fx: &Fixture) -> Vec<Hostile> {
         ),
         info_case(
             "size-nugget-points",
-            "100 000 × 1 elements (a nugget of 4·10⁸ sampling points)",
+            "100 000 × 1 elements (a nugget of 10⁸ sampling points)",
             set(c, "/sheets/0/elements", json!([100000, 1])),
             Fails("welds[0].diameter"),
         ),

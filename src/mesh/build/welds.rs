@@ -371,8 +371,8 @@ impl Sheets<'_> {
                 return Err(ctx.err(
                     path.as_str(),
                     format!(
-                        "{size} mm shells over the {} × {} mm around the nugget on sheet `{}` \
-                         would be {planned:.3e} nodes (at most {MAX_PATCH_NODES} per sheet)",
+                        "{size:e} mm shells over the {:e} × {:e} mm around the nugget on sheet \
+                         `{}` would be {planned:.3e} nodes (at most {MAX_PATCH_NODES} per sheet)",
                         xs[xs.len() - 1] - xs[0],
                         zs[zs.len() - 1] - zs[0],
                         g.name
