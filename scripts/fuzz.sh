@@ -37,6 +37,22 @@ c["rigid_tie"]["master"] = [160.0, 0.5, 12.5]
 c["welds"] = [{"x": 100.0, "z": 12.5, "sheets": ["A", "B"], "diameter": 5.0}]
 json.dump(c, open(sys.argv[1], "w"))
 PY
+# Huge coordinates and sizes (checked in floating point before any allocation).
+python3 - "$seeds/case" <<'PY'
+import json, sys
+base = json.load(open("cases/friction_bar.json"))
+edits = {
+    "x_1e308": lambda c: c["sheets"][0].update(x=[0.0, 1e308]),
+    "x_span_overflow": lambda c: c["sheets"][0].update(x=[-1e308, 1e308]),
+    "x_1e12": lambda c: c["sheets"][1].update(x=[40.0, 1e12]),
+    "thin_shells": lambda c: c["sheets"][0].update(elements=[100000, 1]),
+    "local_mesh_tiny": lambda c: c["welds"][0].update(local_mesh=1e-300),
+}
+for name, edit in edits.items():
+    c = json.loads(json.dumps(base))
+    edit(c)
+    json.dump(c, open(f"{sys.argv[1]}/size_{name}.json", "w"))
+PY
 "$bin" export-matrices "$small" --out "$seeds/matrices" >/dev/null
 cp "$seeds/matrices/K.mtx" "$seeds/mtx/K.mtx"; cp "$seeds/matrices/M.mtx" "$seeds/mtx/M.mtx"
 cp "$seeds/matrices/model.json" "$seeds/map/model.json"

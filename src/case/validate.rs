@@ -95,8 +95,13 @@ pub(crate) fn check_contact_load(
     ctx.positive("end_time", end_time, " s")
 }
 
+/// The longest element side a sheet may have, mm (1 km): sizes and coordinates derived from a
+/// sheet's extent stay far from overflow, and a larger side is a unit mistake.
+pub const MAX_ELEMENT_SIDE: f64 = 1e6;
+
 /// Every sheet's own fields: a unique non-empty name, finite extents of positive length, a finite
-/// y, a positive thickness, element counts ≥ 1 and a model within the DOF budget
+/// y, a positive thickness, element counts ≥ 1, element sides of at most [`MAX_ELEMENT_SIDE`]
+/// and a model within the DOF budget
 /// ([`crate::files::dof_budget`]).
 pub(crate) fn check_sheets(case: &Case, ctx: &Ctx) -> Result<(), Error> {
     if case.sheets.is_empty() {
@@ -143,6 +148,20 @@ pub(crate) fn check_sheets(case: &Case, ctx: &Ctx) -> Result<(), Error> {
             }
         }
         let [nx, nz] = sheet.elements;
+        for (a, (axis, span)) in [("x", sheet.x), ("z", sheet.z)].into_iter().enumerate() {
+            let side = (span[1] - span[0]) / sheet.elements[a] as f64;
+            if side.is_nan() || side > MAX_ELEMENT_SIDE {
+                return Err(ctx.err(
+                    format!("{p}.{axis}"),
+                    format!(
+                        "[{:e}, {:e}] mm in {} elements: an element side of {side:e} mm, over the \
+                         {MAX_ELEMENT_SIDE:e} mm a sheet model admits (check the units: lengths \
+                         are in mm)",
+                        span[0], span[1], sheet.elements[a]
+                    ),
+                ));
+            }
+        }
         // Sheet nodes so far, plus the master node, 6 DOF each, within the model-size budget
         // (checked before anything is allocated).
         let budget = crate::files::dof_budget();

@@ -357,6 +357,10 @@ pub enum IntegrationError {
         outputs: f64,
         max: f64,
     },
+    /// A run stopped at `t` (s) because it crawls: `reason` says which statistic and the flag to
+    /// change.
+    #[error("the run was stopped at t = {t:.6e} s, it cannot finish in reasonable time: {reason}")]
+    Stalled { t: f64, reason: String },
 }
 
 /// A report that cannot be written as asked (the `report` layer).

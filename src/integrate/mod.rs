@@ -13,7 +13,7 @@ pub(crate) mod sundials;
 
 pub use crate::system::Scene;
 pub use driver::{
-    integrate, run, thread_cpu_s, Curves, Profile, Run, RunHook, RunStatus, Trajectory,
+    integrate, run, thread_cpu_s, Curves, Profile, Run, RunHook, RunStatus, Stall, Trajectory,
     TransientOptions,
 };
 pub use mechanical::{EnergySample, MechanicalOde, ProblemOptions};

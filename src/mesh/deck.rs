@@ -91,6 +91,7 @@ pub fn build(deck: &Deck) -> Result<DeckModel, Error> {
             tie,
             pairs,
             material,
+            warnings: Vec::new(),
         },
         grid_ids,
         load,

@@ -215,6 +215,9 @@ pub struct Mesh {
     pub pairs: Vec<JointPair>,
     /// Material of all sheets and welds.
     pub material: Material,
+    /// What the build could not do as asked and did otherwise (a weld whose automatic
+    /// re-meshed neighbourhood could not be built), one sentence each.
+    pub warnings: Vec<String>,
 }
 
 /// Linear elastic isotropic material.

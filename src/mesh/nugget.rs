@@ -40,6 +40,33 @@ pub(super) struct SheetView<'a> {
     pub(super) interpolation: &'a dyn Fn([f64; 2]) -> Interpolation,
 }
 
+/// Most sampling points of one nugget on one sheet: 10⁶ points are ~100 MB with their shape
+/// functions, far beyond any mesh the DOF budget admits around one weld.
+pub(super) const MAX_POINTS: f64 = 1e6;
+
+/// The number of sampling points [`sample`] takes for a nugget of `diameter` on shells of
+/// smaller side `h` (both mm), counted in floating point.
+fn point_count(diameter: f64, h: f64) -> f64 {
+    let radius = 0.5 * diameter;
+    let rings = (RINGS as f64).max((2.0 * radius / h).ceil());
+    let sectors = 4.0 * ((SECTORS / 4) as f64).max((std::f64::consts::PI * radius / h).ceil());
+    rings * sectors
+}
+
+/// Refuses a nugget whose sampling would take more than [`MAX_POINTS`] points (a diameter
+/// many orders above the element size), with the reason.
+pub(super) fn check_points(diameter: f64, h: f64) -> Result<(), String> {
+    let n = point_count(diameter, h);
+    if n <= MAX_POINTS {
+        Ok(())
+    } else {
+        Err(format!(
+            "a {diameter} mm nugget on {h} mm shells would take {n:.3e} sampling points (at \
+             most {MAX_POINTS:e}): the diameter is far larger than the elements"
+        ))
+    }
+}
+
 /// The sampling points of the disc (centre, diameter) kept by `inside` (the clip rectangle,
 /// boundary included), on the sheet `view`.
 pub(super) fn sample(

@@ -206,7 +206,7 @@ impl Model {
             load: case.load.clone(),
             contact: case.contact,
             end_time: case.end_time,
-            warnings: Vec::new(),
+            warnings: mesh.warnings.clone(),
         };
         Model::assemble(mesh, pairs, node_ids, parts, |mesh| Origin::Case {
             case: Box::new(case),

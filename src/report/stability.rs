@@ -26,6 +26,7 @@ fn status_color(s: &RunStatus) -> [u8; 3] {
         RunStatus::Finished => [120, 190, 120],
         RunStatus::Budget { .. } => [245, 170, 60],
         RunStatus::Chatter { .. } => [140, 90, 60],
+        RunStatus::Stalled { .. } => [200, 110, 170],
         RunStatus::Failed { flag, .. } => match flag.name.as_str() {
             "CV_TOO_MUCH_WORK" => [215, 80, 70],
             "CV_CONV_FAILURE" => [150, 90, 190],

@@ -17,7 +17,7 @@
 //! is integrated from rest over a short window ([`SweepOptions::end_time`], 0.01 s of the friction
 //! bar by default; the full model over [`SweepOptions::full_end_time`]) at the paper's Table 1
 //! tolerances, and each cell records its status (`ok`, the CVODE flag such as
-//! `CV_TOO_MUCH_WORK`, `budget`, `chatter` or `error`) with the time reached, the solver
+//! `CV_TOO_MUCH_WORK`, `budget`, `chatter`, `stalled` or `error`) with the time reached, the solver
 //! statistics, the wall time and the relative L2 error over the output times of `‖f_c‖(t)`
 //!
 //! ```text
@@ -54,7 +54,9 @@
 //!   ±iω lie; high-order steps over the fast modes fail the error test and the step shrinks.
 //! - `budget` with **events**: gaps of nearly closed pairs and stick/slip switches change sign
 //!   at nearly every step (penalty oscillation), each root restarts the integrator at order 1;
-//!   a switch that fires repeatedly at the same time would end the cell as `chatter`.
+//!   a switch that fires repeatedly at the same time would end the cell as `chatter`, and a
+//!   full-model cell whose roots fire every other step at a crawl ends as `stalled`
+//!   ([`crate::integrate::Stall`]) within seconds instead of spending its budget.
 //! - `budget` with **Newton at k_n = 1e6** (w(g) ROM, full model): the contact oscillation at
 //!   `√(k_n/m)` must be resolved to the tolerance, an accuracy limit that a stable implicit
 //!   method does not remove.
@@ -291,7 +293,7 @@ pub struct Cell {
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Outcome {
     /// `ok`, the CVODE flag (`CV_TOO_MUCH_WORK`, `CV_CONV_FAILURE`, `CV_ERR_FAILURE`, ...),
-    /// `budget`, `chatter` or `error` (serialized as [`RunStatus::name`]).
+    /// `budget`, `chatter`, `stalled` or `error` (serialized as [`RunStatus::name`]).
     pub status: RunStatus,
     /// The failure's message (`None` when ok).
     pub message: Option<String>,

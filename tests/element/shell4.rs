@@ -309,6 +309,7 @@ fn strip(length: f64, width: f64, t: f64, nx: usize, nz: usize, material: Materi
         },
         pairs: vec![],
         material,
+        warnings: Vec::new(),
     }
 }
 

@@ -102,6 +102,53 @@ fn case_files() {
     });
 }
 
+/// Sizes derived from case numbers: seeds whose sheet spans 1e308 or 1e12 mm, whose shells are
+/// 1e-3 mm against a 5 mm nugget, or whose `local_mesh` is 1e-300 mm, with the automatic
+/// neighbourhoods on. Every mutant's mesh is built (the grids, nuggets and neighbourhoods whose
+/// sizes are checked before they are allocated); the condensation is not, to keep each input
+/// quick.
+#[test]
+fn case_sizes() {
+    let base: serde_json::Value = serde_json::from_str(&common::case_text("friction_bar")).unwrap();
+    let variants: [(&str, serde_json::Value); 5] = [
+        ("/sheets/0/x", serde_json::json!([0.0, 1e308])),
+        ("/sheets/0/x", serde_json::json!([-1e308, 1e308])),
+        ("/sheets/1/x", serde_json::json!([40.0, 1e12])),
+        ("/sheets/0/elements", serde_json::json!([100000, 1])),
+        ("/welds/0/diameter", serde_json::json!(24.0)),
+    ];
+    let mut seeds: Vec<Vec<u8>> = variants
+        .iter()
+        .map(|(ptr, v)| {
+            let mut case = base.clone();
+            *case.pointer_mut(ptr).unwrap() = v.clone();
+            serde_json::to_string_pretty(&case).unwrap().into_bytes()
+        })
+        .collect();
+    let mut tiny = base.clone();
+    tiny["welds"][0]["local_mesh"] = serde_json::json!(1e-300);
+    seeds.push(serde_json::to_string_pretty(&tiny).unwrap().into_bytes());
+    // The seeds themselves: all but the wide nugget (accepted) are refused, none panics.
+    let refused = seeds
+        .iter()
+        .filter(|s| {
+            Case::from_json_str(std::str::from_utf8(s).unwrap(), "seed.json")
+                .and_then(|case| jointrom::mesh::Mesh::from_case(&case))
+                .is_err()
+        })
+        .count();
+    assert_eq!(refused, seeds.len() - 1);
+    fuzz("case-sizes", &seeds, 6, |bytes| {
+        let Ok(text) = std::str::from_utf8(bytes) else {
+            return false;
+        };
+        match Case::from_json_str(text, "fuzz.json") {
+            Ok(case) => jointrom::mesh::Mesh::from_case(&case).is_ok(),
+            Err(_) => false,
+        }
+    });
+}
+
 /// The friction bar on a coarse grid (6 × 2 shells a sheet, 20 mm apart, no welds).
 fn shrink(case: &mut serde_json::Value) {
     case["sheets"][0]["x"] = serde_json::json!([0.0, 120.0]);

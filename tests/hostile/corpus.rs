@@ -178,6 +178,7 @@ pub fn corpus() -> Vec<Hostile> {
     v.extend(outputs(fx));
     v.extend(output_links());
     v.extend(decks());
+    v.extend(sizes_and_crawls(fx));
     v
 }
 
@@ -1539,5 +1540,100 @@ fn decks() -> Vec<Hostile> {
             "deck.bdf",
             d.replace("ENDDATA", "INCLUDE 'nowhere.bdf'\nENDDATA"),
         ),
+    ]
+}
+
+/// Sizes derived from absurd case numbers, runs that crawl, a weld whose re-meshed
+/// neighbourhood cannot be built, and a reduced model run under another case.
+fn sizes_and_crawls(fx: &Fixture) -> Vec<Hostile> {
+    let c = &fx.case;
+    use Expect::{Fails, Warns};
+    let full = |extra: &[&str]| {
+        let mut args = vec!["transient", "friction_bar", "--model", "full"];
+        args.extend_from_slice(extra);
+        args.iter().map(|s| s.to_string()).collect::<Vec<_>>()
+    };
+    let mut close = serde_json::from_str::<Value>(c).unwrap();
+    close["welds"]
+        .as_array_mut()
+        .unwrap()
+        .push(json!({"x": 70.0, "z": 12.5, "sheets": ["A", "B"], "diameter": 5.0}));
+    let mut chatter = entry(
+        "run-events-chatter",
+        "flag",
+        "full FE model with --events on (roots every other step)",
+        &[],
+        Fails("--events off"),
+    );
+    chatter.args = full(&["--events", "on", "--end-time", "2e-4"]);
+    let mut collapse = entry(
+        "run-step-collapse",
+        "flag",
+        "full FE model with --max-order 5 --velocity-scale 1 (the step collapses)",
+        &[],
+        Fails("--max-order 2"),
+    );
+    collapse.args = full(&[
+        "--max-order",
+        "5",
+        "--velocity-scale",
+        "1",
+        "--end-time",
+        "5e-3",
+    ]);
+    vec![
+        info_case(
+            "size-sheet-1e308",
+            "sheet x = [0, 1e308] mm",
+            set(c, "/sheets/0/x", json!([0.0, 1e308])),
+            Fails("sheets[0].x"),
+        ),
+        info_case(
+            "size-sheet-1e12",
+            "sheet x = [0, 1e12] mm",
+            set(c, "/sheets/0/x", json!([0.0, 1e12])),
+            Fails("element side"),
+        ),
+        info_case(
+            "size-sheet-span-overflow",
+            "sheet x = [-1e308, 1e308] mm (the length overflows)",
+            set(c, "/sheets/0/x", json!([-1e308, 1e308])),
+            Fails("sheets[0].x"),
+        ),
+        info_case(
+            "size-local-mesh-tiny",
+            "`local_mesh` of 1e-300 mm",
+            edit(c, |v| v["welds"][0]["local_mesh"] = json!(1e-300)),
+            Fails("welds[0].local_mesh"),
+        ),
+        info_case(
+            "size-nugget-points",
+            "100 000 × 1 elements (a nugget of 10⁸ sampling points)",
+            set(c, "/sheets/0/elements", json!([100000, 1])),
+            Fails("welds[0].diameter"),
+        ),
+        chatter,
+        collapse,
+        info_case(
+            "weld-auto-downgrade",
+            "two welds too close for separate re-meshed neighbourhoods",
+            serde_json::to_string_pretty(&close).unwrap(),
+            Warns("welds[2] at (x, z) = (70, 12.5) mm"),
+        ),
+        entry(
+            "rom-other-case",
+            "reduced-model file",
+            "the friction bar's reduced model run under the multilayer sheet",
+            &[
+                "transient",
+                "multilayer_sheet",
+                "--model",
+                ROM,
+                "--end-time",
+                "0.001",
+            ],
+            Fails("exported from `friction_bar`"),
+        )
+        .file("rom.json", fx.rom.clone()),
     ]
 }

@@ -8,6 +8,13 @@ use jointrom::{Error, Model};
 
 pub use jointrom::report::info::{area_welds, cell_count, info_json};
 
+/// `doc` with the model's warnings as `warnings` (the JSON of every command that loads a model
+/// carries what its standard error said about the model).
+pub fn with_warnings(model: &Model, mut doc: Value) -> Value {
+    doc["warnings"] = json!(model.warnings);
+    doc
+}
+
 /// The linear static solution under `scale` × the master load (also part of `run`'s
 /// results.json).
 pub fn static_json(model: &Model, scale: f64) -> Result<Value, Error> {

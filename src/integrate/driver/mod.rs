@@ -14,18 +14,20 @@
 use std::time::{Duration, Instant};
 
 use super::mechanical::MechanicalOde;
-use super::problem::{CallbackError, OdeProblem, Stop};
+use super::problem::{CallbackError, OdeProblem, OdeStats, Stop};
 use super::sundials::Cvode;
 use crate::error::Error;
 use crate::system::{Scene, SecondOrderSystem};
 
 mod options;
 mod outcome;
+mod stall;
 
 pub use options::{RunHook, TransientOptions};
 pub use outcome::{
     Curves, EnergyCheck, Profile, Run, RunStatus, Trajectory, ENERGY_BALANCE_TOLERANCE,
 };
+pub use stall::Stall;
 
 /// The most output points a run keeps (`end_time / output_step`): 10⁶ samples of every curve
 /// are ~100 MB with the energies; beyond that a typo (`--output-step 1e-300`, `--end-time
@@ -300,7 +302,11 @@ impl<S: SecondOrderSystem> Driver<S> {
             curves,
             trajectory,
             y0,
-            roots: RootGuard::new(),
+            roots: RootGuard::watched(stall::StallWatch::new(
+                0.0,
+                opts.ode.max_order,
+                opts.problem.velocity_scale,
+            )),
         })
     }
 
@@ -317,6 +323,10 @@ impl<S: SecondOrderSystem> Driver<S> {
                 break;
             }
             let t = self.cv.t();
+            if let Some(e) = self.roots.watch_output(t, &self.cv.stats()) {
+                failure = Some(e);
+                break;
+            }
             let y = self.cv.y().to_vec();
             let s = self.cv.problem_mut().inner.sample(t, &y);
             self.curves.push(&s);
@@ -332,10 +342,17 @@ impl<S: SecondOrderSystem> Driver<S> {
         let wall_s = wall.elapsed().as_secs_f64();
         let cpu_s = thread_cpu_s() - cpu0;
         let t_reached = self.cv.t();
-        let status = match &failure {
-            None => RunStatus::Finished,
-            Some(Error::Chatter { .. }) => RunStatus::Chatter { t: t_reached },
-            Some(e) => RunStatus::of_error(e, t_reached, self.cv.problem().exceeded),
+        let stalled = self.roots.watch.as_ref().and_then(|w| w.stalled);
+        let status = match (&failure, stalled) {
+            (Some(_), Some(reason)) => RunStatus::Stalled {
+                t: t_reached,
+                reason,
+            },
+            (failure, _) => match failure {
+                None => RunStatus::Finished,
+                Some(Error::Chatter { .. }) => RunStatus::Chatter { t: t_reached },
+                Some(e) => RunStatus::of_error(e, t_reached, self.cv.problem().exceeded),
+            },
         };
         let mut stats = self.cv.stats();
         stats.newton_refreshes = self.cv.problem().inner.refreshes();
@@ -361,6 +378,15 @@ impl<S: SecondOrderSystem> Driver<S> {
     }
 }
 
+/// The error of a run stopped at `t` (s) because it crawls.
+fn stalled_error(t: f64, reason: &str) -> Error {
+    crate::error::IntegrationError::Stalled {
+        t,
+        reason: reason.to_string(),
+    }
+    .into()
+}
+
 /// Event handling shared by the driver loop and [`super::Stepper`]: integrates to an output time,
 /// re-initialising at every root, and ends a chattering switch ([`MAX_STALLED_ROOTS`] roots in
 /// a row without progress in time) with [`Error::Chatter`].
@@ -370,6 +396,8 @@ pub(super) struct RootGuard {
     pub(super) events: u64,
     last_root_t: f64,
     stalled: usize,
+    /// The driver's watch for runs that crawl (none in a co-simulation).
+    watch: Option<stall::StallWatch>,
 }
 
 impl RootGuard {
@@ -378,7 +406,23 @@ impl RootGuard {
             events: 0,
             last_root_t: f64::NEG_INFINITY,
             stalled: 0,
+            watch: None,
         }
+    }
+
+    /// A guard that also stops a run that crawls ([`Stall`]).
+    fn watched(watch: stall::StallWatch) -> RootGuard {
+        RootGuard {
+            watch: Some(watch),
+            ..RootGuard::new()
+        }
+    }
+
+    /// At an output at `t`: the error that stops a run that crawls, if it does.
+    fn watch_output(&mut self, t: f64, stats: &OdeStats) -> Option<Error> {
+        let events = self.events;
+        let reason = self.watch.as_mut()?.at_output(t, stats, events)?;
+        Some(stalled_error(t, &reason))
     }
 
     /// Integrates `cv` to `tout`, re-initialising at every root.
@@ -405,6 +449,11 @@ impl RootGuard {
                         self.stalled = 0;
                     }
                     self.last_root_t = t;
+                    if let Some(w) = &mut self.watch {
+                        if let Some(reason) = w.at_root(t, &cv.stats(), self.events) {
+                            return Err(stalled_error(t, &reason));
+                        }
+                    }
                     let y = cv.y().to_vec();
                     cv.reinit(t, &y)?;
                 }

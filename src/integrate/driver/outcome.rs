@@ -151,6 +151,14 @@ pub enum RunStatus {
         /// Time reached, s.
         t: f64,
     },
+    /// Stopped at `t` (s) because the run crawls: its statistics show it cannot finish in
+    /// reasonable time ([`Stall`](super::Stall): chattering events or a collapsing step).
+    Stalled {
+        /// Time reached, s.
+        t: f64,
+        /// What the statistics showed.
+        reason: super::Stall,
+    },
     /// A SUNDIALS call failed (`function` returned `flag`), or a problem callback failed and
     /// made CVODE return `flag` (`callback` names it) at `t` (s).
     Failed {
@@ -169,12 +177,14 @@ pub enum RunStatus {
 
 impl RunStatus {
     /// `ok`, the CVODE flag's name (`CV_TOO_MUCH_WORK`, `CV_CONV_FAILURE`, ...), `sundials` or
-    /// `callback` for a failure without a CVODE flag name, `budget`, `chatter` or `error`.
+    /// `callback` for a failure without a CVODE flag name, `budget`, `chatter`, `stalled` or
+    /// `error`.
     pub fn name(&self) -> &str {
         match self {
             RunStatus::Finished => "ok",
             RunStatus::Budget { .. } => "budget",
             RunStatus::Chatter { .. } => "chatter",
+            RunStatus::Stalled { .. } => "stalled",
             RunStatus::Failed { flag, .. } if flag.name.starts_with("CV_") => &flag.name,
             RunStatus::Failed { callback: None, .. } => "sundials",
             RunStatus::Failed { .. } => "callback",

@@ -48,7 +48,13 @@ pub(super) fn build(case: &Case) -> Result<Mesh, Error> {
         .collect();
     let (tied, tie) = sheets.rigid_tie(&case.rigid_tie, &clamp_of, &mut nodes)?;
     let mut welds = sheets.welds(&case.welds)?;
-    check_patches(&ctx, &mut welds.welds, &clamp_of, &tied)?;
+    check_patches(
+        &ctx,
+        &mut welds.welds,
+        &clamp_of,
+        &tied,
+        &mut welds.warnings,
+    )?;
     let supports = Supports {
         clamp_of,
         tied,
@@ -82,6 +88,7 @@ pub(super) fn build(case: &Case) -> Result<Mesh, Error> {
             poisson_ratio: case.material.poisson_ratio,
             density: case.material.density,
         },
+        warnings: welds.warnings,
     })
 }
 
@@ -187,6 +194,8 @@ struct Welds {
     welds: Vec<WeldElem>,
     /// The area welds' nuggets, for taking welded node pairs out of the joints.
     nuggets: Vec<Nugget>,
+    /// Welds whose automatic neighbourhood could not be built.
+    warnings: Vec<String>,
 }
 
 /// An area weld's nugget as the joints pass sees it.

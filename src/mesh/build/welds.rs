@@ -13,12 +13,13 @@ use crate::mesh::{BeamElem, PatchLayer, WeldElem, WeldPatch};
 /// A weld's re-meshed neighbourhood (`local_mesh`) may neither hold a clamped or tied node
 /// (the small shells would not be held with it) nor overlap another weld's. An explicit size
 /// that breaks this is an error; an automatic neighbourhood is left out (checked after every
-/// explicit one, in file order).
+/// explicit one, in file order) with a warning in `warnings`.
 pub(super) fn check_patches(
     ctx: &Ctx,
     welds: &mut [WeldElem],
     clamp_of: &[Option<usize>],
     tied: &[bool],
+    warnings: &mut Vec<String>,
 ) -> Result<(), Error> {
     let mut owner: HashMap<usize, usize> = HashMap::new();
     for automatic in [false, true] {
@@ -30,7 +31,10 @@ pub(super) fn check_patches(
             let conflict = patch_conflict(patch, weld.index, &owner, clamp_of, tied);
             match conflict {
                 None => owner.extend(patch.replaced.iter().map(|&shell| (shell, weld.index))),
-                Some(_) if automatic => weld.patch = None,
+                Some(reason) if automatic => {
+                    weld.patch = None;
+                    warnings.push(downgrade_warning(weld.index, weld.centre, &reason));
+                }
                 Some(reason) => {
                     return Err(ctx.err(format!("welds[{}].local_mesh", weld.index), reason))
                 }
@@ -38,6 +42,19 @@ pub(super) fn check_patches(
         }
     }
     Ok(())
+}
+
+/// The warning for area weld `welds[index]` at `centre` (x, z, mm) whose automatic re-meshed
+/// neighbourhood was wanted (its sheets' shells are coarser than the nugget) but cannot be built
+/// for `reason`.
+fn downgrade_warning(index: usize, centre: [f64; 2], reason: &str) -> String {
+    format!(
+        "welds[{index}] at (x, z) = ({}, {}) mm: its re-meshed neighbourhood \
+         (`\"local_mesh\": \"auto\"`) cannot be built — {reason}; the weld acts on the sheets' \
+         own shells, coarser than its nugget (a stiffer, less accurate weld): move it, set \
+         `local_mesh` to a size or `\"off\"`, or refine the sheets",
+        centre[0], centre[1]
+    )
 }
 
 /// Why `patch` (of `welds[index]`) is inadmissible given the shells `owner` already gives to
@@ -156,7 +173,7 @@ impl Sheets<'_> {
                     elem.patch = match weld.local_mesh {
                         LocalMesh::Off => None,
                         LocalMesh::Size(size) => Some(self.weld_patch(w, weld, &stack, size)?),
-                        LocalMesh::Auto => self.auto_patch(w, weld, &stack),
+                        LocalMesh::Auto => self.auto_patch(w, weld, &stack, &mut out.warnings),
                     };
                     out.nuggets.push(Nugget {
                         index: w,
@@ -226,6 +243,11 @@ impl Sheets<'_> {
                 ));
             }
         }
+        for &s in stack {
+            let g = &grids[s];
+            nugget::check_points(weld.diameter, g.step[0].min(g.step[1]))
+                .map_err(|reason| ctx.err(format!("welds[{w}].diameter"), reason))?;
+        }
         let clip = Rect::common(stack.iter().map(|&s| &grids[s]));
         let inside = |p: [f64; 2]| clip.contains(p);
         let layers = stack
@@ -254,8 +276,15 @@ impl Sheets<'_> {
     /// The neighbourhood `"local_mesh": "auto"` gives area weld `welds[w]`: re-meshed at
     /// d · [`LocalMesh::AUTO_SIZE_PER_DIAMETER`] when a welded sheet's shells have a side longer
     /// than d · [`LocalMesh::AUTO_UNRESOLVED_PER_DIAMETER`] and the neighbourhood is within the
-    /// size limits; `None` otherwise (the nugget acts on the sheets' own shells).
-    fn auto_patch(&self, w: usize, weld: &WeldSpec, stack: &[usize]) -> Option<WeldPatch> {
+    /// size limits; `None` otherwise (the nugget acts on the sheets' own shells), with a warning
+    /// in `warnings` when the neighbourhood was wanted but cannot be built.
+    fn auto_patch(
+        &self,
+        w: usize,
+        weld: &WeldSpec,
+        stack: &[usize],
+        warnings: &mut Vec<String>,
+    ) -> Option<WeldPatch> {
         let d = weld.diameter;
         let unresolved = stack.iter().any(|&s| {
             let step = self.grids[s].step;
@@ -265,9 +294,20 @@ impl Sheets<'_> {
             return None;
         }
         let size = LocalMesh::AUTO_SIZE_PER_DIAMETER * d;
-        let mut patch = self.weld_patch(w, weld, stack, size).ok()?;
-        patch.automatic = true;
-        Some(patch)
+        match self.weld_patch(w, weld, stack, size) {
+            Ok(mut patch) => {
+                patch.automatic = true;
+                Some(patch)
+            }
+            Err(e) => {
+                let reason = match e {
+                    Error::Case { reason, .. } => reason,
+                    other => other.to_string(),
+                };
+                warnings.push(downgrade_warning(w, [weld.x, weld.z], &reason));
+                None
+            }
+        }
     }
 
     /// The re-meshed neighbourhood of area weld `welds[w]` (`local_mesh` = `size`, mm): on each
@@ -318,6 +358,27 @@ impl Sheets<'_> {
             let nodes = (i0..=i1)
                 .flat_map(|i| (k0..=k1).map(move |k| g.index(i, k)))
                 .collect();
+            // The fine grid's size, counted in floating point before anything is allocated (a
+            // sheet spanning 1e308 mm or a `local_mesh` of 1e-300 mm would overflow an index).
+            let lines_of = |lines: &[f64]| -> f64 {
+                1.0 + lines
+                    .windows(2)
+                    .map(|pair| ((pair[1] - pair[0]) / size - 1e-9).ceil().max(1.0))
+                    .sum::<f64>()
+            };
+            let planned = lines_of(&xs) * lines_of(&zs);
+            if planned.is_nan() || planned > MAX_PATCH_NODES as f64 {
+                return Err(ctx.err(
+                    path.as_str(),
+                    format!(
+                        "{size:e} mm shells over the {:e} × {:e} mm around the nugget on sheet \
+                         `{}` would be {planned:.3e} nodes (at most {MAX_PATCH_NODES} per sheet)",
+                        xs[xs.len() - 1] - xs[0],
+                        zs[zs.len() - 1] - zs[0],
+                        g.name
+                    ),
+                ));
+            }
             let fine = |lines: &[f64]| -> Vec<f64> {
                 let mut out = vec![lines[0]];
                 for pair in lines.windows(2) {
@@ -351,6 +412,8 @@ impl Sheets<'_> {
                 h: size,
                 interpolation: &interpolation,
             };
+            nugget::check_points(weld.diameter, size)
+                .map_err(|reason| ctx.err(path.as_str(), reason))?;
             nugget.push(nugget::sample(centre, weld.diameter, &inside, &view));
             offset += count;
             layers.push(PatchLayer {

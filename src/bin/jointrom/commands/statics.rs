@@ -14,7 +14,7 @@ use jointrom::studies::convergence as study;
 use jointrom::{Error, Model};
 
 use crate::common::{print_json, print_master_displacement};
-use crate::summary::static_json;
+use crate::summary::{static_json, with_warnings};
 
 #[derive(Args)]
 pub struct StaticArgs {
@@ -74,7 +74,7 @@ pub fn run(a: StaticArgs) -> Result<(), Error> {
         contact_json(&model, scale)?
     };
     if a.json {
-        print_json(&v);
+        print_json(&with_warnings(&model, v));
         return Ok(());
     }
     let kind = if a.linear {
@@ -162,7 +162,7 @@ fn tolerance_static(
     });
     add_pair_forces(&mut v, model, st);
     if json {
-        print_json(&v);
+        print_json(&with_warnings(model, v));
         return Ok(());
     }
     println!(
@@ -228,7 +228,7 @@ fn reduced_static(
     });
     add_pair_forces(&mut v, model, st);
     if json {
-        print_json(&v);
+        print_json(&with_warnings(model, v));
         return Ok(());
     }
     println!(

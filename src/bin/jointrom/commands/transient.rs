@@ -191,6 +191,8 @@ pub fn run(a: TransientArgs) -> Result<(), Error> {
         "energy_check": c.energy_check(opts.energy_resolution()),
         "training": o.training,
         "profile": o.run.profile,
+        "status": o.run.status,
+        "warnings": model.warnings,
     });
     let check = c.energy_check(opts.energy_resolution());
     if !check.ok {
