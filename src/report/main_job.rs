@@ -365,7 +365,7 @@ fn speed_chart(rep: &Report, dir: &Path) -> Result<Vec<PathBuf>, Error> {
         }
     }
     c.references.push(Reference {
-        label: "2 % (issue target)".into(),
+        label: "2 % (accuracy target)".into(),
         value: 0.02,
         color: Some([200, 0, 0]),
     });
