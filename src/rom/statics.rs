@@ -38,19 +38,30 @@ pub struct ReducedStatic {
     pub state: ContactState,
 }
 
-/// Frictionless contact statics of a reduced model under its load `Φᵀ f` times `scale`
-/// ([`contact_static_reduced`] on `K̃` and the normal rows of `B Φ`).
-pub fn reduced_contact_static(
+/// The dense contact problem of a reduced model under its load `Φᵀ f` times `scale`: `K̃`, the
+/// normal rows of `B Φ`, `f̃`, `k_n`.
+type DenseContactSolver = fn(
+    faer::MatRef<'_, f64>,
+    faer::MatRef<'_, f64>,
+    &[f64],
+    f64,
+    &ContactOptions,
+) -> Result<(Vec<f64>, ContactState), Error>;
+
+/// `solve` on the reduced contact problem of `rm` under `scale` × its load, with the master
+/// displacement of the solution.
+fn solve_reduced(
     model: &Model,
     rm: &ReducedSystem,
     scale: f64,
     opts: &ContactOptions,
+    solve: DenseContactSolver,
 ) -> Result<ReducedStatic, Error> {
     let w = model.joint.pairs();
     let r = rm.dim();
     let b_n = Mat::from_fn(w, r, |i, j| rm.b_phi()[(3 * i + NORMAL, j)]);
     let f: Vec<f64> = rm.reduced_load().iter().map(|v| v * scale).collect();
-    let (eta, state) = contact_static_reduced(
+    let (eta, state) = solve(
         rm.k().as_ref(),
         b_n.as_ref(),
         &f,
@@ -64,6 +75,17 @@ pub fn reduced_contact_static(
         master_displacement,
         state,
     })
+}
+
+/// Frictionless contact statics of a reduced model under its load `Φᵀ f` times `scale`
+/// ([`contact_static_reduced`] on `K̃` and the normal rows of `B Φ`).
+pub fn reduced_contact_static(
+    model: &Model,
+    rm: &ReducedSystem,
+    scale: f64,
+    opts: &ContactOptions,
+) -> Result<ReducedStatic, Error> {
+    solve_reduced(model, rm, scale, opts, contact_static_reduced)
 }
 
 /// [`reduced_contact_static`] (the active-set Newton method of [`crate::joint::statics`]) from
@@ -96,22 +118,5 @@ pub fn reduced_contact_static_damped(
     scale: f64,
     opts: &ContactOptions,
 ) -> Result<ReducedStatic, Error> {
-    let w = model.joint.pairs();
-    let r = rm.dim();
-    let b = Mat::from_fn(w, r, |i, j| rm.b_phi()[(3 * i + NORMAL, j)]);
-    let f: Vec<f64> = rm.reduced_load().iter().map(|v| v * scale).collect();
-    let (eta, state) = contact_static_reduced_damped(
-        rm.k().as_ref(),
-        b.as_ref(),
-        &f,
-        model.contact.normal_stiffness,
-        opts,
-    )?;
-    let master_displacement =
-        std::array::from_fn(|k| (0..r).map(|c| rm.phi_master[(k, c)] * eta[c]).sum::<f64>());
-    Ok(ReducedStatic {
-        eta,
-        master_displacement,
-        state,
-    })
+    solve_reduced(model, rm, scale, opts, contact_static_reduced_damped)
 }
