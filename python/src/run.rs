@@ -2,8 +2,7 @@
 //! the keyword arguments of `Model.transient`, `Rom.transient` and `Model.reduce`, checked as
 //! the CLI checks its flags (the messages name the flags).
 
-use jointrom::error::FlagError;
-use jointrom::integrate::{RunHook, TransientOptions};
+use jointrom::integrate::{RunChoices, RunHook, TransientOptions};
 use jointrom::rom::ModelRun;
 use jointrom::studies::stability::IterKind;
 use jointrom::Error;
@@ -26,47 +25,21 @@ pub struct RunArgs {
     pub max_wall: f64,
 }
 
-/// `v` if finite and positive, else the CLI's error naming `--flag`.
-fn positive(flag: &'static str, v: f64) -> Result<f64, Error> {
-    if v.is_finite() && v > 0.0 {
-        Ok(v)
-    } else {
-        Err(FlagError::NotPositive { flag, value: v }.into())
-    }
-}
-
 impl RunArgs {
     /// The transient options, as `jointrom transient` makes them from its flags.
     pub fn options(&self, hook: Option<RunHook>) -> Result<TransientOptions, Error> {
-        let mut o = TransientOptions::default();
-        o.ode.iteration = IterKind::parse(&self.iteration)?.iteration();
-        o.problem.friction = self.friction;
-        o.problem.events = self.events;
-        if let Some(r) = self.rtol {
-            o.ode.rtol = positive("rtol", r)?;
+        let mut o = RunChoices {
+            iteration: IterKind::parse(&self.iteration)?.iteration(),
+            friction: self.friction,
+            events: self.events,
+            rtol: self.rtol,
+            atol: self.atol,
+            max_order: self.max_order,
+            end_time: self.end_time,
+            output_step: self.output_step,
+            max_wall: self.max_wall,
         }
-        if let Some(a) = self.atol {
-            o.ode.atol = positive("atol", a)?;
-        }
-        if let Some(k) = self.max_order {
-            if !(1..=5).contains(&k) {
-                return Err(FlagError::Range {
-                    flag: "max-order",
-                    need: "1..=5 (BDF)",
-                    got: k.to_string(),
-                }
-                .into());
-            }
-            o.ode.max_order = k;
-        }
-        if let Some(t) = self.end_time {
-            o.end_time = Some(positive("end-time", t)?);
-        }
-        o.output_step = positive("output-step", self.output_step)?;
-        if let Some(t) = o.end_time {
-            jointrom::integrate::driver::output_count(t, o.output_step)?;
-        }
-        o.budget_s = Some(positive("max-wall", self.max_wall)?);
+        .options()?;
         o.hook = hook;
         Ok(o)
     }

@@ -13,8 +13,8 @@ pub(crate) mod sundials;
 
 pub use crate::system::Scene;
 pub use driver::{
-    integrate, run, thread_cpu_s, Curves, Profile, Run, RunHook, RunStatus, Stall, Trajectory,
-    TransientOptions,
+    integrate, positive_flag, run, thread_cpu_s, Curves, Profile, Run, RunChoices, RunHook,
+    RunStatus, Stall, Trajectory, TransientOptions,
 };
 pub use mechanical::{EnergySample, MechanicalOde, ProblemOptions};
 pub use stepper::Stepper;

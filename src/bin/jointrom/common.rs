@@ -3,7 +3,6 @@
 use std::path::Path;
 use std::sync::Mutex;
 
-use jointrom::error::FlagError;
 use jointrom::{Error, Model};
 use serde_json::Value;
 
@@ -38,11 +37,7 @@ pub fn print_master_displacement(u: impl Fn(usize) -> f64) {
 
 /// `v` if finite and positive, else an error naming `--flag`.
 pub fn positive(flag: &'static str, v: f64) -> Result<f64, Error> {
-    if v.is_finite() && v > 0.0 {
-        Ok(v)
-    } else {
-        Err(FlagError::NotPositive { flag, value: v }.into())
-    }
+    jointrom::integrate::positive_flag(flag, v)
 }
 
 /// Creates `dir` and its parents.

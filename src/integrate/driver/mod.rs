@@ -23,7 +23,7 @@ mod options;
 mod outcome;
 mod stall;
 
-pub use options::{RunHook, TransientOptions};
+pub use options::{positive_flag, RunChoices, RunHook, TransientOptions};
 pub use outcome::{
     Curves, EnergyCheck, Profile, Run, RunStatus, Trajectory, ENERGY_BALANCE_TOLERANCE,
 };

@@ -4,8 +4,9 @@ use std::sync::Arc;
 
 use serde::Serialize;
 
+use crate::error::{Error, FlagError};
 use crate::integrate::mechanical::{ProblemOptions, DEFAULT_MAX_ORDER};
-use crate::integrate::problem::OdeOptions;
+use crate::integrate::problem::{Iteration, OdeOptions};
 
 /// Options of [`integrate`](super::integrate). Defaults: the integrator's defaults ([`OdeOptions::default`]: BDF,
 /// Newton with the structured solve, rtol 1e-8, atol 1e-6 — the paper's Table 1) except the
@@ -84,5 +85,80 @@ impl TransientOptions {
     /// millisecond of a ramp: 1e-7 N·mm) cannot balance better than it, relative to anything.
     pub fn energy_resolution(&self) -> f64 {
         10.0 * self.ode.atol * self.problem.energy_scale
+    }
+}
+
+/// `v` if finite and positive, else the error naming the command-line flag `--{flag}`.
+pub fn positive_flag(flag: &'static str, v: f64) -> Result<f64, Error> {
+    if v.is_finite() && v > 0.0 {
+        Ok(v)
+    } else {
+        Err(FlagError::NotPositive { flag, value: v }.into())
+    }
+}
+
+/// The choices of a run a user makes — `jointrom transient`'s flags and the Python package's
+/// keyword arguments of the same names — checked into [`TransientOptions`] in one place (errors
+/// name the flags). Callers add what only they have (the CLI's `--velocity-scale`,
+/// `--refresh`, ...; Python's hook) to the options this returns.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RunChoices {
+    /// Newton or functional iteration.
+    pub iteration: Iteration,
+    /// Friction on.
+    pub friction: bool,
+    /// Event location on gaps and stick/slip switches.
+    pub events: bool,
+    /// CVODE's relative tolerance (`None`: the paper's 1e-8).
+    pub rtol: Option<f64>,
+    /// Absolute tolerance, mm (`None`: the paper's 1e-6).
+    pub atol: Option<f64>,
+    /// Maximum BDF order 1–5 (`None`: [`DEFAULT_MAX_ORDER`]).
+    pub max_order: Option<usize>,
+    /// End time, s (`None`: the scene's).
+    pub end_time: Option<f64>,
+    /// Output spacing, s.
+    pub output_step: f64,
+    /// Wall-clock budget of the integration, s.
+    pub max_wall: f64,
+}
+
+impl RunChoices {
+    /// The checked transient options of these choices.
+    ///
+    /// # Errors
+    /// A tolerance, time, step or budget that is not finite and positive, a max order outside
+    /// 1–5, more outputs than a run keeps — each naming its flag.
+    pub fn options(&self) -> Result<TransientOptions, Error> {
+        let mut o = TransientOptions::default();
+        o.ode.iteration = self.iteration;
+        o.problem.friction = self.friction;
+        o.problem.events = self.events;
+        if let Some(r) = self.rtol {
+            o.ode.rtol = positive_flag("rtol", r)?;
+        }
+        if let Some(a) = self.atol {
+            o.ode.atol = positive_flag("atol", a)?;
+        }
+        if let Some(k) = self.max_order {
+            if !(1..=5).contains(&k) {
+                return Err(FlagError::Range {
+                    flag: "max-order",
+                    need: "1..=5 (BDF)",
+                    got: k.to_string(),
+                }
+                .into());
+            }
+            o.ode.max_order = k;
+        }
+        if let Some(t) = self.end_time {
+            o.end_time = Some(positive_flag("end-time", t)?);
+        }
+        o.output_step = positive_flag("output-step", self.output_step)?;
+        if let Some(t) = o.end_time {
+            super::output_count(t, o.output_step)?;
+        }
+        o.budget_s = Some(positive_flag("max-wall", self.max_wall)?);
+        Ok(o)
     }
 }

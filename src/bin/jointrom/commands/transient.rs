@@ -8,7 +8,7 @@ use clap::Args;
 use serde_json::{json, Value};
 
 use jointrom::error::{FlagError, RomError};
-use jointrom::integrate::{Curves, TransientOptions};
+use jointrom::integrate::{Curves, RunChoices, TransientOptions};
 use jointrom::reduction::BasisKind;
 use jointrom::rom::compare::{ReferenceCurves, ReferenceErrors};
 use jointrom::rom::spec::DEFAULT_SNAPSHOTS;
@@ -238,29 +238,20 @@ pub fn run(a: TransientArgs) -> Result<(), Error> {
 
 /// The options of a `transient` run from its flags (errors name the flag).
 fn transient_options(a: &TransientArgs) -> Result<TransientOptions, Error> {
-    let mut o = TransientOptions::default();
-    o.ode.iteration = a.iteration.iteration();
-    o.problem.friction = a.friction.is_on();
-    o.problem.events = a.events.is_on();
-    if let Some(r) = a.rtol {
-        o.ode.rtol = positive("rtol", r)?;
+    let mut o = RunChoices {
+        iteration: a.iteration.iteration(),
+        friction: a.friction.is_on(),
+        events: a.events.is_on(),
+        rtol: a.rtol,
+        atol: a.atol,
+        max_order: a.max_order,
+        end_time: a.end_time,
+        output_step: a.output_step,
+        max_wall: a.max_wall,
     }
-    if let Some(r) = a.atol {
-        o.ode.atol = positive("atol", r)?;
-    }
+    .options()?;
     if let Some(v) = a.velocity_scale {
         o.problem.velocity_scale = positive("velocity-scale", v)?;
-    }
-    if let Some(k) = a.max_order {
-        if !(1..=5).contains(&k) {
-            return Err(FlagError::Range {
-                flag: "max-order",
-                need: "1..=5 (BDF)",
-                got: k.to_string(),
-            }
-            .into());
-        }
-        o.ode.max_order = k;
     }
     if let Some(s) = a.stab_lim_det {
         o.ode.stab_lim_det = s.is_on();
@@ -294,14 +285,6 @@ fn transient_options(a: &TransientArgs) -> Result<TransientOptions, Error> {
         }
         o.ode.step_growth = g;
     }
-    if let Some(t) = a.end_time {
-        o.end_time = Some(positive("end-time", t)?);
-    }
-    o.output_step = positive("output-step", a.output_step)?;
-    if let Some(t) = o.end_time {
-        jointrom::integrate::driver::output_count(t, o.output_step)?;
-    }
-    o.budget_s = Some(positive("max-wall", a.max_wall)?);
     Ok(o)
 }
 
