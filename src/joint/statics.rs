@@ -276,15 +276,7 @@ pub fn contact_static_reduced(
     k_n: f64,
     opts: &ContactOptions,
 ) -> Result<(Vec<f64>, ContactState), Error> {
-    let r = k_red.nrows();
-    if k_red.ncols() != r || b_n_phi.ncols() != r || f_red.len() != r {
-        return Err(JointError::ReducedStaticsSizes {
-            k_r: (k_red.nrows(), k_red.ncols()),
-            b_n_phi: (b_n_phi.nrows(), b_n_phi.ncols()),
-            load: f_red.len(),
-        }
-        .into());
-    }
+    let r = reduced_sizes(k_red, b_n_phi, f_red)?;
     let w = b_n_phi.nrows();
     // Nonzero columns of each pair row (B_n Φ is sparse when Φ selects DOF).
     let support: Vec<Vec<usize>> = (0..w)
@@ -472,15 +464,7 @@ pub fn contact_static_reduced_damped(
     k_n: f64,
     opts: &ContactOptions,
 ) -> Result<(Vec<f64>, ContactState), Error> {
-    let (w, r) = (b_n_phi.nrows(), k_red.nrows());
-    if k_red.ncols() != r || b_n_phi.ncols() != r || f.len() != r {
-        return Err(JointError::ReducedStaticsSizes {
-            k_r: (k_red.nrows(), k_red.ncols()),
-            b_n_phi: (b_n_phi.nrows(), b_n_phi.ncols()),
-            load: f.len(),
-        }
-        .into());
-    }
+    let (w, r) = (b_n_phi.nrows(), reduced_sizes(k_red, b_n_phi, f)?);
     let b = b_n_phi;
     let gaps_of = |eta: &[f64]| -> Vec<f64> {
         (0..w)
@@ -573,4 +557,23 @@ pub fn contact_static_reduced_damped(
         what: "damped reduced contact",
         steps: max_steps,
     }))
+}
+
+/// r of a reduced contact problem (`K_r` r × r, `B_n Φ` w × r, `f_r` r), or the error naming the
+/// sizes that do not fit.
+fn reduced_sizes(
+    k_red: MatRef<'_, f64>,
+    b_n_phi: MatRef<'_, f64>,
+    f_red: &[f64],
+) -> Result<usize, Error> {
+    let r = k_red.nrows();
+    if k_red.ncols() != r || b_n_phi.ncols() != r || f_red.len() != r {
+        return Err(JointError::ReducedStaticsSizes {
+            k_r: (k_red.nrows(), k_red.ncols()),
+            b_n_phi: (b_n_phi.nrows(), b_n_phi.ncols()),
+            load: f_red.len(),
+        }
+        .into());
+    }
+    Ok(r)
 }
