@@ -317,6 +317,14 @@ pub enum IntegrationError {
         len: usize,
         n: usize,
     },
+    /// An initial state whose block `what` (q, v or the slip memory) has `len` entries where
+    /// the problem has `need`, or a non-finite entry (`len == need`).
+    #[error("initial state: {what} has {len} entries (need {need}) or a non-finite one")]
+    InitialState {
+        what: &'static str,
+        len: usize,
+        need: usize,
+    },
     /// `function`: `y[index] = value` is not finite.
     #[error("{function}: y[{index}] = {value} is not finite")]
     StateNotFinite {
@@ -713,6 +721,13 @@ pub enum StudyError {
     /// A stability map option that must be finite and positive.
     #[error("{option} must be finite and positive, got {value}")]
     NotPositive { option: String, value: f64 },
+    /// `--modes mode` beyond the `available` modes of the model `model`.
+    #[error("--modes {mode}: the {model} model has only {available} modes")]
+    ModeBeyond {
+        mode: usize,
+        available: usize,
+        model: String,
+    },
     /// A stability map reference factor below 1.
     #[error("reference_factor must be ≥ 1, got {factor}")]
     ReferenceFactor { factor: f64 },

@@ -13,7 +13,8 @@ pub(crate) mod sundials;
 
 pub use crate::system::Scene;
 pub use driver::{
-    integrate, positive_flag, run, thread_cpu_s, Curves, Profile, Run, RunChoices, RunHook,
+    integrate, positive_flag, run, thread_cpu_s, Curves, InitialState, Profile, Run, RunChoices,
+    RunHook,
     RunStatus, Stall, Trajectory, TransientOptions,
 };
 pub use mechanical::{EnergySample, MechanicalOde, ProblemOptions};

@@ -1,8 +1,9 @@
-//! Output for people and tools: charts ([`chart`], [`heatmap`]), VTU fields for ParaView
+//! Output for people and tools: a backbone's table, CSV and charts ([`backbone`]), charts ([`chart`], [`heatmap`]), VTU fields for ParaView
 //! ([`vtu`], [`shapes`]), CSV curves ([`curves`]), the convergence study's and the stability
 //! map's outputs ([`convergence`], [`stability`]), the main job's report ([`main_job`]) and the
 //! reduced model as an FMI 2.0 co-simulation FMU ([`fmu`]).
 
+pub mod backbone;
 pub mod chart;
 pub mod convergence;
 pub mod curves;

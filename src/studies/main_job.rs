@@ -332,6 +332,7 @@ fn transient_options(
         record: false,
         profile: false,
         hook: None,
+        ..TransientOptions::default()
     }
 }
 

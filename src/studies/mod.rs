@@ -6,3 +6,4 @@ pub mod convergence;
 pub mod main_job;
 pub mod stability;
 pub mod sweep;
+pub mod backbone;

@@ -618,6 +618,7 @@ impl Pass<'_> {
                 record: false,
                 profile: false,
                 hook: None,
+                ..TransientOptions::default()
             };
             let o = system_run(self.model, prep, &spec);
             self.progress(&format!(
@@ -688,6 +689,7 @@ impl Pass<'_> {
                             record: false,
                             profile: false,
                             hook: None,
+                            ..TransientOptions::default()
                         };
                         let o = system_run(self.model, prep, &spec);
                         let cell = Cell {

@@ -10,7 +10,7 @@ use jointrom::studies::stability::{IterKind, ModelKind};
 use jointrom::Error;
 
 use crate::commands::{
-    basis, distributed, export, export_matrices, info, modes, run, shapes, stability, statics,
+    backbone, basis, distributed, export, export_matrices, info, modes, run, shapes, stability, statics,
     study as study_cmd, sweep, transient,
 };
 
@@ -52,6 +52,10 @@ pub enum Command {
     /// Runs a list of variants (load factor, μ, k_n, k_t) of one reduced model in parallel,
     /// sharing the basis → a table (or JSON with every run's curves).
     Sweep(sweep::SweepArgs),
+    /// Backbones: frequency and damping ratio of modes against amplitude, from free decays of
+    /// the reduced (or full FE) model about the equilibrium under a preload → table, JSON, CSV,
+    /// charts.
+    Backbone(backbone::BackboneArgs),
     /// Writes a reduced model as a versioned JSON file (schema `jointrom-rom` v1: M̃, K̃, BΦ,
     /// master rows, reduced loads, contact law, load ramp; see `jointrom::rom::file`).
     Export(export::ExportArgs),
@@ -81,6 +85,7 @@ impl Command {
             Command::Transient(a) => transient::run(a),
             Command::Shapes(a) => shapes::run(a),
             Command::Sweep(a) => sweep::run(a),
+            Command::Backbone(a) => backbone::run(a),
             Command::Export(a) => export::run(a),
             Command::ExportMatrices(a) => export_matrices::run(a),
             Command::Run(a) => run::run(a),

@@ -1,5 +1,5 @@
-//! The one driver loop: a [`SecondOrderSystem`] with its joint law integrated from rest by
-//! CVODE, sampled every `output_step`, optionally under a wall-clock deadline, with an observer
+//! The one driver loop: a [`SecondOrderSystem`] with its joint law integrated from rest (or
+//! from a given [`InitialState`], under a constant load: a free decay) by CVODE, sampled every `output_step`, optionally under a wall-clock deadline, with an observer
 //! of the coordinates at every output. Every caller — the `transient` command, the stability
 //! map, the main job's report, sweeps, POD training — runs through [`integrate`] and gets a typed
 //! [`RunStatus`].
@@ -23,7 +23,7 @@ mod options;
 mod outcome;
 mod stall;
 
-pub use options::{positive_flag, RunChoices, RunHook, TransientOptions};
+pub use options::{positive_flag, InitialState, RunChoices, RunHook, TransientOptions};
 pub use outcome::{
     Curves, EnergyCheck, Profile, Run, RunStatus, Trajectory, ENERGY_BALANCE_TOLERANCE,
 };
@@ -274,8 +274,14 @@ impl<S: SecondOrderSystem> Driver<S> {
             }
         }
         let mut ode = MechanicalOde::new(system, &scene.contact, &opts.problem)?;
+        if let Some(f) = opts.constant_load {
+            ode.set_load(0.0, f)?;
+        }
         let dim = ode.coords();
-        let y0 = ode.initial_state();
+        let y0 = match &opts.start {
+            Some(s) => ode.state_from(s)?,
+            None => ode.initial_state(),
+        };
         let mut curves = Curves::default();
         curves.push(&ode.sample(0.0, &y0));
         let trajectory = opts.record.then(|| {

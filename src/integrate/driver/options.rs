@@ -41,6 +41,29 @@ pub struct TransientOptions {
     /// `None` by default. It sees the run, it does not change it.
     #[serde(skip)]
     pub hook: Option<RunHook>,
+    /// Where the run starts (`None`: at rest, undeformed, no slip — the default). A free decay
+    /// starts from a displaced state ([`InitialState`]).
+    #[serde(skip)]
+    pub start: Option<InitialState>,
+    /// A master-node load `[Fx, Fy, Fz (N), Mx, My, Mz (N·mm)]` held constant from t = 0,
+    /// replacing the system's own (ramped) load (`None`: the system's load — the default). A
+    /// preload under which a structure rings down.
+    #[serde(skip)]
+    pub constant_load: Option<[f64; 6]>,
+}
+
+/// The state a run starts from instead of rest: coordinates, velocities and slip memory (the
+/// energy states W and D start at zero, so the energy balance is counted from this state:
+/// [`Curves::balance`](super::Curves::balance) subtracts its value at t = 0).
+#[derive(Clone, Debug, PartialEq)]
+pub struct InitialState {
+    /// Coordinates q (n: mm and rad of the full model, generalized coordinates of a reduced
+    /// one).
+    pub q: Vec<f64>,
+    /// Velocities q̇ (n), same units per s.
+    pub v: Vec<f64>,
+    /// Slip memory s (2 per pair: t1, t2; mm). Ignored with friction off.
+    pub slip: Vec<f64>,
 }
 
 /// A caller's hook into a running integration: `f(t)` → keep going.
@@ -74,6 +97,8 @@ impl Default for TransientOptions {
             record: false,
             profile: false,
             hook: None,
+            start: None,
+            constant_load: None,
         }
     }
 }

@@ -44,14 +44,17 @@ impl Curves {
         self.dissipated.push(s.dissipated);
     }
 
-    /// The energy balance `E_kin + E_strain + E_pair + D − W` at each output, N·mm.
+    /// The energy balance `E_kin + E_strain + E_pair + D − W` at each output minus its value at
+    /// the first output, N·mm: zero for an exact solution. A run from rest starts with every
+    /// energy zero; a run from an initial state ([`TransientOptions::start`](super::TransientOptions::start)) with its stored
+    /// energy, which the balance then conserves.
     pub fn balance(&self) -> Vec<f64> {
-        (0..self.t.len())
-            .map(|i| {
-                self.kinetic[i] + self.strain[i] + self.pair[i] + self.dissipated[i]
-                    - self.external_work[i]
-            })
-            .collect()
+        let at = |i: usize| {
+            self.kinetic[i] + self.strain[i] + self.pair[i] + self.dissipated[i]
+                - self.external_work[i]
+        };
+        let b0 = if self.t.is_empty() { 0.0 } else { at(0) };
+        (0..self.t.len()).map(|i| at(i) - b0).collect()
     }
 }
 

@@ -21,8 +21,9 @@
 //! memory to carry) and `D' = 0`. `W` and `D` are integrated by the integrator itself (so they
 //! are as accurate as the motion, independent of the output spacing); they do not feed back into
 //! the motion. The energy balance
-//! `E_kin + E_strain + E_pair − W + D = 0` (from rest, [`EnergySample::balance`]) then closes up
-//! to the integration error and the viscoplastic lag of [`crate::joint::law`].
+//! `E_kin + E_strain + E_pair − W + D = 0` (from rest, [`EnergySample::balance`]; from an initial
+//! state, its value there) then closes up to the integration error and the viscoplastic lag of
+//! [`crate::joint::law`].
 //!
 //! ## The Newton solve
 //!
@@ -485,6 +486,40 @@ impl<S: SecondOrderSystem> MechanicalOde<S> {
     /// The initial state: at rest, undeformed, no slip, no work.
     pub(crate) fn initial_state(&self) -> Vec<f64> {
         vec![0.0; self.dim()]
+    }
+
+    /// The state `y` of an [`InitialState`](crate::integrate::InitialState): its
+    /// coordinates, velocities and (with friction) slip memory, no work done yet.
+    ///
+    /// # Errors
+    /// [`IntegrationError::InitialState`] naming the block of the wrong length or with a
+    /// non-finite entry.
+    pub(crate) fn state_from(
+        &self,
+        start: &crate::integrate::InitialState,
+    ) -> Result<Vec<f64>, Error> {
+        let ns = self.ns();
+        let blocks: [(&'static str, &[f64], usize); 3] = [
+            ("q", &start.q, self.n),
+            ("v", &start.v, self.n),
+            ("the slip memory", if ns > 0 { &start.slip } else { &[] }, ns),
+        ];
+        let mut y = Vec::with_capacity(self.dim());
+        for (what, x, need) in blocks {
+            if x.len() != need || x.iter().any(|v| !v.is_finite()) {
+                return Err(IntegrationError::InitialState {
+                    what,
+                    len: x.len(),
+                    need,
+                }
+                .into());
+            }
+            y.extend_from_slice(x);
+        }
+        let s0 = 2 * self.n;
+        y[s0..].iter_mut().for_each(|s| *s /= self.s_scale);
+        y.extend_from_slice(&[0.0, 0.0]);
+        Ok(y)
     }
 
     /// Outputs at `(t, y)`: force norms, master displacement, energies.

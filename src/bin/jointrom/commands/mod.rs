@@ -1,6 +1,7 @@
 //! One module per subcommand: its flags (`…Args`) and `run`. Commands use the shared modules
 //! ([`crate::args`], [`crate::common`]) and the library, never each other or [`crate::cli`].
 
+pub mod backbone;
 pub mod basis;
 pub mod distributed;
 pub mod export;

@@ -1,0 +1,433 @@
+//! Backbones: the amplitude-dependent frequency and damping ratio of a jointed structure's
+//! modes, from free decays (ring-downs) of the reduced or the full FE model.
+//!
+//! For each mode k and amplitude A the model starts from its preloaded equilibrium displaced by
+//! A times the mode's shape, at rest, with the equilibrium's slip memory ([`linear`]), and rings
+//! down under the constant preload with friction on — no other force. The modal coordinate
+//! `a(t) = ψᵀM(q − q_eq) / ψᵀMψ` (mm; an M-orthogonal projection, which filters the other
+//! linearised modes out of the motion), the master's motion along the mode's master direction
+//! and the dissipated energy are sampled 64 times per linearised period, and each cycle's
+//! frequency, amplitude and equivalent viscous damping ratio are extracted from them
+//! ([`extract`]).
+//!
+//! ## Tolerances follow the amplitude
+//!
+//! With no preload, zero initial gaps, penalty contact and a Coulomb limit μ|p_n|, every force
+//! scales with the displacement and so does the viscoplastic slip law; the free decay of a
+//! scaled shape is the same motion scaled and the backbone is flat. For the computed decay to
+//! keep that property the integrator's absolute tolerances must scale too: a ring-down of
+//! amplitude A runs with `atol = rel_atol · A` (mm), the energy states' unit scaled by A/(1 mm)
+//! (their tolerance ∝ A²) and the active-set refresh margin scaled by A/(1 mm). Under a preload
+//! the stick radius `μ|p_n|/k_t` is fixed and small amplitudes stick: the tolerance then only
+//! resolves the motion better than it needs.
+//!
+//! ## Where a backbone stops meaning something
+//!
+//! Each decay is checked: its energy balance ([`crate::integrate::Curves::energy_check`]: a miss
+//! names `--amplitudes`), whether the joint's contact force vanished at some output (the joint
+//! opened fully: the equilibrium's contact state, and with it mode k, no longer describes the
+//! motion), and whether the decay gave a cycle at all. Modes that couple (close linearised
+//! frequencies, or a slipping joint transferring energy into another mode) show as a modal
+//! coordinate that stops decaying like one mode: the extracted frequency then drifts from cycle
+//! to cycle. Both are reported, not hidden.
+
+pub mod extract;
+pub mod linear;
+
+use std::time::Instant;
+
+use serde::Serialize;
+
+use crate::error::{Error, FlagError, StudyError};
+use crate::integrate::{integrate, InitialState, RunStatus, TransientOptions};
+use crate::model::Model;
+use crate::rom::{build_rom, ModelSpec};
+use crate::system::{FullSystem, Scene, SecondOrderSystem};
+
+pub use extract::{cycles, Cycle, Samples};
+pub use linear::{
+    full_equilibrium, full_modes, reduced_equilibrium, reduced_modes, Equilibrium, LinearMode,
+};
+
+/// Outputs per linearised period of a ring-down.
+pub const SAMPLES_PER_PERIOD: usize = 64;
+
+/// The amplitude the tolerances are stated at, mm (`rel_atol` = atol at 1 mm).
+const REFERENCE_AMPLITUDE: f64 = 1.0;
+
+/// What a backbone computes.
+#[derive(Clone, Debug)]
+pub struct BackboneOptions {
+    /// Mode numbers (1 = lowest).
+    pub modes: Vec<usize>,
+    /// Amplitudes A of the initial modal displacement, mm of the largest nodal translation
+    /// (finite, > 0).
+    pub amplitudes: Vec<f64>,
+    /// Preload factor S on the case's master load (0: none).
+    pub preload: f64,
+    /// Cycles of each ring-down (≥ 1; the run lasts (cycles + ½) linearised periods plus
+    /// half as much again for softening).
+    pub cycles: usize,
+    /// The run's options: integrator, friction, τ, wall-clock budget (end time, output step,
+    /// start and load are set per ring-down; `ode.atol` is taken relative to 1 mm of
+    /// amplitude, see the module docs).
+    pub transient: TransientOptions,
+}
+
+impl BackboneOptions {
+    /// The checked options.
+    ///
+    /// # Errors
+    /// No mode or a mode 0, no amplitude or one not finite and positive, a non-finite preload,
+    /// no cycle — each naming its flag.
+    pub fn check(&self) -> Result<(), Error> {
+        if self.modes.is_empty() || self.modes.contains(&0) {
+            return Err(FlagError::Value {
+                flag: "modes",
+                value: format!("{:?}", self.modes),
+                need: "give mode numbers from 1 (the lowest), e.g. 1,2,3",
+            }
+            .into());
+        }
+        if self.amplitudes.is_empty() {
+            return Err(FlagError::Value {
+                flag: "amplitudes",
+                value: "(none)".into(),
+                need: "give one or more amplitudes in mm, or --range A_MIN A_MAX N",
+            }
+            .into());
+        }
+        for &a in &self.amplitudes {
+            crate::integrate::positive_flag("amplitudes", a)?;
+        }
+        if !self.preload.is_finite() {
+            return Err(FlagError::NotFinite {
+                flag: "preload",
+                value: self.preload,
+            }
+            .into());
+        }
+        if self.cycles == 0 {
+            return Err(FlagError::AtLeast {
+                flag: "cycles",
+                min: 1,
+            }
+            .into());
+        }
+        Ok(())
+    }
+}
+
+/// `n` amplitudes spaced logarithmically from `lo` to `hi` (mm).
+///
+/// # Errors
+/// Bounds not finite and positive, `hi < lo`, `n` = 0 — naming `--range`.
+pub fn log_range(lo: f64, hi: f64, n: usize) -> Result<Vec<f64>, Error> {
+    crate::integrate::positive_flag("range", lo)?;
+    crate::integrate::positive_flag("range", hi)?;
+    if hi < lo || n == 0 || (n == 1 && hi != lo) {
+        return Err(FlagError::Value {
+            flag: "range",
+            value: format!("{lo} {hi} {n}"),
+            need: "A_MIN ≤ A_MAX (mm) and N ≥ 1 points (N = 1 needs A_MIN = A_MAX)",
+        }
+        .into());
+    }
+    Ok((0..n)
+        .map(|i| {
+            if n == 1 {
+                lo
+            } else {
+                lo * (hi / lo).powf(i as f64 / (n - 1) as f64)
+            }
+        })
+        .collect())
+}
+
+/// One ring-down: its amplitude, how it ran and its cycles.
+#[derive(Clone, Debug, Serialize)]
+pub struct RingDown {
+    /// The initial amplitude A, mm.
+    pub amplitude: f64,
+    /// How the run ended.
+    pub status: RunStatus,
+    /// Simulated span, s.
+    pub end_time: f64,
+    /// Integrator steps.
+    pub steps: u64,
+    /// CPU time of the integration, s.
+    pub cpu_s: f64,
+    /// Wall time of the integration, s.
+    pub wall_s: f64,
+    /// Energy-balance residual relative to the run's energy scale, and whether it passed.
+    pub energy_residual_ratio: f64,
+    pub energy_ok: bool,
+    /// The joint's contact force vanished at some output (the joint opened fully).
+    pub joint_opened: bool,
+    /// Energy dissipated over the run, N·mm.
+    pub dissipated: f64,
+    /// The extracted cycles.
+    pub cycles: Vec<Cycle>,
+}
+
+impl RingDown {
+    /// The first cycle (the one starting at the initial amplitude), if any.
+    pub fn first(&self) -> Option<&Cycle> {
+        self.cycles.first()
+    }
+}
+
+/// The backbone of one mode.
+#[derive(Clone, Debug, Serialize)]
+pub struct ModeBackbone {
+    /// Mode number k.
+    pub mode: usize,
+    /// The linearised model's frequency, Hz.
+    pub linear_frequency_hz: f64,
+    /// The master's displacement in the (1 mm) shape `[ux, uy, uz (mm), rx, ry, rz (rad)]`.
+    pub shape_master: [f64; 6],
+    /// `ψᵀMψ` of the 1 mm shape, t.
+    pub modal_mass: f64,
+    /// One ring-down per amplitude, in the order given.
+    pub ring_downs: Vec<RingDown>,
+}
+
+/// A computed backbone.
+#[derive(Clone, Debug, Serialize)]
+pub struct Backbone {
+    /// The model's name (`full`, a basis kind, `adaptive`).
+    pub model: String,
+    /// Its size: DOF of the full model, r of a reduced one.
+    pub model_size: usize,
+    /// The preload factor S and its master load `[Fx, Fy, Fz (N), Mx, My, Mz (N·mm)]`.
+    pub preload: f64,
+    pub preload_load: [f64; 6],
+    /// Closed pairs at the equilibrium (of all pairs).
+    pub closed_pairs: usize,
+    pub pairs: usize,
+    /// The master's equilibrium displacement `[ux, uy, uz (mm), rx, ry, rz (rad)]`.
+    pub equilibrium_master: [f64; 6],
+    /// Friction on.
+    pub friction: bool,
+    /// Wall time of building the model, the equilibrium and the modes, s.
+    pub setup_s: f64,
+    /// CPU and wall time of all ring-downs, s.
+    pub ring_down_cpu_s: f64,
+    pub ring_down_wall_s: f64,
+    /// The modes.
+    pub modes: Vec<ModeBackbone>,
+    /// What a reader must know (energy checks missed, joints opened, decays without cycles).
+    pub warnings: Vec<String>,
+}
+
+/// The transient options of one ring-down of `mode` at amplitude `a` from `eq`.
+fn ring_down_options(
+    base: &TransientOptions,
+    eq: &Equilibrium,
+    mode: &LinearMode,
+    a: f64,
+    cycles: usize,
+) -> TransientOptions {
+    let period = 1.0 / mode.frequency_hz;
+    let rel = a / REFERENCE_AMPLITUDE;
+    let mut o = base.clone();
+    o.ode.atol = base.ode.atol * rel;
+    o.problem.energy_scale = base.problem.energy_scale * rel;
+    o.problem.refresh = base.problem.refresh.map(|m| m * rel);
+    o.end_time = Some(1.5 * (cycles as f64 + 0.5) * period);
+    o.output_step = period / SAMPLES_PER_PERIOD as f64;
+    o.start = Some(InitialState {
+        q: eq.q.iter().zip(&mode.shape).map(|(q, s)| q + a * s).collect(),
+        v: vec![0.0; eq.q.len()],
+        slip: eq.slip.clone(),
+    });
+    o.constant_load = Some(eq.load);
+    o
+}
+
+/// One ring-down of `sys` (module docs).
+pub fn ring_down<S: SecondOrderSystem>(
+    sys: S,
+    scene: &Scene,
+    eq: &Equilibrium,
+    mode: &LinearMode,
+    amplitude: f64,
+    opts: &BackboneOptions,
+) -> RingDown {
+    let o = ring_down_options(&opts.transient, eq, mode, amplitude, opts.cycles);
+    let master = master_functional(&sys, &mode.master);
+    let mut samples = Samples::default();
+    let run = integrate(sys, scene, &o, |t, q| {
+        let dq = |w: &[f64]| -> f64 { q.iter().zip(&eq.q).zip(w).map(|((q, e), w)| (q - e) * w).sum() };
+        samples.t.push(t);
+        samples.modal.push(dq(&mode.mass_shape) / mode.modal_mass);
+        if let Some(g) = &master {
+            samples.master.push(dq(g));
+        }
+    });
+    let n = run.curves.dissipated.len().min(samples.t.len());
+    samples.dissipated = run.curves.dissipated[..n].to_vec();
+    samples.t.truncate(n);
+    samples.modal.truncate(n);
+    if master.is_some() {
+        samples.master.truncate(n);
+    }
+    let check = run.curves.energy_check(o.energy_resolution());
+    let preload = eq.load.iter().any(|&v| v != 0.0);
+    let joint_opened = preload && run.curves.contact_force_norm.iter().any(|&f| f == 0.0);
+    RingDown {
+        amplitude,
+        status: run.status.clone(),
+        end_time: run.t_reached,
+        steps: run.stats.steps,
+        cpu_s: run.cpu_s,
+        wall_s: run.wall_s,
+        energy_residual_ratio: check.residual_ratio,
+        energy_ok: check.ok,
+        joint_opened,
+        dissipated: run.curves.dissipated.last().copied().unwrap_or(0.0),
+        cycles: cycles(&samples, 1.0 / mode.frequency_hz, mode.modal_mass),
+    }
+}
+
+/// The linear functional `g` with `gᵀ q` = the master's translation along the unit direction of
+/// the shape's master translation `shape_master[..3]`, or `None` when the shape does not move
+/// the master (a translation below 1e-6 mm per mm of amplitude). The master displacement is
+/// linear in q, so g is probed with unit vectors (O(1) each for the full model, O(r) for a
+/// reduced one).
+fn master_functional<S: SecondOrderSystem>(sys: &S, shape_master: &[f64; 6]) -> Option<Vec<f64>> {
+    let m = shape_master;
+    let norm = (m[0] * m[0] + m[1] * m[1] + m[2] * m[2]).sqrt();
+    if norm <= 1e-6 {
+        return None;
+    }
+    let dir = [m[0] / norm, m[1] / norm, m[2] / norm];
+    let n = sys.dim();
+    let mut e = vec![0.0; n];
+    let mut g = vec![0.0; n];
+    for j in 0..n {
+        e[j] = 1.0;
+        let d = sys.master_displacement(&e);
+        g[j] = dir[0] * d[0] + dir[1] * d[1] + dir[2] * d[2];
+        e[j] = 0.0;
+    }
+    Some(g)
+}
+
+/// The backbone of the model `spec` names on `model` (module docs): the full FE model or a
+/// reduced one (a basis or `--tolerance`; its rounds run the case's own transient with
+/// `opts.transient`).
+///
+/// # Errors
+/// Bad options (naming their flags), a mode beyond the model's, a model that cannot be built,
+/// an equilibrium or eigensolve that fails. A ring-down that fails or misses its energy check
+/// is a warning in the result, not an error.
+pub fn compute(model: &Model, spec: &ModelSpec, opts: &BackboneOptions) -> Result<Backbone, Error> {
+    opts.check()?;
+    let t0 = Instant::now();
+    let count = opts.modes.iter().copied().max().unwrap_or(1);
+    let friction = opts.transient.problem.friction;
+    let scene = Scene::of(model);
+    let (size, eq, modes, rom) = match spec {
+        ModelSpec::Full => {
+            check_modes(count, model.dofs(), "full")?;
+            let eq = full_equilibrium(model, opts.preload)?;
+            let modes = full_modes(model, &eq, count, friction)?;
+            (model.dofs(), eq, modes, None)
+        }
+        _ => {
+            let built = build_rom(model, spec, &opts.transient, "backbone")?;
+            let rom = built.rom;
+            check_modes(count, rom.dim(), &spec.name())?;
+            let eq = reduced_equilibrium(model, &rom, opts.preload)?;
+            let modes = reduced_modes(model, &rom, &eq, count, friction)?;
+            (rom.dim(), eq, modes, Some(rom))
+        }
+    };
+    let setup_s = t0.elapsed().as_secs_f64();
+    let mut out = Backbone {
+        model: spec.name(),
+        model_size: size,
+        preload: opts.preload,
+        preload_load: eq.load,
+        closed_pairs: eq.closed.iter().filter(|&&c| c).count(),
+        pairs: eq.closed.len(),
+        equilibrium_master: eq.master,
+        friction,
+        setup_s,
+        ring_down_cpu_s: 0.0,
+        ring_down_wall_s: 0.0,
+        modes: Vec::new(),
+        warnings: Vec::new(),
+    };
+    for &k in &opts.modes {
+        let mode = &modes[k - 1];
+        let mut ring_downs = Vec::with_capacity(opts.amplitudes.len());
+        for &a in &opts.amplitudes {
+            let r = match &rom {
+                Some(rom) => ring_down(rom.clone(), &scene, &eq, mode, a, opts),
+                None => ring_down(FullSystem::new(model)?, &scene, &eq, mode, a, opts),
+            };
+            out.ring_down_cpu_s += r.cpu_s;
+            out.ring_down_wall_s += r.wall_s;
+            out.warnings.extend(warnings_of(k, &r, opts.cycles));
+            ring_downs.push(r);
+        }
+        out.modes.push(ModeBackbone {
+            mode: k,
+            linear_frequency_hz: mode.frequency_hz,
+            shape_master: mode.master,
+            modal_mass: mode.modal_mass,
+            ring_downs,
+        });
+    }
+    Ok(out)
+}
+
+/// An error unless `count` modes exist among `available`.
+fn check_modes(count: usize, available: usize, model: &str) -> Result<(), Error> {
+    if count > available {
+        return Err(StudyError::ModeBeyond {
+            mode: count,
+            available,
+            model: model.to_string(),
+        }
+        .into());
+    }
+    Ok(())
+}
+
+/// What a reader must know about one ring-down of mode `k` (module docs, *Where a backbone
+/// stops meaning something*).
+fn warnings_of(k: usize, r: &RingDown, cycles: usize) -> Vec<String> {
+    let a = r.amplitude;
+    let mut w = Vec::new();
+    if !r.status.finished() {
+        w.push(format!(
+            "mode {k}, --amplitudes {a}: the ring-down stopped at t = {:.4e} s ({})",
+            r.end_time, r.status
+        ));
+    }
+    if !r.energy_ok {
+        w.push(format!(
+            "mode {k}, --amplitudes {a}: the energy balance misses by {:.2} % of the run's \
+             energy (> {} %): its frequency and damping cannot be trusted; use a smaller amplitude",
+            100.0 * r.energy_residual_ratio,
+            100.0 * crate::integrate::driver::ENERGY_BALANCE_TOLERANCE
+        ));
+    }
+    if r.joint_opened {
+        w.push(format!(
+            "mode {k}, --amplitudes {a}: the joint opened fully during the decay: beyond the \
+             amplitudes where mode {k} of the preloaded joint describes the motion"
+        ));
+    }
+    if r.cycles.is_empty() {
+        w.push(format!(
+            "mode {k}, --amplitudes {a}: the decay is too short to extract a frequency (no full \
+             cycle in {:.4e} s; --cycles {cycles})",
+            r.end_time
+        ));
+    }
+    w
+}
