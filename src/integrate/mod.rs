@@ -14,8 +14,7 @@ pub(crate) mod sundials;
 pub use crate::system::Scene;
 pub use driver::{
     integrate, positive_flag, run, thread_cpu_s, Curves, InitialState, Profile, Run, RunChoices,
-    RunHook,
-    RunStatus, Stall, Trajectory, TransientOptions,
+    RunHook, RunStatus, Stall, Trajectory, TransientOptions,
 };
 pub use mechanical::{EnergySample, MechanicalOde, ProblemOptions};
 pub use stepper::Stepper;

@@ -21,7 +21,10 @@ pub fn csv(b: &Backbone) -> String {
     for m in &b.modes {
         for r in &m.ring_downs {
             for c in &r.cycles {
-                let master = c.master_amplitude.map(|v| format!("{v:e}")).unwrap_or_default();
+                let master = c
+                    .master_amplitude
+                    .map(|v| format!("{v:e}"))
+                    .unwrap_or_default();
                 let _ = writeln!(
                     s,
                     "{},{:e},{},{:e},{:e},{:e},{},{:e},{:e},{:e},{:e}",
@@ -44,7 +47,10 @@ pub fn csv(b: &Backbone) -> String {
 }
 
 /// Every cycle of mode `m` as (modal amplitude, value).
-fn points(b: &Backbone, value: impl Fn(f64, &crate::studies::backbone::Cycle) -> f64) -> Vec<Series> {
+fn points(
+    b: &Backbone,
+    value: impl Fn(f64, &crate::studies::backbone::Cycle) -> f64,
+) -> Vec<Series> {
     b.modes
         .iter()
         .map(|m| {

@@ -2,8 +2,8 @@
 //! stability map ([`stability`]), parameter sweeps on one reduced model ([`sweep`]) and the main
 //! job ([`main_job`]). One reduced model and its run live in [`crate::rom`].
 
+pub mod backbone;
 pub mod convergence;
 pub mod main_job;
 pub mod stability;
 pub mod sweep;
-pub mod backbone;

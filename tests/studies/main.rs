@@ -1,9 +1,10 @@
-//! Studies (`jointrom::studies`): the static convergence study, the stability map, parameter
-//! sweeps, the POD-snapshot ROM.
+//! Studies (`jointrom::studies`): backbones, the static convergence study, the stability map,
+//! parameter sweeps, the POD-snapshot ROM.
 
 #[path = "../common/mod.rs"]
 mod common;
 
+mod backbone;
 mod pod_snapshots;
 mod stability;
 mod study;

@@ -10,8 +10,8 @@ use jointrom::studies::stability::{IterKind, ModelKind};
 use jointrom::Error;
 
 use crate::commands::{
-    backbone, basis, distributed, export, export_matrices, info, modes, run, shapes, stability, statics,
-    study as study_cmd, sweep, transient,
+    backbone, basis, distributed, export, export_matrices, info, modes, run, shapes, stability,
+    statics, study as study_cmd, sweep, transient,
 };
 
 #[derive(Parser)]

@@ -502,7 +502,11 @@ impl<S: SecondOrderSystem> MechanicalOde<S> {
         let blocks: [(&'static str, &[f64], usize); 3] = [
             ("q", &start.q, self.n),
             ("v", &start.v, self.n),
-            ("the slip memory", if ns > 0 { &start.slip } else { &[] }, ns),
+            (
+                "the slip memory",
+                if ns > 0 { &start.slip } else { &[] },
+                ns,
+            ),
         ];
         let mut y = Vec::with_capacity(self.dim());
         for (what, x, need) in blocks {

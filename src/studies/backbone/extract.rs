@@ -206,7 +206,9 @@ mod tests {
             let m = x.master_amplitude.unwrap();
             assert!((m / x.modal_amplitude - 0.5).abs() < 1e-12);
         }
-        assert!((c[0].modal_amplitude - (-zeta * 2.0 * std::f64::consts::PI * 0.5).exp()).abs() < 0.02);
+        assert!(
+            (c[0].modal_amplitude - (-zeta * 2.0 * std::f64::consts::PI * 0.5).exp()).abs() < 0.02
+        );
     }
 
     #[test]

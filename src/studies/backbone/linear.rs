@@ -228,13 +228,14 @@ pub fn reduced_modes(
     count: usize,
     friction: bool,
 ) -> Result<Vec<LinearMode>, Error> {
-    let phi = rom.phi.as_ref().ok_or_else(|| {
-        crate::error::RomError::Unsupported {
+    let phi = rom
+        .phi
+        .as_ref()
+        .ok_or_else(|| crate::error::RomError::Unsupported {
             command: "backbone".into(),
             model: "a reduced model without its basis".into(),
             takes: "a reduced basis or --tolerance (the mode shape is normalised on Φψ)",
-        }
-    })?;
+        })?;
     let r = rom.dim();
     let mut k = rom.k().clone();
     let b = rom.b_phi();

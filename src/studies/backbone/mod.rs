@@ -65,8 +65,8 @@ pub struct BackboneOptions {
     pub amplitudes: Vec<f64>,
     /// Preload factor S on the case's master load (0: none).
     pub preload: f64,
-    /// Cycles of each ring-down (≥ 1; the run lasts (cycles + ½) linearised periods plus
-    /// half as much again for softening).
+    /// Cycles of each ring-down (≥ 1): the decay runs in chunks of 1.5 × (cycles + ½)
+    /// linearised periods until it has them ([`MAX_CHUNKS`] at most).
     pub cycles: usize,
     /// The run's options: integrator, friction, τ, wall-clock budget (end time, output step,
     /// start and load are set per ring-down; `ode.atol` is taken relative to 1 mm of
@@ -237,7 +237,12 @@ fn ring_down_options(
     o.end_time = Some(1.5 * (cycles as f64 + 0.5) * period);
     o.output_step = period / SAMPLES_PER_PERIOD as f64;
     o.start = Some(InitialState {
-        q: eq.q.iter().zip(&mode.shape).map(|(q, s)| q + a * s).collect(),
+        q: eq
+            .q
+            .iter()
+            .zip(&mode.shape)
+            .map(|(q, s)| q + a * s)
+            .collect(),
         v: vec![0.0; eq.q.len()],
         slip: eq.slip.clone(),
     });
@@ -245,49 +250,141 @@ fn ring_down_options(
     o
 }
 
-/// One ring-down of `sys` (module docs).
+/// Chunks a ring-down may take before it gives up on finding its cycles: the decay runs in
+/// chunks of 1.5 × (cycles + ½) linearised periods, each continuing from the last one's state,
+/// until `cycles` cycles are found — a softened mode takes longer than its linearisation says.
+pub const MAX_CHUNKS: usize = 8;
+
+/// One ring-down (module docs) of the systems `make` builds (one per chunk).
 pub fn ring_down<S: SecondOrderSystem>(
-    sys: S,
+    mut make: impl FnMut() -> Result<S, Error>,
     scene: &Scene,
     eq: &Equilibrium,
     mode: &LinearMode,
     amplitude: f64,
     opts: &BackboneOptions,
-) -> RingDown {
-    let o = ring_down_options(&opts.transient, eq, mode, amplitude, opts.cycles);
-    let master = master_functional(&sys, &mode.master);
+) -> Result<RingDown, Error> {
+    let mut o = ring_down_options(&opts.transient, eq, mode, amplitude, opts.cycles);
+    let chunk = o.end_time.unwrap_or(scene.end_time);
+    let first = make()?;
+    if let Some(start) = &mut o.start {
+        start.slip = admissible_slip(&first, &scene.contact, &start.q, &eq.slip);
+    }
+    let master = master_functional(&first, &mode.master);
+    let n = first.dim();
+    let mut sys = Some(first);
     let mut samples = Samples::default();
-    let run = integrate(sys, scene, &o, |t, q| {
-        let dq = |w: &[f64]| -> f64 { q.iter().zip(&eq.q).zip(w).map(|((q, e), w)| (q - e) * w).sum() };
-        samples.t.push(t);
-        samples.modal.push(dq(&mode.mass_shape) / mode.modal_mass);
-        if let Some(g) = &master {
-            samples.master.push(dq(g));
-        }
-    });
-    let n = run.curves.dissipated.len().min(samples.t.len());
-    samples.dissipated = run.curves.dissipated[..n].to_vec();
-    samples.t.truncate(n);
-    samples.modal.truncate(n);
-    if master.is_some() {
-        samples.master.truncate(n);
-    }
-    let check = run.curves.energy_check(o.energy_resolution());
     let preload = eq.load.iter().any(|&v| v != 0.0);
-    let joint_opened = preload && run.curves.contact_force_norm.iter().any(|&f| f == 0.0);
-    RingDown {
+    let mut out = RingDown {
         amplitude,
-        status: run.status.clone(),
-        end_time: run.t_reached,
-        steps: run.stats.steps,
-        cpu_s: run.cpu_s,
-        wall_s: run.wall_s,
-        energy_residual_ratio: check.residual_ratio,
-        energy_ok: check.ok,
-        joint_opened,
-        dissipated: run.curves.dissipated.last().copied().unwrap_or(0.0),
-        cycles: cycles(&samples, 1.0 / mode.frequency_hz, mode.modal_mass),
+        status: RunStatus::Finished,
+        end_time: 0.0,
+        steps: 0,
+        cpu_s: 0.0,
+        wall_s: 0.0,
+        energy_residual_ratio: 0.0,
+        energy_ok: true,
+        joint_opened: false,
+        dissipated: 0.0,
+        cycles: Vec::new(),
+    };
+    let want = 2 * opts.cycles - 1;
+    for _ in 0..MAX_CHUNKS {
+        let system = match sys.take() {
+            Some(s) => s,
+            None => make()?,
+        };
+        let (t0, d0) = (out.end_time, out.dissipated);
+        let skip = usize::from(!samples.t.is_empty());
+        let mut k = 0usize;
+        let run = integrate(system, scene, &o, |t, q| {
+            k += 1;
+            if k <= skip {
+                return;
+            }
+            let dq = |w: &[f64]| -> f64 {
+                q.iter()
+                    .zip(&eq.q)
+                    .zip(w)
+                    .map(|((q, e), w)| (q - e) * w)
+                    .sum()
+            };
+            samples.t.push(t0 + t);
+            samples.modal.push(dq(&mode.mass_shape) / mode.modal_mass);
+            if let Some(g) = &master {
+                samples.master.push(dq(g));
+            }
+        });
+        samples
+            .dissipated
+            .extend(run.curves.dissipated.iter().skip(skip).map(|d| d0 + d));
+        let check = run.curves.energy_check(o.energy_resolution());
+        out.status = run.status.clone();
+        out.end_time = t0 + run.t_reached;
+        out.steps += run.stats.steps;
+        out.cpu_s += run.cpu_s;
+        out.wall_s += run.wall_s;
+        out.energy_residual_ratio = out.energy_residual_ratio.max(check.residual_ratio);
+        out.energy_ok &= check.ok;
+        out.joint_opened |= preload && run.curves.contact_force_norm.iter().any(|&f| f == 0.0);
+        out.dissipated = d0 + run.curves.dissipated.last().copied().unwrap_or(0.0);
+        let m = samples.dissipated.len().min(samples.t.len());
+        samples.t.truncate(m);
+        samples.modal.truncate(m);
+        samples.dissipated.truncate(m);
+        if master.is_some() {
+            samples.master.truncate(m);
+        }
+        out.cycles = cycles(&samples, 1.0 / mode.frequency_hz, mode.modal_mass);
+        if !run.status.finished() || out.cycles.len() >= want {
+            break;
+        }
+        // Continue from where the chunk ended: its state, its slip memory (in mm).
+        let y = &run.final_state;
+        let slip_scale = o.problem.slip_scale;
+        let ns = if o.problem.friction { eq.slip.len() } else { 0 };
+        o.start = Some(InitialState {
+            q: y[..n].to_vec(),
+            v: y[n..2 * n].to_vec(),
+            slip: y[2 * n..2 * n + ns]
+                .iter()
+                .map(|s| s * slip_scale)
+                .collect(),
+        });
+        o.end_time = Some(chunk);
     }
+    out.cycles.truncate(want);
+    Ok(out)
+}
+
+/// The slip memory of a ring-down's initial state: the equilibrium's `slip`, except where the
+/// displaced state `q` would stretch a pair's stick spring beyond its cone (`|u_t − s| > c =
+/// μ|p_n|/k_t`; an open pair has c = 0) — there the memory is returned to the cone,
+/// `s = u_t − c e/|e|`, the state a monotonic loading from the equilibrium to `q` leaves
+/// (Masing's virgin curve). Without this the law would dissipate the excess stretch within τ
+/// at the start, energy the structure never stored.
+fn admissible_slip<S: SecondOrderSystem>(
+    sys: &S,
+    contact: &crate::case::ContactSpec,
+    q: &[f64],
+    slip: &[f64],
+) -> Vec<f64> {
+    let w = sys.pairs();
+    let mut u = vec![0.0; 3 * w];
+    sys.joint_apply_into(q, &mut u);
+    let mut out = slip.to_vec();
+    for k in 0..w.min(slip.len() / 2) {
+        let g = u[3 * k];
+        let c = contact.friction_coefficient * contact.normal_stiffness * (-g).max(0.0)
+            / contact.stick_stiffness;
+        let e = [u[3 * k + 1] - slip[2 * k], u[3 * k + 2] - slip[2 * k + 1]];
+        let norm = e[0].hypot(e[1]);
+        if norm > c {
+            out[2 * k] = u[3 * k + 1] - c * e[0] / norm;
+            out[2 * k + 1] = u[3 * k + 2] - c * e[1] / norm;
+        }
+    }
+    out
 }
 
 /// The linear functional `g` with `gᵀ q` = the master's translation along the unit direction of
@@ -365,8 +462,8 @@ pub fn compute(model: &Model, spec: &ModelSpec, opts: &BackboneOptions) -> Resul
         let mut ring_downs = Vec::with_capacity(opts.amplitudes.len());
         for &a in &opts.amplitudes {
             let r = match &rom {
-                Some(rom) => ring_down(rom.clone(), &scene, &eq, mode, a, opts),
-                None => ring_down(FullSystem::new(model)?, &scene, &eq, mode, a, opts),
+                Some(rom) => ring_down(|| Ok(rom.clone()), &scene, &eq, mode, a, opts)?,
+                None => ring_down(|| FullSystem::new(model), &scene, &eq, mode, a, opts)?,
             };
             out.ring_down_cpu_s += r.cpu_s;
             out.ring_down_wall_s += r.wall_s;

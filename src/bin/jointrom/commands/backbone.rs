@@ -28,7 +28,12 @@ pub struct BackboneArgs {
     #[arg(long, value_delimiter = ',', default_value = "1")]
     modes: Vec<usize>,
     /// Initial amplitudes, mm of the mode shape's largest nodal translation, e.g. 0.001,0.01,0.1.
-    #[arg(long, value_delimiter = ',', allow_negative_numbers = true, conflicts_with = "range")]
+    #[arg(
+        long,
+        value_delimiter = ',',
+        allow_negative_numbers = true,
+        conflicts_with = "range"
+    )]
     amplitudes: Vec<f64>,
     /// N amplitudes spaced logarithmically from A_MIN to A_MAX (mm).
     #[arg(long, num_args = 3, value_names = ["A_MIN", "A_MAX", "N"], allow_negative_numbers = true)]
@@ -82,7 +87,9 @@ fn amplitudes(a: &BackboneArgs) -> Result<Vec<f64>, Error> {
 
 pub fn run(a: BackboneArgs) -> Result<(), Error> {
     let transient = RunChoices {
-        iteration: jointrom::integrate::TransientOptions::default().ode.iteration,
+        iteration: jointrom::integrate::TransientOptions::default()
+            .ode
+            .iteration,
         friction: a.friction.is_on(),
         events: false,
         rtol: a.rtol,
@@ -121,7 +128,10 @@ pub fn run(a: BackboneArgs) -> Result<(), Error> {
     let doc = json!({"case": model.name, "backbone": b});
     if let Some(dir) = &a.out {
         create_dir(dir)?;
-        write_file(&dir.join("backbone.json"), serde_json::to_string_pretty(&doc).unwrap_or_default())?;
+        write_file(
+            &dir.join("backbone.json"),
+            serde_json::to_string_pretty(&doc).unwrap_or_default(),
+        )?;
         write_file(&dir.join("backbone.csv"), report::csv(&b))?;
         write_file(&dir.join("backbone.md"), report::markdown(&b))?;
         report::charts(&b, dir, "backbone")?;
