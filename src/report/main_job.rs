@@ -79,6 +79,12 @@ pub fn write_report(
     for f in crate::report::shapes::write_shapes(model, &sh, &shape_dir)? {
         report.files.push(relative(dir, &f));
     }
+    // The backbone's charts.
+    if let Some(b) = &report.backbone {
+        for f in crate::report::backbone::charts(b, dir, "backbone")? {
+            report.files.push(relative(dir, &f));
+        }
+    }
     // 5. The stored stability map.
     let stab = opts.stability_dir.join(&case);
     let mut stability_files = Vec::new();
@@ -466,9 +472,41 @@ fn markdown(rep: &Report, stab: &Path, stability: bool) -> String {
          the Craig–Bampton vectors, the first TVD and joint modes: `shapes/*.vtu`.\n\n\
          ![joint modes](shapes/joint_modes.png)\n"
     );
+    backbone_section(&mut s, rep);
     study_section(&mut s, rep);
     stability_section(&mut s, rep, stab, stability);
     s
+}
+
+/// The short backbone of mode 1 (`studies::main_job::report_backbone`).
+fn backbone_section(s: &mut String, rep: &Report) {
+    use std::fmt::Write;
+    let _ = writeln!(
+        s,
+        "## Backbone of mode 1 (reduced model, under the static load)
+"
+    );
+    match (&rep.backbone, &rep.backbone_error) {
+        (Some(b), _) => {
+            let _ = writeln!(
+                s,
+                "Free decays of the a-priori TVD model from its equilibrium under the case's \
+                 load, displaced by mode 1 of the model linearised with its closed pairs stuck; \
+                 frequency and equivalent viscous damping ratio per cycle (`jointrom backbone`, \
+                 docs/guide/backbone.md).\n"
+            );
+            s.push_str(&crate::report::backbone::markdown(b));
+            let _ = writeln!(
+                s,
+                "\n![backbone frequency](backbone_frequency.png)\n\n\
+                 ![backbone damping](backbone_damping.png)\n"
+            );
+        }
+        (None, Some(e)) => {
+            let _ = writeln!(s, "Not computed: {e}\n");
+        }
+        (None, None) => {}
+    }
 }
 
 /// The headline reduced model: the tolerance-chosen one, its true error against its estimate

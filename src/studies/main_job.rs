@@ -191,6 +191,12 @@ pub struct Report {
     pub files: Vec<String>,
     /// Whole job, s.
     pub total_s: f64,
+    /// A short backbone of mode 1 of the a-priori TVD model under the case's static load
+    /// ([`report_backbone`]); `None` if it could not be computed (`backbone_error` says why).
+    pub backbone: Option<crate::studies::backbone::Backbone>,
+    /// Why the backbone is missing.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub backbone_error: Option<String>,
     /// Further fields given by the caller (model summary, modes, linear statics).
     #[serde(flatten)]
     pub extra: serde_json::Map<String, serde_json::Value>,
@@ -452,6 +458,8 @@ pub fn run_main_job(
     reduced_runs(model, &flex, opts, &plan, span, &mut bar, &mut runs)?;
     snapshot_runs(model, &flex, opts, &snapshots, span, &mut bar, &mut runs);
     let headline = tolerance_runs(model, opts, span, &mut bar, &mut runs);
+    bar.set_message("backbone of mode 1");
+    let backbone = report_backbone(model, g_chosen, opts.quick);
     bar.finish_and_clear();
 
     // Errors, speed-ups, Pareto front.
@@ -482,11 +490,51 @@ pub fn run_main_job(
         paper_anchors: anchors,
         files: Vec::new(),
         total_s: 0.0,
+        backbone_error: backbone.as_ref().err().map(|e| e.to_string()),
+        backbone: backbone.ok(),
         extra,
     };
 
     report.total_s = t_all.elapsed().as_secs_f64();
     Ok(report)
+}
+
+/// The main job's backbone: mode 1 of the a-priori TVD model (g reduced vectors) under the
+/// case's static load, two cycles per ring-down at 5 amplitudes (3 when `quick`) spaced
+/// logarithmically from 1e-6 to 1e-4 of the master's static linear translation (1 mm if the
+/// load does not move it) — where the friction bar's joint goes from stick to slip. A few
+/// seconds of reduced runs.
+pub fn report_backbone(
+    model: &Model,
+    g: usize,
+    quick: bool,
+) -> Result<crate::studies::backbone::Backbone, Error> {
+    use crate::studies::backbone::{compute, log_range, BackboneOptions};
+    let u = model
+        .static_linear(&[model.master_load()])?
+        .first()
+        .map(|s| {
+            let m = s.master_displacement;
+            (m[0] * m[0] + m[1] * m[1] + m[2] * m[2]).sqrt()
+        })
+        .unwrap_or(0.0);
+    let base = if u.is_finite() && u > 0.0 { u } else { 1.0 };
+    let opts = BackboneOptions {
+        modes: vec![1],
+        amplitudes: log_range(1e-6 * base, 1e-4 * base, if quick { 3 } else { 5 })?,
+        preload: 1.0,
+        cycles: 2,
+        transient: TransientOptions {
+            budget_s: Some(60.0),
+            ..TransientOptions::default()
+        },
+    };
+    let spec = crate::rom::ModelSpec::Basis {
+        kind: crate::reduction::BasisKind::Tvd,
+        g: Some(g),
+        nu: BasisOptions::default().nu,
+    };
+    compute(model, &spec, &opts)
 }
 
 /// Marks the runs no other run beats in both CPU time and ‖f_c‖ error (finished runs with an

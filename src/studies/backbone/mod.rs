@@ -326,7 +326,7 @@ pub fn ring_down<S: SecondOrderSystem>(
         out.wall_s += run.wall_s;
         out.energy_residual_ratio = out.energy_residual_ratio.max(check.residual_ratio);
         out.energy_ok &= check.ok;
-        out.joint_opened |= preload && run.curves.contact_force_norm.iter().any(|&f| f == 0.0);
+        out.joint_opened |= preload && run.curves.contact_force_norm.contains(&0.0);
         out.dissipated = d0 + run.curves.dissipated.last().copied().unwrap_or(0.0);
         let m = samples.dissipated.len().min(samples.t.len());
         samples.t.truncate(m);
