@@ -70,8 +70,8 @@ fn points(
         .collect()
 }
 
-/// Writes `STEM_frequency.{svg,png}` and `STEM_damping.{svg,png}` into `dir`; returns the
-/// paths written.
+/// Writes `STEM_frequency.{svg,png}` and `STEM_damping.{svg,png}` into `dir` (nothing when no
+/// cycle was extracted); returns the paths written.
 pub fn charts(b: &Backbone, dir: &Path, stem: &str) -> Result<Vec<PathBuf>, Error> {
     let title = format!("{} model, preload {}", b.model, b.preload);
     let mut f = LineChart::new(
@@ -90,6 +90,11 @@ pub fn charts(b: &Backbone, dir: &Path, stem: &str) -> Result<Vec<PathBuf>, Erro
     d.x_log = true;
     d.series = points(b, |_, c| c.damping_ratio);
     let mut out = Vec::new();
+    // A backbone without a single extracted cycle (every decay too short or failed, said in
+    // its warnings) has nothing to draw.
+    if f.series.iter().all(|s| s.points.is_empty()) {
+        return Ok(out);
+    }
     out.extend(f.write(&dir.join(format!("{stem}_frequency")))?);
     out.extend(d.write(&dir.join(format!("{stem}_damping")))?);
     Ok(out)
