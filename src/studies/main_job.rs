@@ -501,9 +501,9 @@ pub fn run_main_job(
 
 /// The main job's backbone: mode 1 of the a-priori TVD model (g reduced vectors) under the
 /// case's static load, two cycles per ring-down at 5 amplitudes (3 when `quick`) spaced
-/// logarithmically from 1e-6 to 1e-4 of the master's static linear translation (1 mm if the
-/// load does not move it) — where the friction bar's joint goes from stick to slip. A few
-/// seconds of reduced runs.
+/// logarithmically from 1e-8 to 1e-4 of the master's static linear translation (1 mm if the
+/// load does not move it): four decades, over which the built-in scenes' joints go from stick
+/// to slip. A few seconds of reduced runs.
 pub fn report_backbone(
     model: &Model,
     g: usize,
@@ -521,7 +521,7 @@ pub fn report_backbone(
     let base = if u.is_finite() && u > 0.0 { u } else { 1.0 };
     let opts = BackboneOptions {
         modes: vec![1],
-        amplitudes: log_range(1e-6 * base, 1e-4 * base, if quick { 3 } else { 5 })?,
+        amplitudes: log_range(1e-8 * base, 1e-4 * base, if quick { 3 } else { 5 })?,
         preload: 1.0,
         cycles: 2,
         transient: TransientOptions {

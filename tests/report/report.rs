@@ -115,6 +115,24 @@ fn quick_report_on_the_friction_bar() {
             );
         }
     }
+    // The short backbone of mode 1: its smallest amplitude sticks (the linearised frequency,
+    // no dissipation), its largest slips (softer, damped).
+    let b = rep.backbone.as_ref().expect("a backbone");
+    let m = &b.modes[0];
+    let (small, large) = (
+        &m.ring_downs[0].cycles[0],
+        &m.ring_downs.last().unwrap().cycles[0],
+    );
+    assert!(
+        (small.frequency_hz / m.linear_frequency_hz - 1.0).abs() < 1e-3,
+        "{small:?} vs {}",
+        m.linear_frequency_hz
+    );
+    assert!(small.damping_ratio.abs() < 1e-6, "{small:?}");
+    assert!(
+        large.frequency_hz < small.frequency_hz && large.damping_ratio > 1e-4,
+        "{large:?}"
+    );
     let h = &rep.runs[rep.headline.expect("a headline model")];
     assert_eq!(h.model, "adaptive");
     assert!(
@@ -143,6 +161,8 @@ fn check_outputs(dir: &std::path::Path) {
         "study/fc_error.png",
         "study/w.png",
         "stability_status.png",
+        "backbone_frequency.png",
+        "backbone_damping.png",
     ] {
         let p = dir.join(f);
         let len = std::fs::metadata(&p)
@@ -160,6 +180,7 @@ fn check_outputs(dir: &std::path::Path) {
         "fc_t.png",
         "study/w.png",
         "stability_status.png",
+        "backbone_damping.png",
     ] {
         assert!(md.contains(needle), "report.md does not show {needle}");
     }
