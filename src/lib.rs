@@ -21,7 +21,7 @@
 //! 10. [`integrate`]: the mechanical ODE and the one CVODE driver loop;
 //! 11. [`rom`]: the reduced model's home — the model choice ([`rom::ModelSpec`]), the
 //!     tolerance-chosen model, every reduced run with its error estimate, the reduced-model file;
-//! 12. [`studies`]: convergence study, stability map, sweeps, the main job;
+//! 12. [`studies`]: convergence study, stability map, sweeps, backbones, the main job;
 //! 13. [`report`]: charts, heat maps, VTU, the main job's report.
 //!
 //! ```no_run

@@ -1,6 +1,7 @@
-//! Studies: orchestration of many runs — the static convergence study ([`convergence`]), the
-//! stability map ([`stability`]), parameter sweeps on one reduced model ([`sweep`]) and the main
-//! job ([`main_job`]). One reduced model and its run live in [`crate::rom`].
+//! Studies: orchestration of many runs — backbones from free decays ([`backbone`]), the static
+//! convergence study ([`convergence`]), the stability map ([`stability`]), parameter sweeps on
+//! one reduced model ([`sweep`]) and the main job ([`main_job`]). One reduced model and its run
+//! live in [`crate::rom`].
 
 pub mod backbone;
 pub mod convergence;

@@ -351,3 +351,37 @@ fn bad_input_names_the_flag() {
     let r = backbone::log_range(1e-4, 1e-2, 3).unwrap();
     assert!((r[1] / 1e-3 - 1.0).abs() < 1e-12);
 }
+
+#[test]
+fn an_initial_state_of_the_wrong_size_is_an_error_naming_its_block() {
+    let (eq, _) = setup(PRESS, [1.0, 0.0], 100.0);
+    let mut o = TransientOptions {
+        end_time: Some(1e-3),
+        constant_load: Some(eq.load),
+        ..TransientOptions::default()
+    };
+    for (q, slip, what) in [
+        (vec![0.0; 3], vec![0.0; 2], "q has 3 entries"),
+        (vec![0.0; 2], vec![0.0; 1], "slip memory has 1 entries"),
+        (vec![f64::NAN, 0.0], vec![0.0; 2], "q has 2 entries"),
+    ] {
+        o.start = Some(jointrom::integrate::InitialState {
+            q,
+            v: vec![0.0; 2],
+            slip,
+        });
+        let e = jointrom::integrate::run(system(), &scene(), &o)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains(what), "{e}");
+    }
+    // The right size runs, and the balance is counted from the start.
+    o.start = Some(jointrom::integrate::InitialState {
+        q: vec![1e-3, eq.q[1]],
+        v: vec![0.0; 2],
+        slip: eq.slip.clone(),
+    });
+    let r = jointrom::integrate::run(system(), &scene(), &o).unwrap();
+    assert_eq!(r.curves.balance()[0], 0.0);
+    assert!(r.curves.energy_check(o.energy_resolution()).ok);
+}

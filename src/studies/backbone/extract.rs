@@ -13,7 +13,8 @@
 //! 2. **Cycles**, one per turning point k with two successors (so consecutive cycles overlap by
 //!    half a cycle): period `T = t_{k+2} − t_k`, frequency `1/T`, amplitude the mean of the two
 //!    half peak-to-peak swings `Ā = (|a_k − a_{k+1}| + |a_{k+1} − a_{k+2}|)/4` (insensitive to
-//!    a drift of the centre, which slip causes), the master's amplitude the same of `m`.
+//!    a drift of the centre, which slip causes), the master's amplitude the same of `m` (`m` at
+//!    the turning times of `a` by the parabola through the nearest three samples).
 //! 3. **Damping** from energy, not from the envelope: `ΔD = D(t_{k+2}) − D(t_k)` (linear
 //!    interpolation of the sampled `D`, which is flat at the turning points where the slip
 //!    rate vanishes with the velocity) and the equivalent viscous damping ratio of a cycle of
@@ -129,6 +130,20 @@ fn interp(t: &[f64], y: &[f64], x: f64) -> f64 {
     y[i - 1] + w * (y[i] - y[i - 1])
 }
 
+/// `y` at time `x` by the parabola through the three samples nearest to it (a turning point
+/// of a smooth curve, where linear interpolation is off by `O(h²)`).
+fn interp_quadratic(t: &[f64], y: &[f64], x: f64) -> f64 {
+    if t.len() < 3 {
+        return interp(t, y, x);
+    }
+    let i = t.partition_point(|&ti| ti <= x).clamp(1, t.len() - 2);
+    let (t0, t1, t2) = (t[i - 1], t[i], t[i + 1]);
+    let l0 = (x - t1) * (x - t2) / ((t0 - t1) * (t0 - t2));
+    let l1 = (x - t0) * (x - t2) / ((t1 - t0) * (t1 - t2));
+    let l2 = (x - t0) * (x - t1) / ((t2 - t0) * (t2 - t1));
+    l0 * y[i - 1] + l1 * y[i] + l2 * y[i + 1]
+}
+
 /// The cycles of a decay (module docs). `period` is the linearised period (s; turning points
 /// closer than a quarter of it are wiggles), `modal_mass` = ψᵀMψ (t).
 pub fn cycles(s: &Samples, period: f64, modal_mass: f64) -> Vec<Cycle> {
@@ -136,7 +151,7 @@ pub fn cycles(s: &Samples, period: f64, modal_mass: f64) -> Vec<Cycle> {
         return Vec::new();
     }
     let tp = turns(&s.t, &s.modal, 0.25 * period);
-    let master_at = |x: f64| (!s.master.is_empty()).then(|| interp(&s.t, &s.master, x));
+    let master_at = |x: f64| (!s.master.is_empty()).then(|| interp_quadratic(&s.t, &s.master, x));
     let mut out = Vec::new();
     for k in 0..tp.len().saturating_sub(2) {
         let (p0, p1, p2) = (tp[k], tp[k + 1], tp[k + 2]);
@@ -204,7 +219,7 @@ mod tests {
             assert!((x.frequency_hz / fd - 1.0).abs() < 1e-5, "{x:?}");
             assert!((x.damping_ratio / zeta - 1.0).abs() < 0.02, "{x:?}");
             let m = x.master_amplitude.unwrap();
-            assert!((m / x.modal_amplitude - 0.5).abs() < 1e-12);
+            assert!((m / x.modal_amplitude - 0.5).abs() < 1e-5, "{m} {x:?}");
         }
         assert!(
             (c[0].modal_amplitude - (-zeta * 2.0 * std::f64::consts::PI * 0.5).exp()).abs() < 0.02
