@@ -226,4 +226,19 @@ pub struct OdeStats {
     pub newton_low_rank: u64,
     /// Pairs that had switched branch at the refreshes, summed.
     pub newton_refresh_pairs: u64,
+    /// Pair screening ([`crate::integrate::mechanical`], *Pair screening*): builds of the
+    /// tracked set (0 without screening).
+    pub screen_builds: u64,
+    /// Tracked pairs summed over the builds (mean = this / `screen_builds`).
+    pub screen_tracked_sum: u64,
+    /// The most pairs tracked at once.
+    pub screen_tracked_max: u64,
+    /// Untracked pairs found closed by a right-hand side (late entries into the set).
+    pub screen_violations: u64,
+    /// Pairs that joined the tracked set, summed.
+    pub screen_entries: u64,
+    /// Untracked pairs whose gap was computed exactly (their bound was not positive), summed.
+    pub screen_exact_checks: u64,
+    /// Pairs that left it, summed.
+    pub screen_exits: u64,
 }

@@ -177,6 +177,7 @@ impl<S: SecondOrderSystem> Stepper<S> {
         stats.newton_refreshes = self.cv.problem().refreshes();
         stats.newton_low_rank = self.cv.problem().low_rank_refreshes();
         stats.newton_refresh_pairs = self.cv.problem().refresh_pairs();
+        self.cv.problem().add_screen_stats(&mut stats);
         stats
     }
 

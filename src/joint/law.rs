@@ -276,9 +276,33 @@ pub fn evaluate_pairs(
     p: &mut [f64],
     s_rate: &mut [f64],
 ) -> PairTotals {
-    let w = u.len() / 3;
+    evaluate_iter(law, 0..u.len() / 3, u, s, p, s_rate)
+}
+
+/// [`evaluate_pairs`] on the listed pairs only (ascending; the other pairs' entries of `p` and
+/// `s_rate` are left as they are): the screened right-hand side of
+/// [`crate::integrate::mechanical`].
+pub fn evaluate_listed_pairs(
+    law: &PairLaw,
+    pairs: &[usize],
+    u: &[f64],
+    s: &[f64],
+    p: &mut [f64],
+    s_rate: &mut [f64],
+) -> PairTotals {
+    evaluate_iter(law, pairs.iter().copied(), u, s, p, s_rate)
+}
+
+fn evaluate_iter(
+    law: &PairLaw,
+    pairs: impl Iterator<Item = usize>,
+    u: &[f64],
+    s: &[f64],
+    p: &mut [f64],
+    s_rate: &mut [f64],
+) -> PairTotals {
     let mut tot = PairTotals::default();
-    for k in 0..w {
+    for k in pairs {
         let sk = if law.friction {
             [s[2 * k], s[2 * k + 1]]
         } else {

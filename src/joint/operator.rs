@@ -138,6 +138,25 @@ impl JointOperator {
         }
     }
 
+    /// `(B q)_r`: row r's product with q.
+    pub fn row_dot(&self, r: usize, q: &[f64]) -> f64 {
+        self.row(r).map(|(c, v)| v * q[c]).sum()
+    }
+
+    /// `f += Σ_{k ∈ pairs} B_kᵀ p_k` over the three rows of each listed pair.
+    pub fn apply_transpose_add_rows(&self, p: &[f64], pairs: &[usize], f: &mut [f64]) {
+        for &k in pairs {
+            for r in 3 * k..3 * k + 3 {
+                let pr = p[r];
+                if pr != 0.0 {
+                    for (c, v) in self.row(r) {
+                        f[c] += v * pr;
+                    }
+                }
+            }
+        }
+    }
+
     /// The normal gaps `g = B_n q` of all pairs (w values).
     pub fn gaps(&self, q: &[f64], out: &mut [f64]) {
         for (k, o) in out.iter_mut().enumerate().take(self.pairs) {

@@ -218,6 +218,18 @@ impl SecondOrderSystem for FullSystem {
     fn joint_transpose_add(&self, p: &[f64], out: &mut [f64]) {
         self.joint.apply_transpose_add(p, out);
     }
+    fn joint_normal_apply_into(&self, q: &[f64], out: &mut [f64]) {
+        self.joint.gaps(q, out);
+    }
+    fn joint_normal_gap(&self, q: &[f64], z: usize) -> f64 {
+        self.joint.row_dot(3 * z, q)
+    }
+    fn joint_pair(&self, q: &[f64], z: usize) -> [f64; 3] {
+        [0, 1, 2].map(|i| self.joint.row_dot(3 * z + i, q))
+    }
+    fn joint_transpose_add_pairs(&self, p: &[f64], pairs: &[usize], out: &mut [f64]) {
+        self.joint.apply_transpose_add_rows(p, pairs, out);
+    }
     fn newton_factor(&mut self, gamma: f64, kc: &[f64]) -> Result<(), Error> {
         let g2 = gamma * gamma;
         let vals = &mut self.newton_values;

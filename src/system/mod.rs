@@ -85,6 +85,28 @@ pub trait SecondOrderSystem {
     fn joint_apply_into(&self, q: &[f64], out: &mut [f64]);
     /// `out += Bᵀ p`.
     fn joint_transpose_add(&self, p: &[f64], out: &mut [f64]);
+    /// The Euclidean norm of each pair's normal row of `B` in these coordinates (w values; mm
+    /// per unit coordinate) if the system screens its pairs
+    /// ([`crate::integrate::mechanical`], *Pair screening*): a reduced model, whose dense
+    /// `B q` costs 3w·r per product. `None` (the default): every pair is evaluated at every
+    /// right-hand side (the full model, whose sparse `B q` costs a few entries per pair).
+    fn joint_normal_row_norms(&self) -> Option<Vec<f64>> {
+        None
+    }
+    /// `out = B_n q`: the normal gaps of all pairs (w values, mm).
+    fn joint_normal_apply_into(&self, q: &[f64], out: &mut [f64]);
+    /// Pair z's normal gap `(B q)_{3z}`, mm.
+    fn joint_normal_gap(&self, q: &[f64], z: usize) -> f64;
+    /// Pair z's kinematics `[(B q)_{3z}, (B q)_{3z+1}, (B q)_{3z+2}]` (gap, slip x, slip z; mm).
+    fn joint_pair(&self, q: &[f64], z: usize) -> [f64; 3];
+    /// `out[3z..3z+3] = (B q)_{3z..3z+3}` for the pairs z in `pairs` (other entries untouched).
+    fn joint_apply_pairs_into(&self, q: &[f64], pairs: &[usize], out: &mut [f64]) {
+        for &z in pairs {
+            out[3 * z..3 * z + 3].copy_from_slice(&self.joint_pair(q, z));
+        }
+    }
+    /// `out += Σ_{z ∈ pairs} B_zᵀ p_z` (the rows of the other pairs are skipped).
+    fn joint_transpose_add_pairs(&self, p: &[f64], pairs: &[usize], out: &mut [f64]);
     /// Factors `M + γ² (K + Bᵀ K_c B)`; `kc` holds one 3×3 row-major symmetric block per pair
     /// (N/mm). Errors if the matrix is not positive definite.
     fn newton_factor(&mut self, gamma: f64, kc: &[f64]) -> Result<(), Error>;

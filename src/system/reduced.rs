@@ -363,6 +363,42 @@ impl SecondOrderSystem for ReducedSystem {
     fn joint_transpose_add(&self, p: &[f64], out: &mut [f64]) {
         kernels::mul_t_add_row_major(&self.b_rows, p, out);
     }
+    fn joint_normal_row_norms(&self) -> Option<Vec<f64>> {
+        let r = self.r;
+        Some(
+            (0..self.pairs())
+                .map(|z| {
+                    let row = &self.b_rows[3 * z * r..3 * z * r + r];
+                    row.iter().map(|x| x * x).sum::<f64>().sqrt()
+                })
+                .collect(),
+        )
+    }
+    fn joint_normal_apply_into(&self, q: &[f64], out: &mut [f64]) {
+        let r = self.r;
+        for (z, o) in out.iter_mut().enumerate() {
+            *o = kernels::dot(&self.b_rows[3 * z * r..3 * z * r + r], q);
+        }
+    }
+    fn joint_normal_gap(&self, q: &[f64], z: usize) -> f64 {
+        let r = self.r;
+        kernels::dot(&self.b_rows[3 * z * r..3 * z * r + r], q)
+    }
+    fn joint_pair(&self, q: &[f64], z: usize) -> [f64; 3] {
+        let r = self.r;
+        [0, 1, 2].map(|i| kernels::dot(&self.b_rows[(3 * z + i) * r..(3 * z + i + 1) * r], q))
+    }
+    fn joint_transpose_add_pairs(&self, p: &[f64], pairs: &[usize], out: &mut [f64]) {
+        let r = self.r;
+        for &z in pairs {
+            for i in 3 * z..3 * z + 3 {
+                let pi = p[i];
+                if pi != 0.0 {
+                    kernels::axpy(pi, &self.b_rows[i * r..(i + 1) * r], out);
+                }
+            }
+        }
+    }
     fn newton_factor(&mut self, gamma: f64, kc: &[f64]) -> Result<(), Error> {
         let r = self.r;
         let g2 = gamma * gamma;

@@ -7,6 +7,7 @@ mod common;
 mod cvode;
 mod friction;
 mod refresh;
+mod screen;
 mod stepper;
 mod system;
 mod transient_reference;

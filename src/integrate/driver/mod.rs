@@ -364,6 +364,7 @@ impl<S: SecondOrderSystem> Driver<S> {
         stats.newton_refreshes = self.cv.problem().inner.refreshes();
         stats.newton_low_rank = self.cv.problem().inner.low_rank_refreshes();
         stats.newton_refresh_pairs = self.cv.problem().inner.refresh_pairs();
+        self.cv.problem().inner.add_screen_stats(&mut stats);
         let profile = self.cv.problem().profile.clone().map(|mut p| {
             p.other_s = wall_s - p.rhs_s - p.setup_s - p.solve_s;
             p

@@ -78,6 +78,50 @@
 //! full re-linearization would leave them; the sliding ones keep the tangent of their last
 //! linearization.
 //!
+//! ## Pair screening
+//!
+//! A reduced model's joint kinematics `B Φ q` are dense: 3w·r operations per product, several
+//! products per step (right-hand sides, the refresh check, the Newton solve), for every pair of
+//! the interface — although at any time only a few are in contact. With
+//! [`ProblemOptions::screen`] (opt-in) a step evaluates only a *tracked set* T of pairs and
+//! proves every other pair open. At a Newton setup (between steps, so that a step sees one
+//! right-hand side) the set is built from the gaps, their rates and accelerations at
+//! `(t_ref, q_ref, v_ref)` (three products of the normal rows over all pairs): pair z joins if
+//! the least gap of its quadratic prediction over the horizon `H = 60 γ` (≈ 40 steps) is not
+//! positive, and leaves if that of `2H` is positive; the set is rebuilt at the first setup
+//! after `H/2`. Every right-hand side proves the untracked pairs open by
+//!
+//! ```text
+//! g_z(q) = g_ref + ġ_ref τ + B_{n,z} Δ ≥ g_ref + ġ_ref τ − ‖B_{n,z}‖ ‖Δ‖ ,
+//! Δ = q − q_ref − v_ref τ ,  τ = t − t_ref
+//! ```
+//!
+//! (Cauchy–Schwarz on the normal row; `‖Δ‖` costs r operations, the test one per pair), checks
+//! the pairs whose bound is not positive exactly (one row product each), and lets a pair found
+//! closed join at once (a *late entry*): no contact is ever missed; the prediction only sets
+//! the cost. The tracked pairs' products, law, `Bᵀp`, Newton blocks and refresh check run over
+//! T alone.
+//!
+//! **The slip memory of untracked pairs.** An open pair's memory relaxes to its tangential
+//! displacement with time constant τ ([`crate::joint::law`]): it carries no information but
+//! "no elastic stretch" when the pair closes. A pair that leaves T keeps the memory rate it
+//! had (from the setup's right-hand side), held constant — its Jacobian rows are zero, and the
+//! state's derivative is continuous. When it joins again its memory becomes
+//! `s = slip_scale · state + offset` with the offset chosen so that `s = u_t − τ ṡ_frozen`:
+//! the open-pair law then returns the same rate, so the derivative is again continuous and
+//! CVODE's history stays valid; the elastic stretch starts at `τ ṡ_frozen` (≈ 1e-5 mm at
+//! 10 mm/s), the size of the lag the law already has.
+//!
+//! **Why it is not the default.** A thin lap joint is pressed nearly shut: its open pairs' gaps
+//! are 1e-4–1e-3 of the structure's motion in coordinate space, so within a few steps the bound
+//! `‖B_{n,z}‖ ‖Δ‖` exceeds most gaps and half the untracked pairs need their exact product,
+//! and the set changes (late entries, joins and leaves at builds) cost error-test failures.
+//! On the refined friction bars the screened run evaluates a fraction of the pairs but takes
+//! more steps (docs/performance/speed.md, *Pair screening*).
+//! The full model does not screen (its sparse `B q` costs a few entries per pair); screening
+//! is off with events on (the root functions need every pair). Curves with and without
+//! screening agree to the integration tolerance (`tests/integrate/screen.rs`).
+//!
 //! ## What sets the step size
 //!
 //! Every model takes about the steps of its Craig–Bampton motion at BDF order 2: the accuracy
@@ -149,11 +193,14 @@
 use crate::case::ContactSpec;
 use crate::error::{Error, IntegrationError};
 use crate::integrate::problem::{CallbackError, OdeProblem};
-use crate::joint::law::{evaluate_pairs, PairLaw, PairState, DEFAULT_TAU};
+use crate::joint::law::{evaluate_listed_pairs, evaluate_pairs, PairLaw, PairState, DEFAULT_TAU};
 use crate::system::SecondOrderSystem;
 
 mod newton;
 mod refresh;
+mod screen;
+
+pub use screen::ScreenStats;
 
 /// Default [`ProblemOptions::velocity_scale`], 1/s: velocities are held to `atol · ω_ref` with
 /// ω_ref = 1e3 rad/s (160 Hz, between the friction bar's 1st and 2nd fixed-interface modes,
@@ -202,6 +249,12 @@ pub struct ProblemOptions {
     /// `slip_scale`, i.e. the same in units of the states' tolerances). See the module docs,
     /// *Active-set refresh*. Default `Some(1e-8)` ([`DEFAULT_REFRESH_MARGIN`]).
     pub refresh: Option<f64>,
+    /// Pair screening (module docs, *Pair screening*): a system that offers it (the reduced
+    /// model) evaluates only the pairs that may be in contact within the step; the others are
+    /// proved open by a bound. Ignored with events on and by the full model. Off by default:
+    /// on the refined friction bars the set changes cost more steps than the pairs it skips
+    /// save (docs/performance/speed.md, *Pair screening*).
+    pub screen: bool,
 }
 
 impl Default for ProblemOptions {
@@ -214,6 +267,7 @@ impl Default for ProblemOptions {
             energy_scale: 1e-3,
             velocity_scale: DEFAULT_VELOCITY_SCALE,
             refresh: Some(DEFAULT_REFRESH_MARGIN),
+            screen: false,
         }
     }
 }
@@ -282,6 +336,14 @@ pub struct MechanicalOde<S: SecondOrderSystem> {
     v_scale: f64,
     /// The co-simulation's load ([`MechanicalOde::set_load`]); `None`: the system's own load.
     load_hook: Option<LoadHook>,
+    /// The pairs evaluated at a right-hand side, ascending: all of them, or the screen's
+    /// tracked set.
+    live: Vec<usize>,
+    /// Pair screening, if on.
+    screen: Option<screen::PairScreen>,
+    /// Slip-memory offsets (2w with friction, mm): the memory is `slip_scale · state + offset`,
+    /// zero unless a pair joined the screened set ([`screen`]).
+    offset: Vec<f64>,
 }
 
 /// A load other than the system's own ([`MechanicalOde::set_load`]):
@@ -331,6 +393,12 @@ impl<S: SecondOrderSystem> MechanicalOde<S> {
         };
         let n = sys.dim();
         let w = sys.pairs();
+        let screen = if opts.screen && !opts.events {
+            sys.joint_normal_row_norms()
+                .map(|norms| screen::PairScreen::new(norms, n))
+        } else {
+            None
+        };
         Ok(MechanicalOde {
             law,
             events: opts.events,
@@ -361,6 +429,9 @@ impl<S: SecondOrderSystem> MechanicalOde<S> {
             e_scale: opts.energy_scale,
             v_scale: opts.velocity_scale,
             load_hook: None,
+            live: (0..w).collect(),
+            screen,
+            offset: vec![0.0; if opts.friction { 2 * w } else { 0 }],
             sys,
         })
     }
@@ -462,8 +533,26 @@ impl<S: SecondOrderSystem> MechanicalOde<S> {
     /// Copies the slip memory of `y` into `s_phys` (mm).
     fn load_slip(&mut self, y: &[f64]) {
         let i0 = 2 * self.n;
-        for (o, &x) in self.s_phys.iter_mut().zip(&y[i0..]) {
-            *o = self.s_scale * x;
+        for ((o, &x), &d) in self.s_phys.iter_mut().zip(&y[i0..]).zip(&self.offset) {
+            *o = self.s_scale * x + d;
+        }
+    }
+
+    /// `u = B q` on the live pairs (all pairs without screening).
+    fn apply_live(&mut self, q: &[f64]) {
+        if self.screen.is_some() {
+            self.sys.joint_apply_pairs_into(q, &self.live, &mut self.u);
+        } else {
+            self.sys.joint_apply_into(q, &mut self.u);
+        }
+    }
+
+    /// `out += Bᵀ p` on the live pairs.
+    fn transpose_add_live(&self, out: &mut [f64]) {
+        if self.screen.is_some() {
+            self.sys.joint_transpose_add_pairs(&self.p, &self.live, out);
+        } else {
+            self.sys.joint_transpose_add(&self.p, out);
         }
     }
 
@@ -533,8 +622,20 @@ impl<S: SecondOrderSystem> MechanicalOde<S> {
         let (q, rest) = y.split_at(n);
         let (v, rest) = rest.split_at(n);
         let rest = &rest[self.ns()..];
-        let s = &self.s_phys;
         self.sys.joint_apply_into(q, &mut self.u);
+        if self.screen.is_some() && self.law.friction {
+            // An untracked pair is open, its memory its tangential displacement.
+            let mut live = self.live.iter().peekable();
+            for k in 0..self.w {
+                if live.peek() == Some(&&k) {
+                    live.next();
+                } else {
+                    self.s_phys[2 * k] = self.u[3 * k + 1];
+                    self.s_phys[2 * k + 1] = self.u[3 * k + 2];
+                }
+            }
+        }
+        let s = &self.s_phys;
         evaluate_pairs(&self.law, &self.u, s, &mut self.p, &mut self.srate);
         let mut fc = 0.0;
         let mut fr = 0.0;
@@ -633,23 +734,37 @@ impl<S: SecondOrderSystem> OdeProblem for MechanicalOde<S> {
     fn rhs(&mut self, t: f64, y: &[f64], ydot: &mut [f64]) -> Result<(), CallbackError> {
         let n = self.n;
         let ns = self.ns();
+        self.check_untracked(t, y);
         self.load_slip(y);
         let (q, rest) = y.split_at(n);
         let v = &rest[..n];
-        self.sys.joint_apply_into(q, &mut self.u);
+        self.apply_live(q);
         self.rhs_q.copy_from_slice(q);
         self.rhs_s.copy_from_slice(&y[2 * n..2 * n + ns]);
         self.rhs_u.copy_from_slice(&self.u);
-        let tot = evaluate_pairs(
-            &self.law,
-            &self.u,
-            &self.s_phys,
-            &mut self.p,
-            &mut self.srate,
-        );
+        let tot = if self.screen.is_some() {
+            evaluate_listed_pairs(
+                &self.law,
+                &self.live,
+                &self.u,
+                &self.s_phys,
+                &mut self.p,
+                &mut self.srate,
+            )
+        } else {
+            evaluate_pairs(
+                &self.law,
+                &self.u,
+                &self.s_phys,
+                &mut self.p,
+                &mut self.srate,
+            )
+        };
         self.total_load_into_f(t);
         self.sys.mul_k_into(q, &mut self.tmp);
-        self.sys.joint_transpose_add(&self.p, &mut self.tmp);
+        let mut tmp = std::mem::take(&mut self.tmp);
+        self.transpose_add_live(&mut tmp);
+        self.tmp = tmp;
         let (dq, drest) = ydot.split_at_mut(n);
         let (dv, drest) = drest.split_at_mut(n);
         dq.copy_from_slice(v);
@@ -658,8 +773,18 @@ impl<S: SecondOrderSystem> OdeProblem for MechanicalOde<S> {
         }
         self.sys.solve_m_in_place(dv);
         let inv_s = 1.0 / self.s_scale;
-        for (o, &r) in drest[..ns].iter_mut().zip(&self.srate) {
-            *o = inv_s * r;
+        if let Some(sc) = &self.screen {
+            // Untracked pairs' memory keeps the rate it left the set with.
+            sc.frozen_rates_into(&mut drest[..ns]);
+            for &k in &self.live {
+                for i in 2 * k..2 * k + ns.min(2) {
+                    drest[i] = inv_s * self.srate[i];
+                }
+            }
+        } else {
+            for (o, &r) in drest[..ns].iter_mut().zip(&self.srate) {
+                *o = inv_s * r;
+            }
         }
         drest[ns] = dot(&self.f, v) / self.e_scale;
         drest[ns + 1] = tot.dissipation / self.e_scale;
@@ -703,13 +828,13 @@ impl<S: SecondOrderSystem> OdeProblem for MechanicalOde<S> {
 
     fn newton_setup(
         &mut self,
-        _t: f64,
+        t: f64,
         y: &[f64],
-        _fy: &[f64],
+        fy: &[f64],
         jok: bool,
         gamma: f64,
     ) -> Result<bool, CallbackError> {
-        self.setup_newton(y, jok, gamma)
+        self.setup_newton(t, y, fy, jok, gamma)
     }
 
     fn newton_solve(

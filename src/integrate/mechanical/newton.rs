@@ -12,7 +12,8 @@ impl<S: SecondOrderSystem> MechanicalOde<S> {
     /// the caller), with each pair's branch.
     pub(super) fn linearize(&mut self) {
         let mut slipping = 0;
-        for k in 0..self.w {
+        for i in 0..self.live.len() {
+            let k = self.live[i];
             let state = self.linearize_pair(k);
             if self.law.friction && state == PairState::Slip {
                 slipping += 1;
@@ -54,8 +55,8 @@ impl<S: SecondOrderSystem> MechanicalOde<S> {
 
     /// Builds K_c and the per-pair data for γ from the stored linearization.
     pub(super) fn apply_gamma(&mut self, gamma: f64) {
-        for k in 0..self.w {
-            self.apply_gamma_pair(k, gamma);
+        for i in 0..self.live.len() {
+            self.apply_gamma_pair(self.live[i], gamma);
         }
         self.lin_gamma = gamma;
     }
@@ -89,14 +90,17 @@ impl<S: SecondOrderSystem> MechanicalOde<S> {
     /// Newton matrix at `gamma`. Returns whether the Jacobian data were recomputed.
     pub(super) fn setup_newton(
         &mut self,
+        t: f64,
         y: &[f64],
+        fy: &[f64],
         jok: bool,
         gamma: f64,
     ) -> Result<bool, CallbackError> {
         let n = self.n;
-        let jcur = !(jok && self.have_lin);
+        let moved = self.rebuild_screen(t, y, fy, gamma);
+        let jcur = !(jok && self.have_lin) || moved;
         if jcur {
-            self.sys.joint_apply_into(&y[..n], &mut self.u);
+            self.apply_live(&y[..n]);
             self.load_slip(y);
             self.linearize();
         }
@@ -143,7 +147,7 @@ impl<S: SecondOrderSystem> MechanicalOde<S> {
         }
         self.sys.mul_m_into(&self.tmp2, &mut self.tmp);
         if fr {
-            for k in 0..self.w {
+            for &k in &self.live {
                 let l = &self.lin[k];
                 let x = mul2(&l.inv, [ss * rs[2 * k], ss * rs[2 * k + 1]]);
                 let h = mul2(&l.pt_u, x);
@@ -151,7 +155,9 @@ impl<S: SecondOrderSystem> MechanicalOde<S> {
                 self.p[3 * k + 1] = g * g * h[0];
                 self.p[3 * k + 2] = g * g * h[1];
             }
-            self.sys.joint_transpose_add(&self.p, &mut self.tmp);
+            let mut tmp = std::mem::take(&mut self.tmp);
+            self.transpose_add_live(&mut tmp);
+            self.tmp = tmp;
         }
         let (za, zrest) = z.split_at_mut(n);
         za.copy_from_slice(&self.tmp);
@@ -163,8 +169,10 @@ impl<S: SecondOrderSystem> MechanicalOde<S> {
         let (zs, ze) = zrest.split_at_mut(ns);
         let mut zd = self.e_scale * rest[1];
         if fr {
-            self.sys.joint_apply_into(za, &mut self.u);
-            for k in 0..self.w {
+            // Untracked pairs: frozen memory, zero Jacobian rows (`c = r_s`).
+            zs.copy_from_slice(rs);
+            self.apply_live(za);
+            for &k in &self.live {
                 let l = &self.lin[k];
                 let ba = [self.u[3 * k], self.u[3 * k + 1], self.u[3 * k + 2]];
                 let du = mul2(&l.sdot_u, [ba[1], ba[2]]);

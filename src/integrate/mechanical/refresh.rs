@@ -21,14 +21,15 @@ impl<S: SecondOrderSystem> MechanicalOde<S> {
         if y[..n] == self.rhs_q[..] && y[2 * n..2 * n + ns] == self.rhs_s[..] {
             self.u.copy_from_slice(&self.rhs_u);
         } else {
-            self.sys.joint_apply_into(&y[..n], &mut self.u);
+            self.apply_live(&y[..n]);
         }
         self.load_slip(y);
         // The pairs on another branch than linearized (`changed`); a refresh when one of them
         // is past its switch by more than the margin.
         self.changed.clear();
         let mut switched = false;
-        for k in 0..self.w {
+        for i in 0..self.live.len() {
+            let k = self.live[i];
             let (uk, sk) = self.pair_kinematics(k);
             let (now, then) = (self.law.state(uk, sk), self.branch[k]);
             if now == then {

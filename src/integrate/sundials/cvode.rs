@@ -736,6 +736,13 @@ impl<P: OdeProblem> Cvode<P> {
             newton_refreshes: 0,
             newton_low_rank: 0,
             newton_refresh_pairs: 0,
+            screen_builds: 0,
+            screen_tracked_sum: 0,
+            screen_tracked_max: 0,
+            screen_violations: 0,
+            screen_entries: 0,
+            screen_exact_checks: 0,
+            screen_exits: 0,
         }
     }
 

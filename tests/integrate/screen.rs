@@ -1,0 +1,72 @@
+//! Pair screening of reduced models (`ProblemOptions::screen`): the screened run evaluates a
+//! tracked subset of the pairs and proves the others open, so its curves must be those of the
+//! run that evaluates every pair, to the integration tolerance — on a mesh fine enough that
+//! most pairs are far from contact at any time.
+
+use jointrom::integrate::{run, Run, TransientOptions};
+use jointrom::reduction::{build_basis, BasisKind, BasisOptions};
+use jointrom::system::{ReducedSystem, Scene, SecondOrderSystem};
+
+use crate::common::{self, rel_l2};
+
+fn runs(case: &str, end: f64) -> (Run, Run, usize) {
+    let path = common::repo_path(case);
+    let model = common::model(path.to_str().expect("path"));
+    let basis = build_basis(&model, BasisKind::Tvd, &BasisOptions::default()).expect("basis");
+    let rom = ReducedSystem::new(&model, basis.phi).expect("ROM");
+    let pairs = rom.pairs();
+    let scene = Scene::of(&model);
+    let off = common::until(end);
+    assert!(!off.problem.screen, "screening is off by default");
+    let mut on: TransientOptions = off.clone();
+    on.problem.screen = true;
+    let a = run(rom.clone(), &scene, &on).expect("screened run");
+    let b = run(rom, &scene, &off).expect("run over every pair");
+    (a, b, pairs)
+}
+
+#[test]
+fn screened_reduced_run_keeps_the_curves_and_evaluates_fewer_pairs() {
+    // The friction bar refined 2× (173 pairs) over its first 20 ms: contact builds up under
+    // the ramped load while most of the interface stays open.
+    let (on, off, pairs) = runs("cases/scale/friction_bar_x2.json", 0.02);
+    assert_eq!(on.curves.t.len(), off.curves.t.len(), "output count");
+    let n = on.curves.t.len();
+    let fc = rel_l2(
+        &on.curves.contact_force_norm,
+        &off.curves.contact_force_norm,
+        n,
+    );
+    let fr = rel_l2(
+        &on.curves.friction_force_norm,
+        &off.curves.friction_force_norm,
+        n,
+    );
+    let uy = rel_l2(&on.curves.master_uy, &off.curves.master_uy, n);
+    let d = rel_l2(&on.curves.dissipated, &off.curves.dissipated, n);
+    let s = &on.stats;
+    let mean = s.screen_tracked_sum as f64 / s.screen_builds.max(1) as f64;
+    println!(
+        "screened vs every pair: |f_c| {fc:.2e}, |f_R| {fr:.2e}, u_y {uy:.2e}, D {d:.2e}; \
+         steps {} vs {}; builds {}, tracked mean {mean:.1} max {} of {pairs}, violations {}, \
+         entries {}, exits {}, exact checks {} (right-hand sides {})",
+        s.steps,
+        off.stats.steps,
+        s.screen_builds,
+        s.screen_tracked_max,
+        s.screen_violations,
+        s.screen_entries,
+        s.screen_exits,
+        s.screen_exact_checks,
+        s.rhs_evals
+    );
+    assert!(s.screen_builds > 0, "the screened run never built its set");
+    assert_eq!(off.stats.screen_builds, 0, "screening while off");
+    assert!(
+        mean < 0.5 * pairs as f64,
+        "the screen tracked {mean:.0} of {pairs} pairs on average"
+    );
+    for (what, e) in [("|f_c|", fc), ("|f_R|", fr), ("u_y", uy), ("D", d)] {
+        assert!(e < 2e-3, "{what}(t) moved by {e:.2e} with screening");
+    }
+}
