@@ -54,7 +54,7 @@ pub fn run(a: StaticArgs) -> Result<(), Error> {
     let model = crate::common::load_model(&a.case)?;
     match spec {
         ModelSpec::Full => {}
-        ModelSpec::Tolerance { tolerance, nu } => {
+        ModelSpec::Tolerance { tolerance, nu, .. } => {
             return tolerance_static(&model, tolerance, nu, scale, a.json)
         }
         ModelSpec::Basis { kind, g, nu } => {
