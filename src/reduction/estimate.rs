@@ -142,8 +142,6 @@ pub struct JointFlexibility {
     h: Mat<f64>,
     /// `C = E_mᵀ K⁻¹ E_m` (6 × 6, symmetric).
     c: Mat<f64>,
-    /// `Z_m = K⁻¹ E_m` (n × 6): the static responses to unit master loads, mm/N (N·mm).
-    z_m: Mat<f64>,
     /// Normal penalty stiffness of the model's contact law, N/mm.
     k_n: f64,
     /// The lowest [`TRUNCATION_MODES`] fixed-interface modes (n × count, M-orthonormal, zero at
@@ -204,7 +202,6 @@ impl JointFlexibility {
             master,
             h,
             c,
-            z_m: z,
             k_n: model.contact.normal_stiffness,
             modes: Mutex::new(None),
             columns: Mutex::new(vec![None; model.joint.rows()]),
@@ -449,7 +446,6 @@ impl JointFlexibility {
                 model,
                 phi.as_ref(),
                 self.truncation_modes(model)?.as_ref().as_ref(),
-                self.z_m.as_ref(),
             )?,
             rom: rom.clone(),
         })
@@ -534,9 +530,6 @@ struct Truncation {
     b_psi: Mat<f64>,
     /// `Ψ` at the master DOF (6 × m).
     psi_m: Mat<f64>,
-    /// `E_mᵀ K⁻¹ M Ψ diag(ω²)` (6 × m): how the master moves under the inertia of the truncated
-    /// modes' dynamic excess (module docs, "Truncation").
-    master_excess: Mat<f64>,
     /// `Ψᵀ K Φ` (m × r).
     psi_k_phi: Mat<f64>,
 }
@@ -546,7 +539,6 @@ impl Truncation {
         model: &Model,
         phi: MatRef<'_, f64>,
         modes: MatRef<'_, f64>,
-        z_m: MatRef<'_, f64>,
     ) -> Result<Truncation, Error> {
         let r = phi.ncols();
         let (both, _) = final_basis(&[phi, modes], &model.mass, 1e-6)?;
@@ -568,15 +560,7 @@ impl Truncation {
         }
         let master = model.master_dofs();
         let k_phi = sym_mul_mat(&model.stiffness, phi);
-        let m_psi = sym_mul_mat(&model.mass, psi.as_ref());
-        let mut master_excess = z_m.transpose() * &m_psi;
-        for (j, w2) in omega2.iter().enumerate() {
-            for d in 0..6 {
-                master_excess[(d, j)] *= w2;
-            }
-        }
         Ok(Truncation {
-            master_excess,
             b_psi: model.joint.reduce(psi.as_ref()),
             psi_m: Mat::from_fn(6, psi.ncols(), |d, j| psi[(master[d], j)]),
             psi_k_phi: psi.transpose() * &k_phi,
@@ -888,8 +872,7 @@ impl ErrorEstimator<'_> {
         let q_all = MatRef::from_column_major_slice(states.q, r, outputs);
         let p_all = MatRef::from_column_major_slice(states.p, 3 * w, outputs);
         let excess = self.truncation.excess(states.t, &load, q_all, p_all);
-        let x_hat =
-            &self.flex.c * &load - &self.g_m * &qdd + &self.truncation.master_excess * &excess;
+        let x_hat = &self.flex.c * &load - &self.g_m * &qdd + &self.truncation.psi_m * &excess;
         let mut out = Estimate {
             pair_error: vec![0.0; w],
             ..Default::default()
