@@ -55,6 +55,23 @@
 //! η_fc = ‖ ‖p_n(t)‖ − ‖p_n*(t)‖ ‖_L2 / ‖ ‖p_n*(t)‖ ‖_L2      (likewise ‖f_R‖, u_y)
 //! ```
 //!
+//! ## Friction
+//!
+//! A sticking pair's force `p_t = k_t (u_t − s)` is set by the structure's tangential compliance
+//! at the pair, which a basis of normal attachment modes lacks. The correction solves the
+//! sticking pairs' problem on the exact flexibility with the run's slip memory (a pair the run
+//! slides keeps its direction on the corrected cone `μ|p_n*|`, set L):
+//!
+//! ```text
+//! (I + k_t F_SS) p_S* = k_t (û_S − F_{S,n} p_n* − F_{S,L} p_L* − s_S)
+//! ```
+//!
+//! a pair of S whose force leaves its cone slides on it and S is solved again without it. The
+//! tangential rows of the tangential flexibility columns are kept beside their normal rows.
+//! The dissipated energy `D = ∫ p_t · ṡ dt` of the run and of the correction is summed over the
+//! output states with the run's slip increments (only while the run's pair is closed), and its
+//! estimate is the relative L2 of the two curves and their relative difference at the end.
+//!
 //! ## Truncation: the dynamics of the modes beyond the basis
 //!
 //! The quasi-static identity treats every direction outside Φ as static. The fixed-interface
@@ -806,6 +823,41 @@ pub struct Estimate {
     pub corrected_dissipated: Vec<f64>,
 }
 
+impl Estimate {
+    /// Adds one output's per-pair shares (the run's forces `p`, the correction's `pc`, the
+    /// joint-only correction's `pj`) and returns its squared norms `[‖p_n*‖², ‖p_t*‖²,
+    /// ‖p_n‖², ‖p_t‖², ‖p_n^j‖², ‖p_t^j‖²]`.
+    fn add_output(&mut self, p: &[f64], pc: &[f64], pj: &[f64]) -> [f64; 6] {
+        let mut sums = [0.0; 6];
+        let sq = |v: &[f64], k: usize| {
+            [
+                v[3 * k + NORMAL].powi(2),
+                v[3 * k + T1].powi(2) + v[3 * k + T2].powi(2),
+            ]
+        };
+        for k in 0..self.pair_error.len() {
+            let (a1, a2) = (pj[3 * k + T1], pj[3 * k + T2]);
+            self.pair_tangential_error[k] +=
+                (a1 - p[3 * k + T1]).powi(2) + (a2 - p[3 * k + T2]).powi(2);
+            let m = &mut self.pair_tangential_moment[k];
+            for (b1, b2) in [(a1, a2), (p[3 * k + T1], p[3 * k + T2])] {
+                m[0] += b1 * b1;
+                m[1] += b1 * b2;
+                m[2] += b2 * b2;
+            }
+            self.pair_error[k] += (pj[3 * k + NORMAL] - p[3 * k + NORMAL]).powi(2);
+            for (i, v) in [sq(pc, k), sq(p, k), sq(pj, k)]
+                .iter()
+                .flatten()
+                .enumerate()
+            {
+                sums[i] += v;
+            }
+        }
+        sums
+    }
+}
+
 /// The joint's dissipated energy `D(t) = ∫ p_t · ṡ dt` of the run and of the correction, by the
 /// trapezoidal rule over the output states: both with the run's slip increments, so their
 /// difference is what the corrected forces change of it (module docs, "Friction").
@@ -936,29 +988,10 @@ impl ErrorEstimator<'_> {
             for (c, (pc, pj)) in full.into_iter().zip(joint).enumerate() {
                 let j = first + c;
                 let p = &states.p[3 * w * j..3 * w * (j + 1)];
-                let (mut fc, mut fr, mut fc_rom, mut fr_rom, mut fcj) = (0.0, 0.0, 0.0, 0.0, 0.0);
-                let mut frj = 0.0;
                 if law.friction {
                     dissipation.push(p, &pc, &states.s[ns * j..ns * (j + 1)]);
                 }
-                for k in 0..w {
-                    let (a1, a2) = (pj[3 * k + T1], pj[3 * k + T2]);
-                    frj += a1 * a1 + a2 * a2;
-                    out.pair_tangential_error[k] +=
-                        (a1 - p[3 * k + T1]).powi(2) + (a2 - p[3 * k + T2]).powi(2);
-                    let m = &mut out.pair_tangential_moment[k];
-                    for (b1, b2) in [(a1, a2), (p[3 * k + T1], p[3 * k + T2])] {
-                        m[0] += b1 * b1;
-                        m[1] += b1 * b2;
-                        m[2] += b2 * b2;
-                    }
-                    fc += pc[3 * k + NORMAL].powi(2);
-                    fr += pc[3 * k + T1].powi(2) + pc[3 * k + T2].powi(2);
-                    fc_rom += p[3 * k + NORMAL].powi(2);
-                    fr_rom += p[3 * k + T1].powi(2) + p[3 * k + T2].powi(2);
-                    fcj += pj[3 * k + NORMAL].powi(2);
-                    out.pair_error[k] += (pj[3 * k + NORMAL] - p[3 * k + NORMAL]).powi(2);
-                }
+                let [fc, fr, fc_rom, fr_rom, fcj, frj] = out.add_output(p, &pc, &pj);
                 fc_joint.push(fcj.sqrt());
                 fr_joint.push(frj.sqrt());
                 // x_m* = C f_m − G_m q̈ − Hᵀ p* (the tangential part of p* as in the gaps: the

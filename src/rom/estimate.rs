@@ -14,7 +14,8 @@
 //!   error model.
 //!
 //! Each part is a relative L2 error of a curve over the output times ([`super::compare`]):
-//! ‖f_c‖(t), ‖f_R‖(t) with friction, master u_y(t).
+//! ‖f_c‖(t), ‖f_R‖(t) with friction, master u_y(t), and with friction the dissipated energy
+//! D(t) (also its relative error at the end of the run).
 //!
 //! The estimator's setup, the integration check and the flexibility columns the estimate needs
 //! do not depend on the run, so [`run_estimated`] computes them on a second rayon job beside the

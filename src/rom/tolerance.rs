@@ -1,6 +1,16 @@
 //! Error-controlled reduction: a tolerance on the joint forces in, the smallest reduced model that
 //! meets it out, with the estimate of [`super::estimate`] attached to every reduced run.
 //!
+//! The tolerance holds for the quantities of [`ToleranceOptions::quantities`] — by default
+//! ‖f_c‖(t), ‖f_R‖(t), the master's u_y(t) and the dissipated energy D(t) (the last two need
+//! friction): the rounds below run until the reduction estimate of each is within TOL. The
+//! rules are written for ‖f_c‖; ‖f_R‖ and D add **tangential attachment modes**
+//! `K⁻¹ B_{t,k}ᵀ d_k` by the same selection on the tangential shares
+//! `e_{t,k} = Σ_t |p_{t,k} − p_{t,k}*|²` ([`Estimate::pair_tangential_error`]), first in the
+//! pair's main direction of friction, later across it, and only in rounds that add no normal
+//! modes (the friction cone follows the normal force). With ‖f_R‖ or D controlled the
+//! integration starts ten times tighter ([`integration_looseness_for`]).
+//!
 //! ## Why not the paper's w(g)
 //!
 //! Every TVD column is a static response to loads on the pairs that close, so the TVD span is the
@@ -71,6 +81,8 @@ use crate::integrate::{Run, TransientOptions};
 use crate::joint::statics::ContactOptions;
 use crate::model::Model;
 use crate::reduction::estimate::TRUNCATION_MODES;
+#[cfg(doc)]
+use crate::reduction::Estimate;
 use crate::reduction::{
     craig_bampton, final_basis, modal_rotation, CurveErrors, JointFlexibility, Quantities,
     Quantity, DEFAULT_DROP_TOL,
@@ -86,7 +98,7 @@ pub const SELECTION_MARGIN: f64 = 0.5;
 /// Options of [`tolerance_model`].
 #[derive(Clone, Debug)]
 pub struct ToleranceOptions {
-    /// The tolerance on the relative L2 error of ‖f_c‖(t), in (0, 1).
+    /// The tolerance on the relative L2 errors of the controlled quantities, in (0, 1).
     pub tolerance: f64,
     /// Fixed-interface modes ν of the Craig–Bampton part.
     pub nu: usize,
