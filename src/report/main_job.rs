@@ -146,7 +146,7 @@ fn time_charts(rep: &Report, dir: &Path) -> Result<Vec<PathBuf>, Error> {
         shown.push(h);
     }
     let mut files = Vec::new();
-    let quantities: [(&str, &str, &str, &str, Curve); 3] = [
+    let quantities: [(&str, &str, &str, &str, Curve); 4] = [
         (
             "fc",
             "contact force norm ‖f_c‖",
@@ -164,6 +164,13 @@ fn time_charts(rep: &Report, dir: &Path) -> Result<Vec<PathBuf>, Error> {
         ("uy", "master displacement u_y", "u_y (mm)", "mm", |r| {
             &r.curves.master_uy
         }),
+        (
+            "dissipated",
+            "dissipated energy D of the joint",
+            "D (N·mm)",
+            "N·mm",
+            |r| &r.curves.dissipated,
+        ),
     ];
     for (stem, what, axis, unit, get) in quantities {
         files.extend(
@@ -446,6 +453,7 @@ fn markdown(rep: &Report, stab: &Path, stability: bool) -> String {
         ("fc", "contact force norm"),
         ("fr", "friction force norm"),
         ("uy", "master displacement"),
+        ("dissipated", "dissipated energy D of the joint"),
     ] {
         let _ = writeln!(s, "![{what}]({stem}_t.png)\n");
         if rep.files.iter().any(|f| *f == format!("{stem}_err_t.png")) {
@@ -479,23 +487,32 @@ fn headline(s: &mut String, rep: &Report) {
     let Some(h) = rep.headline.and_then(|i| rep.runs.get(i)) else {
         let _ = writeln!(
             s,
-            "**Headline reduced model** (tolerance {tol:.0e} on ‖f_c‖(t)): could not be built or run \
-             — see the `adaptive` row below.\n"
+            "**Headline reduced model** (tolerance {tol:.0e} on ‖f_c‖, ‖f_R‖, u_y and D): could not \
+             be built or run — see the `adaptive` row below.\n"
         );
         return;
     };
-    let est = h.estimate.as_ref().and_then(|e| e.total.contact_force);
+    let est = |f: fn(&crate::reduction::CurveErrors) -> Option<f64>| {
+        fmt_opt(h.estimate.as_ref().and_then(|e| f(&e.total)), 2)
+    };
     let _ = writeln!(
         s,
-        "**Headline reduced model** (tolerance {tol:.0e} on ‖f_c‖(t)): Craig–Bampton + the attachment \
-         modes of {} pairs, r = {}; ‖f_c‖(t) error {} (estimated {}), u_y {}, ‖f_R‖ {}; {:.2} s \
-         to build, {:.3} s CPU to run ({} of the full run's CPU).",
+        "**Headline reduced model** (tolerance {tol:.0e} on ‖f_c‖, ‖f_R‖, u_y and D): Craig–Bampton \
+         + the attachment modes of {} pairs, r = {}; errors against the full run (estimated): \
+         ‖f_c‖(t) {} ({}), ‖f_R‖(t) {} ({}), u_y {} ({}), D(t) {} ({}), D at the end {} ({}); \
+         {:.2} s to build, {:.3} s CPU to run ({} of the full run's CPU).",
         h.g.unwrap_or(0),
         h.size,
         fmt_opt(h.error_fc, 2),
-        fmt_opt(est, 2),
-        fmt_opt(h.error_uy, 2),
+        est(|e| e.contact_force),
         fmt_opt(h.error_fr, 2),
+        est(|e| e.friction_force),
+        fmt_opt(h.error_uy, 2),
+        est(|e| e.master_uy),
+        fmt_opt(h.error_d, 2),
+        est(|e| e.dissipated),
+        fmt_opt(h.error_d_end, 2),
+        est(|e| e.dissipated_end),
         h.build_s,
         h.cpu_s,
         h.cpu_percent.map_or("–".into(), |p| format!("{p:.2} %")),

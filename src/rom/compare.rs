@@ -415,6 +415,25 @@ mod tests {
     }
 
     #[test]
+    fn dissipated_energy_is_compared_where_the_reference_has_it() {
+        let json = r#"{"t":[0,1,2],"contact_force_norm":[0,1,1],"friction_force_norm":[0,1,1],
+                       "master_uy":[0,1,1],"dissipated":[0,1,2]}"#;
+        let r = JointCurves::parse_json(json, "f.json").unwrap();
+        let mut run = curves(&r.t, |x| x.min(1.0));
+        run.friction_force_norm = r.friction_force_norm.clone();
+        run.dissipated = vec![0.0, 1.0, 2.2];
+        let e = r.errors(&run);
+        let l2 = (0.04f64 / 5.0).sqrt();
+        assert!((e.dissipated.unwrap() - l2).abs() < 1e-12, "{e:?}");
+        assert!((e.dissipated_end.unwrap() - 0.1).abs() < 1e-12, "{e:?}");
+        let without = JointCurves::parse_csv(CSV, "f.csv").unwrap();
+        assert_eq!(without.errors(&run).dissipated, None);
+        let short = json.replace("[0,1,2]}", "[0,1]}");
+        let e = JointCurves::parse_json(&short, "f.json").unwrap_err();
+        assert!(e.to_string().contains("different lengths"), "{e}");
+    }
+
+    #[test]
     fn bad_references_are_refused_with_their_place() {
         let missing = "t,contact_force_norm,master_uy\n0,0,0\n1,1,1\n";
         let e = JointCurves::parse_csv(missing, "f.csv").unwrap_err();

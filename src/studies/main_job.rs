@@ -11,7 +11,8 @@
 //!    reference of every error below;
 //! 3. reduced transients: TVD with g = 0, the paper's sizes (friction bar 10, 25; multilayer
 //!    sheet 20, 60) and the a-priori g (smallest g with w(g) ≥ the threshold, eq. 26), plus the
-//!    competitors (plain POD, modes only, Joint Interface Modes, all joint DOF, and the POD of
+//!    competitors (plain POD, the secant TVD, modes only, Joint Interface Modes, all joint DOF,
+//!    and the POD of
 //!    200 displacement snapshots of the job's own full run, paper Section 5.2) and functional
 //!    (fixed-point) iteration next to Newton; every run under a wall-clock budget, so a method
 //!    that does not finish is a measured failure, not a hang; every reduced run carries its own
@@ -124,6 +125,10 @@ pub struct RunRecord {
     pub error_uy: Option<f64>,
     /// Relative L2 error of ‖f_R‖(t).
     pub error_fr: Option<f64>,
+    /// Relative L2 error of the dissipated energy D(t).
+    pub error_d: Option<f64>,
+    /// Relative error of D at the end of the run.
+    pub error_d_end: Option<f64>,
     /// The run's own error estimate (reduced runs; [`crate::rom::estimate::RunEstimate`]),
     /// to set beside the true errors above.
     pub estimate: Option<RunEstimate>,
@@ -236,7 +241,12 @@ fn plans(case: &str, g_chosen: usize, pairs: usize, quick: bool) -> Vec<Plan> {
         })
         .collect();
     let competitor_g: Vec<usize> = if quick { vec![paper[0]] } else { paper.clone() };
-    for kind in [BasisKind::TvdPlain, BasisKind::Modes, BasisKind::Jim] {
+    for kind in [
+        BasisKind::TvdPlain,
+        BasisKind::TvdSecant,
+        BasisKind::Modes,
+        BasisKind::Jim,
+    ] {
         for &g in &competitor_g {
             out.push(Plan {
                 kind,
@@ -288,6 +298,8 @@ fn record(
         error_fc: None,
         error_uy: None,
         error_fr: None,
+        error_d: None,
+        error_d_end: None,
         estimate: None,
         estimate_note: None,
         tolerance: None,
@@ -789,7 +801,7 @@ fn tolerance_runs(
     headline
 }
 
-/// Each finished reduced run's relative L2 errors of ‖f_c‖, ‖f_R‖ and u_y against the full run
+/// Each finished reduced run's relative L2 errors of ‖f_c‖, ‖f_R‖, u_y and D against the full run
 /// (`runs[0]`) and its CPU speed-up.
 fn compare_to_full(runs: &mut [RunRecord]) {
     let (full, cpu_ref) = (runs[0].curves.clone(), runs[0].cpu_s);
@@ -801,6 +813,8 @@ fn compare_to_full(runs: &mut [RunRecord]) {
         r.error_fc = e.contact_force;
         r.error_uy = e.master_uy;
         r.error_fr = e.friction_force;
+        r.error_d = e.dissipated;
+        r.error_d_end = e.dissipated_end;
         if r.cpu_s > 0.0 && cpu_ref.is_finite() {
             r.speedup = Some(cpu_ref / r.cpu_s);
             r.cpu_percent = Some(100.0 * r.cpu_s / cpu_ref);
