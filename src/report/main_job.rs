@@ -73,6 +73,11 @@ pub fn write_report(
     for f in speed_chart(report, dir)? {
         report.files.push(relative(dir, &f));
     }
+    if let Some(c) = hysteresis_chart(report) {
+        for f in c.write(&dir.join("hysteresis"))? {
+            report.files.push(relative(dir, &f));
+        }
+    }
     // Joint modes: VTU for ParaView and the picture of the first four.
     let shape_dir = dir.join("shapes");
     let sh = crate::report::shapes::shapes(model, BasisOptions::default().nu, 12)?;
@@ -182,6 +187,34 @@ fn time_charts(rep: &Report, dir: &Path) -> Result<Vec<PathBuf>, Error> {
         }
     }
     Ok(files)
+}
+
+/// The joint's hysteresis at the pair that dissipates most: tangential force against relative
+/// tangential displacement, full run and headline model.
+fn hysteresis_chart(rep: &Report) -> Option<LineChart> {
+    let h = rep.hysteresis.as_ref()?;
+    let mut c = LineChart::new(
+        format!(
+            "{}: hysteresis of pair {} (dissipates most: {:.3e} N·mm in the full run)",
+            rep.case, h.pair, h.dissipated
+        ),
+        "relative tangential displacement (mm)",
+        "tangential force (N)",
+    );
+    c.legend = LegendPosition::UpperRight;
+    let headline = rep.headline.and_then(|i| rep.runs.get(i));
+    for (label, pts) in [
+        (format!("full FE ({} DOF)", rep.dofs), &h.full),
+        (
+            headline.map_or("headline model".into(), |r| run_label(rep, r)),
+            &h.reduced,
+        ),
+    ] {
+        let mut s = Series::new(label, pts.clone());
+        s.markers = false;
+        c.series.push(s);
+    }
+    Some(c)
 }
 
 /// The legend text of a run in the time charts.
@@ -459,6 +492,15 @@ fn markdown(rep: &Report, stab: &Path, stability: bool) -> String {
         if rep.files.iter().any(|f| *f == format!("{stem}_err_t.png")) {
             let _ = writeln!(s, "![error of the {what}]({stem}_err_t.png)\n");
         }
+    }
+    if rep.files.iter().any(|f| f == "hysteresis.png") {
+        let _ = writeln!(
+            s,
+            "The joint's dissipated energy D(t) and the hysteresis of the pair that dissipates \
+             most (tangential force against relative tangential displacement along its main \
+             direction of friction), full FE against the headline model:\n\n\
+             ![hysteresis](hysteresis.png)\n"
+        );
     }
     let _ = writeln!(s, "## Speed against accuracy\n");
     let _ = writeln!(

@@ -43,7 +43,10 @@ use serde::Serialize;
 
 use crate::error::{Error, StudyError};
 use crate::integrate::problem::{Iteration, OdeOptions, OdeStats};
-use crate::integrate::{integrate, ProblemOptions, Run, RunStatus, Scene, TransientOptions};
+use crate::integrate::{
+    integrate, ProblemOptions, Run, RunStatus, Scene, Trajectory, TransientOptions,
+};
+use crate::joint::{T1, T2};
 use crate::model::Model;
 use crate::reduction::{build_basis, snapshot_basis, BasisKind, BasisOptions, JointFlexibility};
 use crate::rom::compare::JointCurves;
@@ -156,6 +159,26 @@ pub struct PaperAnchor {
     pub cpu_percent: f64,
 }
 
+/// The joint's hysteresis at one pair: its tangential force against its relative tangential
+/// displacement, both along the pair's main direction of friction (the principal direction of
+/// `Σ_t p_t p_tᵀ` in the full run).
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct Hysteresis {
+    /// The pair (index into the model's joint pairs): the one that dissipates most in the full
+    /// run.
+    pub pair: usize,
+    /// Its dissipated energy over the full run, `Σ ∫ p_t · ṡ dt` from the output states, N·mm.
+    pub dissipated: f64,
+    /// The direction, a unit vector in the pair's (t1, t2) plane.
+    pub direction: [f64; 2],
+    /// The full run: (relative tangential displacement (mm), tangential force (N)) per output.
+    #[serde(skip)]
+    pub full: Vec<(f64, f64)>,
+    /// The headline reduced model, likewise.
+    #[serde(skip)]
+    pub reduced: Vec<(f64, f64)>,
+}
+
 /// Everything the main job measured (written as `results.json`).
 #[derive(Clone, Debug, Serialize)]
 pub struct Report {
@@ -190,6 +213,9 @@ pub struct Report {
     pub headline: Option<usize>,
     /// Its tolerance.
     pub headline_tolerance: f64,
+    /// The joint's hysteresis at the pair that dissipates most, full run and headline model
+    /// (`None` without friction or a headline model).
+    pub hysteresis: Option<Hysteresis>,
     /// The paper's CPU ratios for this case (empty for other cases).
     pub paper_anchors: Vec<PaperAnchor>,
     /// Files written (relative to the report folder).
@@ -458,12 +484,24 @@ pub fn run_main_job(
     // 2. The full reference and 3. the reduced runs.
     let span = (end_time, output_step);
     let mut snapshots = Vec::new();
-    let mut runs = full_runs(model, opts, span, &mut bar, &mut snapshots)?;
+    let mut full_states = None;
+    let mut runs = full_runs(
+        model,
+        opts,
+        span,
+        &mut bar,
+        &mut snapshots,
+        &mut full_states,
+    )?;
     let flex = JointFlexibility::new(model)?;
     reduced_runs(model, &flex, opts, &plan, span, &mut bar, &mut runs)?;
     snapshot_runs(model, &flex, opts, &snapshots, span, &mut bar, &mut runs);
-    let headline = tolerance_runs(model, opts, span, &mut bar, &mut runs);
+    let mut headline_states = None;
+    let headline = tolerance_runs(model, opts, span, &mut bar, &mut runs, &mut headline_states);
     bar.finish_and_clear();
+    let hysteresis = full_states
+        .zip(headline_states)
+        .and_then(|(full, (rom, reduced))| hysteresis(model, &full, &rom, &reduced));
 
     // Errors, speed-ups, Pareto front.
     compare_to_full(&mut runs);
@@ -490,6 +528,7 @@ pub fn run_main_job(
         runs,
         headline,
         headline_tolerance: opts.headline_tolerance,
+        hysteresis,
         paper_anchors: anchors,
         files: Vec::new(),
         total_s: 0.0,
@@ -527,6 +566,7 @@ fn full_runs(
     span: (f64, f64),
     bar: &mut Tracker<'_>,
     snapshots: &mut Vec<Vec<f64>>,
+    states: &mut Option<Trajectory>,
 ) -> Result<Vec<RunRecord>, Error> {
     let problem = ProblemOptions::default();
     bar.set_message("full FE model, Newton");
@@ -536,20 +576,22 @@ fn full_runs(
     // Every k-th displacement state (about SNAPSHOTS) for the POD-snapshot competitor.
     let every = ((span.0 / span.1).ceil() as usize / SNAPSHOTS).max(1);
     let mut k = 0usize;
-    let full = Outcome::of_run(match full_sys {
-        Ok(s) => integrate(
-            s,
-            &Scene::of(model),
-            &transient_options(&problem, ode_options(false), span, opts.full_budget_s),
-            |_, q| {
-                if k % every == 0 {
-                    snapshots.push(q.to_vec());
-                }
-                k += 1;
-            },
-        ),
+    // The full run's states are kept for the joint's hysteresis.
+    let recorded = TransientOptions {
+        record: true,
+        ..transient_options(&problem, ode_options(false), span, opts.full_budget_s)
+    };
+    let mut full_run = match full_sys {
+        Ok(s) => integrate(s, &Scene::of(model), &recorded, |_, q| {
+            if k % every == 0 {
+                snapshots.push(q.to_vec());
+            }
+            k += 1;
+        }),
         Err(e) => Run::failed(e),
-    });
+    };
+    *states = full_run.trajectory.take();
+    let full = Outcome::of_run(full_run);
     if !full.ok() {
         return Err(StudyError::ReferenceFailed {
             t: full.t_reached,
@@ -754,6 +796,7 @@ fn tolerance_runs(
     span: (f64, f64),
     bar: &mut Tracker<'_>,
     runs: &mut Vec<RunRecord>,
+    headline_states: &mut Option<(ReducedSystem, Trajectory)>,
 ) -> Option<usize> {
     let mut headline = None;
     for tol in run_tolerances(opts) {
@@ -767,6 +810,16 @@ fn tolerance_runs(
         );
         let rec = match tolerance_model(model, &t_opts) {
             Ok(t) => {
+                if tol == opts.headline_tolerance {
+                    // The headline model's states for the joint's hysteresis: its run again,
+                    // recorded (the estimate consumed the first run's states).
+                    let again = TransientOptions {
+                        record: true,
+                        ..t.transient.clone()
+                    };
+                    let mut run = integrate(t.rom.clone(), &Scene::of(model), &again, |_, _| {});
+                    *headline_states = run.trajectory.take().map(|tr| (t.rom.clone(), tr));
+                }
                 let mut rec = record(
                     "adaptive",
                     Some(t.pairs.len()),
@@ -820,4 +873,78 @@ fn compare_to_full(runs: &mut [RunRecord]) {
             r.cpu_percent = Some(100.0 * r.cpu_s / cpu_ref);
         }
     }
+}
+
+/// The joint's hysteresis ([`Hysteresis`]) at the pair that dissipates most in the full run,
+/// from the full run's recorded states and the headline model's; `None` without friction.
+fn hysteresis(
+    model: &Model,
+    full: &Trajectory,
+    rom: &ReducedSystem,
+    reduced: &Trajectory,
+) -> Option<Hysteresis> {
+    let w = model.joint.pairs();
+    let outputs = full.p.len() / (3 * w).max(1);
+    if w == 0 || full.s.len() != 2 * w * outputs || outputs < 2 {
+        return None;
+    }
+    let force = |p: &[f64], j: usize, k: usize| {
+        let o = 3 * w * j + 3 * k;
+        [p[o + 1], p[o + 2]]
+    };
+    let mut dissipated = vec![0.0; w];
+    let mut moment = vec![[0.0; 3]; w];
+    for j in 0..outputs {
+        for k in 0..w {
+            let f = force(&full.p, j, k);
+            moment[k][0] += f[0] * f[0];
+            moment[k][1] += f[0] * f[1];
+            moment[k][2] += f[1] * f[1];
+            if j + 1 < outputs {
+                let f1 = force(&full.p, j + 1, k);
+                for c in 0..2 {
+                    let ds = full.s[2 * w * (j + 1) + 2 * k + c] - full.s[2 * w * j + 2 * k + c];
+                    dissipated[k] += 0.5 * (f[c] + f1[c]) * ds;
+                }
+            }
+        }
+    }
+    let pair = (0..w).max_by(|&a, &b| dissipated[a].total_cmp(&dissipated[b]))?;
+    if dissipated[pair] <= 0.0 {
+        return None;
+    }
+    let m = moment[pair];
+    let angle = 0.5 * (2.0 * m[1]).atan2(m[0] - m[2]);
+    let d = [angle.cos(), angle.sin()];
+    let along = |v: [f64; 2]| d[0] * v[0] + d[1] * v[1];
+    let n = model.dofs();
+    let slip =
+        |q: &[f64], c: usize| -> f64 { model.joint.row(3 * pair + c).map(|(i, v)| v * q[i]).sum() };
+    let full_curve = (0..outputs)
+        .map(|j| {
+            let q = &full.q[n * j..n * (j + 1)];
+            (
+                along([slip(q, T1), slip(q, T2)]),
+                along(force(&full.p, j, pair)),
+            )
+        })
+        .collect();
+    let r = rom.dim();
+    let mut u = vec![0.0; 3 * w];
+    let reduced_curve = (0..reduced.p.len() / (3 * w))
+        .map(|j| {
+            rom.joint_apply_into(&reduced.q[r * j..r * (j + 1)], &mut u);
+            (
+                along([u[3 * pair + T1], u[3 * pair + T2]]),
+                along(force(&reduced.p, j, pair)),
+            )
+        })
+        .collect();
+    Some(Hysteresis {
+        pair,
+        dissipated: dissipated[pair],
+        direction: d,
+        full: full_curve,
+        reduced: reduced_curve,
+    })
 }
