@@ -613,6 +613,9 @@ pub enum RomError {
          dissipation)"
     )]
     ToleranceOnName { name: String },
+    /// `--tolerance-on` on `static` with anything but `fc`.
+    #[error("--tolerance-on: static --tolerance controls |f_c| only (give fc, or drop the flag)")]
+    ToleranceOnStatic,
     /// `--tolerance-on` with an empty list.
     #[error("--tolerance-on: the list is empty (give some of fc, fr, uy, dissipation)")]
     ToleranceOnEmpty,

@@ -190,6 +190,18 @@ fn tolerance_on_bad_input_is_named() {
         e.contains("--tolerance-on") && e.contains("--tolerance"),
         "{e}"
     );
+    let e = jointrom_err([
+        "static",
+        "friction_bar",
+        "--tolerance",
+        "1e-2",
+        "--tolerance-on",
+        "fr",
+    ]);
+    assert!(
+        e.contains("--tolerance-on") && e.contains("|f_c| only"),
+        "{e}"
+    );
     for q in ["dissipation", "fr"] {
         let e = jointrom_err([
             "transient",
