@@ -32,7 +32,7 @@
 //!
 //! // A 1 % reduced model, its run and its error estimate.
 //! use jointrom::rom::{run_model, ModelSpec, RunSettings};
-//! let spec = ModelSpec::Tolerance { tolerance: 1e-2, nu: 10 };
+//! let spec = ModelSpec::Tolerance { tolerance: 1e-2, nu: 10, on: None };
 //! let opts = jointrom::integrate::TransientOptions::default();
 //! let out = run_model(&model, &spec, &opts, &RunSettings::default())?;
 //! println!("r = {}, estimate {:?}", out.basis_size, out.estimate);

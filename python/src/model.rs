@@ -367,6 +367,7 @@ impl PyModel {
             g,
             nu,
             tolerance,
+            tolerance_on: None,
         };
         let tvd = ModelSpec::Basis {
             kind: BasisKind::Tvd,

@@ -615,12 +615,37 @@ pub enum RomError {
     /// A tolerance that is not a relative error in (0, 1).
     #[error("--tolerance must be a relative error in (0, 1), got {tolerance}")]
     Tolerance { tolerance: f64 },
+    /// `--tolerance-on` names a quantity that does not exist (`name`, printable).
+    #[error(
+        "--tolerance-on: unknown quantity `{name}` (a comma-separated list of fc, fr, uy, \
+         dissipation)"
+    )]
+    ToleranceOnName { name: String },
+    /// `--tolerance-on` on `static` with anything but `fc`.
+    #[error("--tolerance-on: static --tolerance controls |f_c| only (give fc, or drop the flag)")]
+    ToleranceOnStatic,
+    /// `--tolerance-on` with an empty list.
+    #[error("--tolerance-on: the list is empty (give some of fc, fr, uy, dissipation)")]
+    ToleranceOnEmpty,
+    /// `--tolerance-on` without `--tolerance`.
+    #[error("--tolerance-on selects what --tolerance controls: give --tolerance TOL too")]
+    ToleranceOnWithout,
+    /// `--tolerance-on` names a quantity (`name`) the run does not produce: friction is off.
+    #[error(
+        "--tolerance-on {name}: the run has friction off, so it has no {what}; drop `{name}` or \
+         turn friction on"
+    )]
+    ToleranceOnFriction {
+        name: &'static str,
+        what: &'static str,
+    },
     /// Fewer than two POD snapshots.
     #[error("--snapshots must be at least 2, got {snapshots}")]
     Snapshots { snapshots: usize },
-    /// `--strict`: the best model's estimated |f_c| error misses `--tolerance`.
+    /// `--strict`: the best model's largest estimated error (of the quantities of
+    /// `--tolerance-on`) misses `--tolerance`.
     #[error(
-        "--strict: the estimated |f_c| error {estimate:e} of the best model exceeds --tolerance \
+        "--strict: the estimated error {estimate:e} of the best model exceeds --tolerance \
          {tolerance:e} (the result above is that model's)"
     )]
     Strict { estimate: f64, tolerance: f64 },

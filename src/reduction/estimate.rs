@@ -55,6 +55,23 @@
 //! η_fc = ‖ ‖p_n(t)‖ − ‖p_n*(t)‖ ‖_L2 / ‖ ‖p_n*(t)‖ ‖_L2      (likewise ‖f_R‖, u_y)
 //! ```
 //!
+//! ## Friction
+//!
+//! A sticking pair's force `p_t = k_t (u_t − s)` is set by the structure's tangential compliance
+//! at the pair, which a basis of normal attachment modes lacks. The correction solves the
+//! sticking pairs' problem on the exact flexibility with the run's slip memory (a pair the run
+//! slides keeps its direction on the corrected cone `μ|p_n*|`, set L):
+//!
+//! ```text
+//! (I + k_t F_SS) p_S* = k_t (û_S − F_{S,n} p_n* − F_{S,L} p_L* − s_S)
+//! ```
+//!
+//! a pair of S whose force leaves its cone slides on it and S is solved again without it. The
+//! tangential rows of the tangential flexibility columns are kept beside their normal rows.
+//! The dissipated energy `D = ∫ p_t · ṡ dt` of the run and of the correction is summed over the
+//! output states with the run's slip increments (only while the run's pair is closed), and its
+//! estimate is the relative L2 of the two curves and their relative difference at the end.
+//!
 //! ## Truncation: the dynamics of the modes beyond the basis
 //!
 //! The quasi-static identity treats every direction outside Φ as static. The fixed-interface
@@ -152,6 +169,10 @@ pub struct JointFlexibility {
     /// flexibility column `B_n K⁻¹ b_rᵀ` (w values, mm/N). Shared by every estimate of the
     /// model (sweeps run in parallel), so behind a lock.
     columns: Mutex<Vec<Option<Arc<[f64]>>>>,
+    /// Per tangential joint row r (`3k + T1`, `3k + T2`), once solved: the tangential rows of
+    /// its flexibility column `B_t K⁻¹ b_rᵀ` (2w values, t1 and t2 of each pair in turn, mm/N),
+    /// for the stick correction of the tangential forces (module docs, "Friction").
+    tangential: Mutex<Vec<Option<Arc<[f64]>>>>,
 }
 
 /// Fixed-interface modes computed for the truncation part of the estimate (module docs): the
@@ -201,6 +222,7 @@ impl JointFlexibility {
             k_n: model.contact.normal_stiffness,
             modes: Mutex::new(None),
             columns: Mutex::new(vec![None; model.joint.rows()]),
+            tangential: Mutex::new(vec![None; model.joint.rows()]),
         })
     }
 
@@ -222,6 +244,26 @@ impl JointFlexibility {
             .unwrap_or_else(std::sync::PoisonError::into_inner)
     }
 
+    fn lock_tangential(&self) -> std::sync::MutexGuard<'_, Vec<Option<Arc<[f64]>>>> {
+        self.tangential
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner)
+    }
+
+    /// The flexibility columns of the tangential joint rows `rows`: per row its normal rows
+    /// `B_n K⁻¹ b_rᵀ` (w values) and its tangential rows `B_t K⁻¹ b_rᵀ` (2w values), mm/N,
+    /// solved on first use ([`JointFlexibility::columns`]).
+    #[allow(clippy::type_complexity)]
+    fn tangential_columns(&self, rows: &[usize]) -> Result<Vec<(Arc<[f64]>, Arc<[f64]>)>, Error> {
+        let normal = self.columns(rows)?;
+        let tang = self.lock_tangential();
+        Ok(normal
+            .into_iter()
+            .zip(rows)
+            .map(|(n, &r)| (n, tang[r].clone().expect("solved with its normal rows")))
+            .collect())
+    }
+
     /// The flexibility columns `B_n K⁻¹ b_rᵀ` (each w values, mm/N) of the joint rows `rows`
     /// (`3k + NORMAL` for pair k's normal force, `3k + T1`, `3k + T2` for its tangential ones),
     /// solving the missing ones in blocked multi-right-hand-side solves of [`SOLVE_CHUNK`]
@@ -230,10 +272,11 @@ impl JointFlexibility {
     fn columns(&self, rows: &[usize]) -> Result<Vec<Arc<[f64]>>, Error> {
         let missing: Vec<usize> = {
             let cols = self.lock_columns();
+            let tang = self.lock_tangential();
             let mut m: Vec<usize> = rows
                 .iter()
                 .copied()
-                .filter(|&r| cols[r].is_none())
+                .filter(|&r| cols[r].is_none() || (r % 3 != NORMAL && tang[r].is_none()))
                 .collect();
             m.sort_unstable();
             m.dedup();
@@ -261,14 +304,34 @@ impl JointFlexibility {
                         .collect()
                 })
                 .collect();
-            if solved.iter().any(|c| c.iter().any(|v| !v.is_finite())) {
+            // The tangential rows of the tangential columns (the stick correction's F_tt).
+            let solved_t: Vec<Option<Arc<[f64]>>> = chunk
+                .iter()
+                .enumerate()
+                .map(|(j, &r)| {
+                    (r % 3 != NORMAL).then(|| {
+                        (0..2 * w)
+                            .map(|i| {
+                                let row = 3 * (i / 2) + if i % 2 == 0 { T1 } else { T2 };
+                                self.joint.row(row).map(|(c, v)| v * x[(c, j)]).sum::<f64>()
+                            })
+                            .collect()
+                    })
+                })
+                .collect();
+            let finite = |c: &[f64]| c.iter().all(|v| v.is_finite());
+            if !solved.iter().all(|c| finite(c)) || !solved_t.iter().flatten().all(|c| finite(c)) {
                 return Err(Error::LinearAlgebra(LinalgError::not_finite(
                     "joint flexibility K⁻¹ Bᵀ",
                 )));
             }
             let mut cols = self.lock_columns();
-            for (&r, col) in chunk.iter().zip(solved) {
+            let mut tang = self.lock_tangential();
+            for ((&r, col), t) in chunk.iter().zip(solved).zip(solved_t) {
                 cols[r] = Some(col);
+                if t.is_some() {
+                    tang[r] = t;
+                }
             }
         }
         let cols = self.lock_columns();
@@ -347,6 +410,21 @@ impl JointFlexibility {
         solve_refined(&self.stiffness, &self.chol, &rhs)
     }
 
+    /// The tangential attachment modes `K⁻¹ B_{t,k}ᵀ d` of `pairs`, each with its direction `d`
+    /// (a unit vector in the pair's (t1, t2) plane): n × |pairs|, mm/N — the static response of
+    /// the structure to a unit friction force on the pair in that direction.
+    pub fn tangential_attachment_modes(&self, pairs: &[(usize, [f64; 2])]) -> Mat<f64> {
+        let mut rhs = Mat::<f64>::zeros(self.stiffness.n, pairs.len());
+        for (j, &(k, d)) in pairs.iter().enumerate() {
+            for (row, dk) in [(3 * k + T1, d[0]), (3 * k + T2, d[1])] {
+                for (i, v) in self.joint.row(row) {
+                    rhs[(i, j)] += dk * v;
+                }
+            }
+        }
+        solve_refined(&self.stiffness, &self.chol, &rhs)
+    }
+
     /// The frictionless contact statics (the model's `k_n`) under the master load `load` (`[Fx, Fy, Fz (N), Mx, My,
     /// Mz (N·mm)]`) solved in the pair space, `g = H_n f_m − k_n F_{n,A} g_A`: the full model's
     /// solution condensed exactly to the pairs (module docs). Returns the normal pair forces
@@ -363,7 +441,7 @@ impl JointFlexibility {
             k_t: 0.0,
             tau: 1.0,
         };
-        let pc = Corrector::new(self, &law).correct(&u, &vec![0.0; rows])?;
+        let pc = Corrector::new(self, &law).correct(&u, &vec![0.0; rows], &[])?;
         Ok(pc.iter().step_by(3).copied().collect())
     }
 
@@ -563,7 +641,100 @@ pub struct RunStates<'a> {
     pub s: &'a [f64],
 }
 
-/// Relative L2 errors over a run's output times of its three headline curves.
+/// A quantity a run reports and `--tolerance` can control: ‖f_c‖(t), ‖f_R‖(t), the master's
+/// u_y(t) or the joint's dissipated energy D(t).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Quantity {
+    /// ‖f_c‖(t), the norm of the normal contact forces (`fc`).
+    ContactForce,
+    /// ‖f_R‖(t), the norm of the tangential (friction) forces (`fr`).
+    FrictionForce,
+    /// The master node's u_y(t) (`uy`).
+    MasterUy,
+    /// The joint's dissipated energy D(t) (`dissipation`): relative L2 over the run and
+    /// relative error at its end.
+    Dissipation,
+}
+
+impl Quantity {
+    /// Every quantity, in the order of the outputs.
+    pub const ALL: [Quantity; 4] = [
+        Quantity::ContactForce,
+        Quantity::FrictionForce,
+        Quantity::MasterUy,
+        Quantity::Dissipation,
+    ];
+
+    /// The short name of `--tolerance-on`: `fc`, `fr`, `uy`, `dissipation`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Quantity::ContactForce => "fc",
+            Quantity::FrictionForce => "fr",
+            Quantity::MasterUy => "uy",
+            Quantity::Dissipation => "dissipation",
+        }
+    }
+
+    /// The quantity of a short name ([`Quantity::name`]).
+    pub fn from_name(name: &str) -> Option<Quantity> {
+        Quantity::ALL.into_iter().find(|q| q.name() == name)
+    }
+
+    /// Whether a run produces it: ‖f_R‖ and D need friction.
+    pub fn needs_friction(self) -> bool {
+        matches!(self, Quantity::FrictionForce | Quantity::Dissipation)
+    }
+}
+
+/// A set of [`Quantity`]s: what `--tolerance` controls (`--tolerance-on`). Serialized as the
+/// list of their names.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct Quantities(u8);
+
+impl Quantities {
+    /// All four quantities (the default of `--tolerance`).
+    pub const ALL: Quantities = Quantities(0b1111);
+
+    /// The set of `list`.
+    pub fn of(list: &[Quantity]) -> Quantities {
+        Quantities(list.iter().fold(0, |m, &q| m | 1 << q as u8))
+    }
+
+    /// Whether `q` is in the set.
+    pub fn contains(self, q: Quantity) -> bool {
+        self.0 & 1 << q as u8 != 0
+    }
+
+    /// The quantities of the set, in [`Quantity::ALL`]'s order.
+    pub fn iter(self) -> impl Iterator<Item = Quantity> {
+        Quantity::ALL.into_iter().filter(move |&q| self.contains(q))
+    }
+
+    /// The set without the quantities that need friction.
+    pub fn without_friction(self) -> Quantities {
+        Quantities::of(
+            &self
+                .iter()
+                .filter(|q| !q.needs_friction())
+                .collect::<Vec<_>>(),
+        )
+    }
+
+    /// Whether the set is empty.
+    pub fn is_empty(self) -> bool {
+        self.0 == 0
+    }
+}
+
+impl serde::Serialize for Quantities {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.collect_seq(self.iter().map(Quantity::name))
+    }
+}
+
+/// Relative L2 errors over a run's output times of its headline curves (and the error of the
+/// dissipated energy at the end).
 #[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
 pub struct CurveErrors {
     /// ‖f_c‖(t) (`None`: no contact force in the reference curve).
@@ -572,9 +743,29 @@ pub struct CurveErrors {
     pub friction_force: Option<f64>,
     /// Master u_y(t).
     pub master_uy: Option<f64>,
+    /// The joint's dissipated energy D(t) (`None`: friction off or nothing dissipated).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub dissipated: Option<f64>,
+    /// D at the end of the run: `|D(T) − D_ref(T)| / |D_ref(T)|` (`None` as for `dissipated`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub dissipated_end: Option<f64>,
 }
 
 impl CurveErrors {
+    /// The error of `quantity` (its relative L2 over the run; for D the larger of that and the
+    /// error at the end).
+    pub fn of(&self, quantity: Quantity) -> Option<f64> {
+        match quantity {
+            Quantity::ContactForce => self.contact_force,
+            Quantity::FrictionForce => self.friction_force,
+            Quantity::MasterUy => self.master_uy,
+            Quantity::Dissipation => match (self.dissipated, self.dissipated_end) {
+                (None, None) => None,
+                (a, b) => Some(a.unwrap_or(0.0).max(b.unwrap_or(0.0))),
+            },
+        }
+    }
+
     /// The root sum of squares of two independent error estimates, per curve (a missing one
     /// counts as zero; both missing stays `None`).
     pub fn combine(&self, other: &CurveErrors) -> CurveErrors {
@@ -586,6 +777,8 @@ impl CurveErrors {
             contact_force: rss(self.contact_force, other.contact_force),
             friction_force: rss(self.friction_force, other.friction_force),
             master_uy: rss(self.master_uy, other.master_uy),
+            dissipated: rss(self.dissipated, other.dissipated),
+            dissipated_end: rss(self.dissipated_end, other.dissipated_end),
         }
     }
 }
@@ -603,6 +796,9 @@ pub struct Estimate {
     pub truncation: Option<f64>,
     /// `Σ_t ‖p_n*(t)‖²` of the joint-only correction, N² (the scale of [`Estimate::pair_error`]).
     pub corrected_joint_norm2: f64,
+    /// `Σ_t ‖p_t*‖²` of the joint-only correction, N² (the scale of
+    /// [`Estimate::pair_tangential_error`]).
+    pub corrected_joint_friction_norm2: f64,
     /// The corrected ‖f_c*‖(t), N.
     pub corrected_contact_force: Vec<f64>,
     /// The corrected ‖f_R*‖(t), N.
@@ -612,6 +808,99 @@ pub struct Estimate {
     /// Per pair, `Σ_t (p_{n,k}(t) − p_{n,k}*(t))²` (N²) with the joint-only correction: where
     /// the reduced run's normal forces differ from the corrected ones.
     pub pair_error: Vec<f64>,
+    /// The joint part of the ‖f_R‖(t) estimate (the run against the joint-only correction;
+    /// `None` without friction).
+    pub joint_friction: Option<f64>,
+    /// Per pair, `Σ_t |p_{t,k}(t) − p_{t,k}*(t)|²` (N²) with the joint-only correction: where
+    /// the reduced run's tangential forces differ from the corrected ones.
+    pub pair_tangential_error: Vec<f64>,
+    /// Per pair, the moments `Σ_t [p_1², p_1 p_2, p_2²]` (N²) of the tangential forces of the
+    /// run and of the joint-only correction: their principal direction is the pair's main
+    /// direction of friction.
+    pub pair_tangential_moment: Vec<[f64; 3]>,
+    /// The corrected dissipated energy D*(t) from the output states (module docs, "Friction"),
+    /// N·mm (empty without friction).
+    pub corrected_dissipated: Vec<f64>,
+}
+
+impl Estimate {
+    /// Adds one output's per-pair shares (the run's forces `p`, the correction's `pc`, the
+    /// joint-only correction's `pj`) and returns its squared norms `[‖p_n*‖², ‖p_t*‖²,
+    /// ‖p_n‖², ‖p_t‖², ‖p_n^j‖², ‖p_t^j‖²]`.
+    fn add_output(&mut self, p: &[f64], pc: &[f64], pj: &[f64]) -> [f64; 6] {
+        let mut sums = [0.0; 6];
+        let sq = |v: &[f64], k: usize| {
+            [
+                v[3 * k + NORMAL].powi(2),
+                v[3 * k + T1].powi(2) + v[3 * k + T2].powi(2),
+            ]
+        };
+        for k in 0..self.pair_error.len() {
+            let (a1, a2) = (pj[3 * k + T1], pj[3 * k + T2]);
+            self.pair_tangential_error[k] +=
+                (a1 - p[3 * k + T1]).powi(2) + (a2 - p[3 * k + T2]).powi(2);
+            let m = &mut self.pair_tangential_moment[k];
+            for (b1, b2) in [(a1, a2), (p[3 * k + T1], p[3 * k + T2])] {
+                m[0] += b1 * b1;
+                m[1] += b1 * b2;
+                m[2] += b2 * b2;
+            }
+            self.pair_error[k] += (pj[3 * k + NORMAL] - p[3 * k + NORMAL]).powi(2);
+            for (i, v) in [sq(pc, k), sq(p, k), sq(pj, k)]
+                .iter()
+                .flatten()
+                .enumerate()
+            {
+                sums[i] += v;
+            }
+        }
+        sums
+    }
+}
+
+/// The joint's dissipated energy `D(t) = ∫ p_t · ṡ dt` of the run and of the correction, by the
+/// trapezoidal rule over the output states: both with the run's slip increments, so their
+/// difference is what the corrected forces change of it (module docs, "Friction").
+#[derive(Default)]
+struct Dissipation {
+    /// The run's D at each output so far, N·mm.
+    run: Vec<f64>,
+    /// The correction's D*, N·mm.
+    corrected: Vec<f64>,
+    /// The last output's run forces (3w), corrected forces (3w) and slip memory (2w).
+    last: Option<(Vec<f64>, Vec<f64>, Vec<f64>)>,
+}
+
+impl Dissipation {
+    fn push(&mut self, p: &[f64], pc: &[f64], s: &[f64]) {
+        let (mut d, mut dc) = (
+            self.run.last().copied().unwrap_or(0.0),
+            self.corrected.last().copied().unwrap_or(0.0),
+        );
+        if let Some((p0, pc0, s0)) = &self.last {
+            for (i, (s1, s0)) in s.iter().zip(s0).enumerate() {
+                let ds = s1 - s0;
+                let r = 3 * (i / 2) + 1 + i % 2;
+                let n = 3 * (i / 2) + NORMAL;
+                // Only the intervals the run's pair is closed at both ends: an open pair's memory
+                // relaxes to its tangential displacement without dissipating, and how far a
+                // pair the correction closes would slide is not known.
+                if ds != 0.0 && p[n] != 0.0 && p0[n] != 0.0 {
+                    d += 0.5 * (p[r] + p0[r]) * ds;
+                    dc += 0.5 * (pc[r] + pc0[r]) * ds;
+                }
+            }
+        }
+        self.run.push(d);
+        self.corrected.push(dc);
+        self.last = Some((p.to_vec(), pc.to_vec(), s.to_vec()));
+    }
+
+    /// `|D(T) − D*(T)| / |D*(T)|` (`None` when nothing is dissipated).
+    fn end_error(&self) -> Option<f64> {
+        let (d, dc) = (*self.run.last()?, *self.corrected.last()?);
+        (dc != 0.0).then(|| (d - dc).abs() / dc.abs())
+    }
 }
 
 impl ErrorEstimator<'_> {
@@ -643,6 +932,10 @@ impl ErrorEstimator<'_> {
         // ‖p_n*‖, ‖p_t*‖, u_y* and the run's ‖p_n‖, ‖p_t‖, u_y per output.
         let mut curves: [Vec<f64>; 6] = Default::default();
         let mut fc_joint = Vec::with_capacity(outputs);
+        let mut fr_joint = Vec::with_capacity(outputs);
+        out.pair_tangential_error = vec![0.0; w];
+        out.pair_tangential_moment = vec![[0.0; 3]; w];
+        let mut dissipation = Dissipation::default();
         let mut corr = Corrector::new(self.flex, law);
         let mut corr_joint = Corrector::new(self.flex, law);
         let at = |j: usize| {
@@ -677,8 +970,12 @@ impl ErrorEstimator<'_> {
                     .map(|c| {
                         let j = first + c;
                         let u: Vec<f64> = u.col(c).iter().copied().collect();
-                        corr.correct(&u, &states.p[3 * w * j..3 * w * (j + 1)])
-                            .map_err(at(j))
+                        corr.correct(
+                            &u,
+                            &states.p[3 * w * j..3 * w * (j + 1)],
+                            &states.s[ns * j..ns * (j + 1)],
+                        )
+                        .map_err(at(j))
                     })
                     .collect()
             };
@@ -691,16 +988,12 @@ impl ErrorEstimator<'_> {
             for (c, (pc, pj)) in full.into_iter().zip(joint).enumerate() {
                 let j = first + c;
                 let p = &states.p[3 * w * j..3 * w * (j + 1)];
-                let (mut fc, mut fr, mut fc_rom, mut fr_rom, mut fcj) = (0.0, 0.0, 0.0, 0.0, 0.0);
-                for k in 0..w {
-                    fc += pc[3 * k + NORMAL].powi(2);
-                    fr += pc[3 * k + T1].powi(2) + pc[3 * k + T2].powi(2);
-                    fc_rom += p[3 * k + NORMAL].powi(2);
-                    fr_rom += p[3 * k + T1].powi(2) + p[3 * k + T2].powi(2);
-                    fcj += pj[3 * k + NORMAL].powi(2);
-                    out.pair_error[k] += (pj[3 * k + NORMAL] - p[3 * k + NORMAL]).powi(2);
+                if law.friction {
+                    dissipation.push(p, &pc, &states.s[ns * j..ns * (j + 1)]);
                 }
+                let [fc, fr, fc_rom, fr_rom, fcj, frj] = out.add_output(p, &pc, &pj);
                 fc_joint.push(fcj.sqrt());
+                fr_joint.push(frj.sqrt());
                 // x_m* = C f_m − G_m q̈ − Hᵀ p* (the tangential part of p* as in the gaps: the
                 // run's).
                 let mut uy = x_hat[(1, j)];
@@ -725,8 +1018,14 @@ impl ErrorEstimator<'_> {
         }
         let [fc, fr, uy, fc_rom, fr_rom, uy_rom] = curves;
         out.joint = relative_l2(&fc_rom, &fc_joint);
+        out.joint_friction = if law.friction {
+            relative_l2(&fr_rom, &fr_joint)
+        } else {
+            None
+        };
         out.truncation = relative_l2(&fc_joint, &fc);
         out.corrected_joint_norm2 = fc_joint.iter().map(|v| v * v).sum();
+        out.corrected_joint_friction_norm2 = fr_joint.iter().map(|v| v * v).sum();
         out.errors = CurveErrors {
             contact_force: relative_l2(&fc_rom, &fc),
             friction_force: if law.friction {
@@ -735,7 +1034,13 @@ impl ErrorEstimator<'_> {
                 None
             },
             master_uy: relative_l2(&uy_rom, &uy),
+            dissipated: law
+                .friction
+                .then(|| relative_l2(&dissipation.run, &dissipation.corrected))
+                .flatten(),
+            dissipated_end: law.friction.then(|| dissipation.end_error()).flatten(),
         };
+        out.corrected_dissipated = dissipation.corrected;
         out.corrected_contact_force = fc;
         out.corrected_friction_force = fr;
         out.corrected_master_uy = uy;
@@ -786,6 +1091,9 @@ struct Corrector<'a> {
     /// The Cholesky factor of `I + k_n F_AA` for the set last solved, updated as the set
     /// changes ([`SubsetLlt`]: a few pairs in or out cost O(|A|²) each, not |A|³/3).
     factor: SubsetLlt,
+    /// The Cholesky factor of `I + k_t F_SS` for the tangential rows of the sticking pairs S
+    /// last solved ([`Corrector::tangential`]).
+    stick_factor: SubsetLlt,
     /// The flexibility columns of the pairs met so far (w entries, `None` before).
     cols: Vec<Option<Arc<[f64]>>>,
 }
@@ -825,6 +1133,7 @@ impl<'a> Corrector<'a> {
             w: flex.pairs(),
             active: vec![false; flex.pairs()],
             factor: SubsetLlt::new(),
+            stick_factor: SubsetLlt::new(),
             cols: vec![None; flex.pairs()],
         }
     }
@@ -867,7 +1176,7 @@ impl<'a> Corrector<'a> {
 
     /// The corrected pair forces `p*` (3w) from the pair kinematics `u0 = û − F_{·,t} p_t`
     /// (with the run's tangential forces as loads) and the run's forces `p`.
-    fn correct(&mut self, u0: &[f64], p: &[f64]) -> Result<Vec<f64>, Error> {
+    fn correct(&mut self, u0: &[f64], p: &[f64], s: &[f64]) -> Result<Vec<f64>, Error> {
         let w = self.w;
         let k_n = self.law.k_n;
         let g_hat: Vec<f64> = (0..w).map(|k| u0[3 * k + NORMAL]).collect();
@@ -911,28 +1220,122 @@ impl<'a> Corrector<'a> {
             pc[nrm(k)] = pk;
         }
         if self.law.friction {
-            // Coulomb: a pair's tangential force is capped by μ|p_n|. A sliding pair's force
-            // follows its corrected normal force; a sticking pair keeps its force while it fits
-            // in the corrected cone.
-            let mu = self.law.mu;
-            for k in 0..w {
-                let (pt1, pt2) = (p[3 * k + T1], p[3 * k + T2]);
-                let pt = pt1.hypot(pt2);
-                let cone = mu * pc[nrm(k)].abs();
-                let old_cone = mu * p[nrm(k)].abs();
-                let sliding = pt > 0.0 && pt >= (1.0 - 1e-9) * old_cone;
-                let scale = if pt == 0.0 {
-                    0.0
-                } else if sliding || pt > cone {
-                    cone / pt
-                } else {
-                    1.0
-                };
+            self.tangential(u0, p, s, &mut pc)?;
+        }
+        Ok(pc)
+    }
+
+    /// The corrected tangential forces (module docs, "Friction"), written into the tangential
+    /// rows of `pc` whose normal rows hold the corrected normal forces: a pair the run slides
+    /// keeps its direction on the corrected cone `μ|p_n*|`; the other closed pairs S stick with
+    /// the run's slip memory `s` (2w, mm), `p_t* = k_t (u_t* − s)` at the corrected tangential
+    /// kinematics `u_t* = û_t − F_{t,n} p_n* − F_{t,t} p_t*` — one linear pair-space solve
+    /// `(I + k_t F_SS) p_S = k_t (û_S − F_{S,n} p_n* − F_{S,L} p_L − s_S)`; a sticking pair whose
+    /// force leaves its cone slides on it, and S is solved again without it.
+    fn tangential(
+        &mut self,
+        u0: &[f64],
+        p: &[f64],
+        s: &[f64],
+        pc: &mut [f64],
+    ) -> Result<(), Error> {
+        let (w, mu, k_t) = (self.w, self.law.mu, self.law.k_t);
+        let nrm = |k: usize| 3 * k + NORMAL;
+        // Sliding in the run: on the corrected cone in the run's direction.
+        let mut stick: Vec<usize> = Vec::new();
+        for k in 0..w {
+            let (pt1, pt2) = (p[3 * k + T1], p[3 * k + T2]);
+            let pt = pt1.hypot(pt2);
+            let cone = mu * pc[nrm(k)].abs();
+            let sliding = pt > 0.0 && pt >= (1.0 - 1e-9) * mu * p[nrm(k)].abs();
+            let scale = if cone == 0.0 || pt == 0.0 {
+                0.0
+            } else {
+                cone / pt
+            };
+            if cone > 0.0 && !sliding {
+                stick.push(k);
+            } else {
                 pc[3 * k + T1] = scale * pt1;
                 pc[3 * k + T2] = scale * pt2;
             }
         }
-        Ok(pc)
+        if stick.is_empty() || k_t <= 0.0 {
+            return Ok(());
+        }
+        for _ in 0..=w {
+            for &k in &stick {
+                pc[3 * k + T1] = 0.0;
+                pc[3 * k + T2] = 0.0;
+            }
+            let rows: Vec<usize> = stick
+                .iter()
+                .flat_map(|&k| [3 * k + T1, 3 * k + T2])
+                .collect();
+            let loaded: Vec<usize> = (0..3 * w)
+                .filter(|&r| r % 3 != NORMAL && pc[r] != 0.0)
+                .collect();
+            let cols = self.flex.tangential_columns(&rows)?;
+            let loads = self.flex.tangential_columns(&loaded)?;
+            // Tangential row r of pair k sits at 2k (t1) or 2k + 1 (t2) of a column's
+            // tangential rows and of the slip memory.
+            let t_at = |r: usize| 2 * (r / 3) + (r % 3 - 1);
+            let mut rhs: Vec<f64> = rows
+                .iter()
+                .zip(&cols)
+                .map(|(&r, (normal, _))| {
+                    let from_normal: f64 = (0..w).map(|k| normal[k] * pc[nrm(k)]).sum();
+                    let from_sliding: f64 = loaded
+                        .iter()
+                        .zip(&loads)
+                        .map(|(&l, (_, t))| t[t_at(r)] * pc[l])
+                        .sum();
+                    k_t * (u0[r] - from_normal - from_sliding - s[t_at(r)])
+                })
+                .collect();
+            // The factor's indices are the positions t_at(r) (2w of them).
+            let index: Vec<usize> = rows.iter().map(|&r| t_at(r)).collect();
+            let mut col_of = vec![usize::MAX; 2 * w];
+            for (c, &i) in index.iter().enumerate() {
+                col_of[i] = c;
+            }
+            self.stick_factor
+                .update(&index, |i, j| {
+                    let d = if i == j { 1.0 } else { 0.0 };
+                    d + k_t * 0.5 * (cols[col_of[j]].1[i] + cols[col_of[i]].1[j])
+                })
+                .map_err(|e| {
+                    Error::LinearAlgebra(LinalgError::ContactMatrix {
+                        pairs: stick.len(),
+                        source: Box::new(e),
+                    })
+                })?;
+            let order = self.stick_factor.order().to_vec();
+            let mut x: Vec<f64> = order.iter().map(|&i| rhs[col_of[i]]).collect();
+            self.stick_factor.solve_in_place(&mut x);
+            for (&i, v) in order.iter().zip(&x) {
+                rhs[col_of[i]] = *v;
+            }
+            let mut left = Vec::with_capacity(stick.len());
+            for (c, &k) in stick.iter().enumerate() {
+                let (f1, f2) = (rhs[2 * c], rhs[2 * c + 1]);
+                let (f, cone) = (f1.hypot(f2), mu * pc[nrm(k)].abs());
+                let scale = if f > cone { cone / f } else { 1.0 };
+                pc[3 * k + T1] = scale * f1;
+                pc[3 * k + T2] = scale * f2;
+                if f <= cone {
+                    left.push(k);
+                }
+            }
+            if left.len() == stick.len() {
+                break;
+            }
+            stick = left;
+            if stick.is_empty() {
+                break;
+            }
+        }
+        Ok(())
     }
 }
 

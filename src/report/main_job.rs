@@ -73,6 +73,11 @@ pub fn write_report(
     for f in speed_chart(report, dir)? {
         report.files.push(relative(dir, &f));
     }
+    if let Some(c) = hysteresis_chart(report) {
+        for f in c.write(&dir.join("hysteresis"))? {
+            report.files.push(relative(dir, &f));
+        }
+    }
     // Joint modes: VTU for ParaView and the picture of the first four.
     let shape_dir = dir.join("shapes");
     let sh = crate::report::shapes::shapes(model, BasisOptions::default().nu, 12)?;
@@ -152,7 +157,7 @@ fn time_charts(rep: &Report, dir: &Path) -> Result<Vec<PathBuf>, Error> {
         shown.push(h);
     }
     let mut files = Vec::new();
-    let quantities: [(&str, &str, &str, &str, Curve); 3] = [
+    let quantities: [(&str, &str, &str, &str, Curve); 4] = [
         (
             "fc",
             "contact force norm ‖f_c‖",
@@ -170,6 +175,13 @@ fn time_charts(rep: &Report, dir: &Path) -> Result<Vec<PathBuf>, Error> {
         ("uy", "master displacement u_y", "u_y (mm)", "mm", |r| {
             &r.curves.master_uy
         }),
+        (
+            "dissipated",
+            "dissipated energy D of the joint",
+            "D (N·mm)",
+            "N·mm",
+            |r| &r.curves.dissipated,
+        ),
     ];
     for (stem, what, axis, unit, get) in quantities {
         files.extend(
@@ -181,6 +193,34 @@ fn time_charts(rep: &Report, dir: &Path) -> Result<Vec<PathBuf>, Error> {
         }
     }
     Ok(files)
+}
+
+/// The joint's hysteresis at the pair that dissipates most: tangential force against relative
+/// tangential displacement, full run and headline model.
+fn hysteresis_chart(rep: &Report) -> Option<LineChart> {
+    let h = rep.hysteresis.as_ref()?;
+    let mut c = LineChart::new(
+        format!(
+            "{}: hysteresis of pair {} (dissipates most: {:.3e} N·mm in the full run)",
+            rep.case, h.pair, h.dissipated
+        ),
+        "relative tangential displacement (mm)",
+        "tangential force (N)",
+    );
+    c.legend = LegendPosition::UpperRight;
+    let headline = rep.headline.and_then(|i| rep.runs.get(i));
+    for (label, pts) in [
+        (format!("full FE ({} DOF)", rep.dofs), &h.full),
+        (
+            headline.map_or("headline model".into(), |r| run_label(rep, r)),
+            &h.reduced,
+        ),
+    ] {
+        let mut s = Series::new(label, pts.clone());
+        s.markers = false;
+        c.series.push(s);
+    }
+    Some(c)
 }
 
 /// The legend text of a run in the time charts.
@@ -452,11 +492,21 @@ fn markdown(rep: &Report, stab: &Path, stability: bool) -> String {
         ("fc", "contact force norm"),
         ("fr", "friction force norm"),
         ("uy", "master displacement"),
+        ("dissipated", "dissipated energy D of the joint"),
     ] {
         let _ = writeln!(s, "![{what}]({stem}_t.png)\n");
         if rep.files.iter().any(|f| *f == format!("{stem}_err_t.png")) {
             let _ = writeln!(s, "![error of the {what}]({stem}_err_t.png)\n");
         }
+    }
+    if rep.files.iter().any(|f| f == "hysteresis.png") {
+        let _ = writeln!(
+            s,
+            "The joint's dissipated energy D(t) and the hysteresis of the pair that dissipates \
+             most (tangential force against relative tangential displacement along its main \
+             direction of friction), full FE against the headline model:\n\n\
+             ![hysteresis](hysteresis.png)\n"
+        );
     }
     let _ = writeln!(s, "## Speed against accuracy\n");
     let _ = writeln!(
@@ -517,23 +567,32 @@ fn headline(s: &mut String, rep: &Report) {
     let Some(h) = rep.headline.and_then(|i| rep.runs.get(i)) else {
         let _ = writeln!(
             s,
-            "**Headline reduced model** (tolerance {tol:.0e} on ‖f_c‖(t)): could not be built or run \
-             — see the `adaptive` row below.\n"
+            "**Headline reduced model** (tolerance {tol:.0e} on ‖f_c‖, ‖f_R‖, u_y and D): could not \
+             be built or run — see the `adaptive` row below.\n"
         );
         return;
     };
-    let est = h.estimate.as_ref().and_then(|e| e.total.contact_force);
+    let est = |f: fn(&crate::reduction::CurveErrors) -> Option<f64>| {
+        fmt_opt(h.estimate.as_ref().and_then(|e| f(&e.total)), 2)
+    };
     let _ = writeln!(
         s,
-        "**Headline reduced model** (tolerance {tol:.0e} on ‖f_c‖(t)): Craig–Bampton + the attachment \
-         modes of {} pairs, r = {}; ‖f_c‖(t) error {} (estimated {}), u_y {}, ‖f_R‖ {}; {:.2} s \
-         to build, {:.3} s CPU to run ({} of the full run's CPU).",
+        "**Headline reduced model** (tolerance {tol:.0e} on ‖f_c‖, ‖f_R‖, u_y and D): Craig–Bampton \
+         + the attachment modes of {} pairs, r = {}; errors against the full run (estimated): \
+         ‖f_c‖(t) {} ({}), ‖f_R‖(t) {} ({}), u_y {} ({}), D(t) {} ({}), D at the end {} ({}); \
+         {:.2} s to build, {:.3} s CPU to run ({} of the full run's CPU).",
         h.g.unwrap_or(0),
         h.size,
         fmt_opt(h.error_fc, 2),
-        fmt_opt(est, 2),
-        fmt_opt(h.error_uy, 2),
+        est(|e| e.contact_force),
         fmt_opt(h.error_fr, 2),
+        est(|e| e.friction_force),
+        fmt_opt(h.error_uy, 2),
+        est(|e| e.master_uy),
+        fmt_opt(h.error_d, 2),
+        est(|e| e.dissipated),
+        fmt_opt(h.error_d_end, 2),
+        est(|e| e.dissipated_end),
         h.build_s,
         h.cpu_s,
         h.cpu_percent.map_or("–".into(), |p| format!("{p:.2} %")),

@@ -62,9 +62,10 @@ pub fn build_rom(
                 tolerance: None,
             })
         }
-        &ModelSpec::Tolerance { tolerance, nu } => {
+        &ModelSpec::Tolerance { tolerance, nu, on } => {
             let mut opts = ToleranceOptions::new(tolerance);
             opts.nu = nu;
+            opts.quantities = on;
             opts.transient = transient.clone();
             let t = tolerance_model(model, &opts)?;
             let info = BasisInfo {

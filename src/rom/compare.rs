@@ -36,6 +36,8 @@ pub struct JointCurves {
     pub friction_force_norm: Vec<f64>,
     /// Master u_y, mm.
     pub master_uy: Vec<f64>,
+    /// The joint's dissipated energy D, N·mm (empty: a reference made before it was stored).
+    pub dissipated: Vec<f64>,
 }
 
 /// The relative L2 errors of a run against a reference (module docs); `None` where the
@@ -48,6 +50,10 @@ pub struct ReferenceErrors {
     pub friction_force: Option<f64>,
     /// Master u_y(t).
     pub master_uy: Option<f64>,
+    /// The dissipated energy D(t) (`None`: not in the reference, or zero).
+    pub dissipated: Option<f64>,
+    /// D at the last compared time: `|D(T) − D_ref(T)| / |D_ref(T)|`.
+    pub dissipated_end: Option<f64>,
     /// Output times compared (shared by the run and the reference).
     pub compared_outputs: usize,
     /// Last compared time, s.
@@ -69,6 +75,7 @@ impl From<Curves> for JointCurves {
             contact_force_norm: c.contact_force_norm,
             friction_force_norm: c.friction_force_norm,
             master_uy: c.master_uy,
+            dissipated: c.dissipated,
         }
     }
 }
@@ -81,9 +88,12 @@ impl JointCurves {
     pub fn errors_against(&self, reference: &JointCurves) -> ReferenceErrors {
         reference.errors_of(
             &self.t,
-            &self.contact_force_norm,
-            &self.friction_force_norm,
-            &self.master_uy,
+            [
+                &self.contact_force_norm,
+                &self.friction_force_norm,
+                &self.master_uy,
+                &self.dissipated,
+            ],
         )
     }
 
@@ -146,6 +156,7 @@ impl JointCurves {
         }
         let [t, fc, fr, uy] = cols;
         JointCurves::checked(t, fc, fr, uy, what)
+            .map(|c| c.with_dissipated(optional_csv_column(text, "dissipated")))
     }
 
     /// Parses the compact JSON form (`cases/reference/compact.py`).
@@ -171,6 +182,11 @@ impl JointCurves {
                 })
                 .collect()
         };
+        let dissipated = if v.get("dissipated").is_some() {
+            arr("dissipated")?
+        } else {
+            Vec::new()
+        };
         JointCurves::checked(
             arr(COLUMNS[0])?,
             arr(COLUMNS[1])?,
@@ -178,6 +194,23 @@ impl JointCurves {
             arr(COLUMNS[3])?,
             what,
         )
+        .and_then(|c| {
+            if dissipated.is_empty() || dissipated.len() == c.t.len() {
+                Ok(c.with_dissipated(dissipated))
+            } else {
+                Err(bad(ReferenceProblem::Lengths))
+            }
+        })
+    }
+
+    /// These curves with the dissipated energy `d` (empty or one value per output).
+    fn with_dissipated(mut self, d: Vec<f64>) -> JointCurves {
+        self.dissipated = if d.len() == self.t.len() {
+            d
+        } else {
+            Vec::new()
+        };
+        self
     }
 
     fn checked(
@@ -216,6 +249,7 @@ impl JointCurves {
             contact_force_norm,
             friction_force_norm,
             master_uy,
+            dissipated: Vec::new(),
         })
     }
 
@@ -223,20 +257,28 @@ impl JointCurves {
     pub fn errors(&self, c: &Curves) -> ReferenceErrors {
         self.errors_of(
             &c.t,
-            &c.contact_force_norm,
-            &c.friction_force_norm,
-            &c.master_uy,
+            [
+                &c.contact_force_norm,
+                &c.friction_force_norm,
+                &c.master_uy,
+                &c.dissipated,
+            ],
         )
     }
 
-    /// The errors of the curves `fc`, `fr`, `uy` at times `t` against these.
-    fn errors_of(&self, t: &[f64], fc: &[f64], fr: &[f64], uy: &[f64]) -> ReferenceErrors {
+    /// The errors of the curves `[fc, fr, uy, D]` at times `t` against these (D may be empty).
+    fn errors_of(&self, t: &[f64], [fc, fr, uy, d]: [&[f64]; 4]) -> ReferenceErrors {
         let l2 = |a: &[f64], r: &[f64]| relative_l2(t, a, &self.t, r);
         let (count, until) = self.shared_times(t);
+        let with_d = !d.is_empty() && d.len() == t.len() && !self.dissipated.is_empty();
         ReferenceErrors {
             contact_force: l2(fc, &self.contact_force_norm),
             friction_force: l2(fr, &self.friction_force_norm),
             master_uy: l2(uy, &self.master_uy),
+            dissipated: with_d.then(|| l2(d, &self.dissipated)).flatten(),
+            dissipated_end: with_d
+                .then(|| relative_at(t, d, &self.t, &self.dissipated, until))
+                .flatten(),
             compared_outputs: count,
             compared_until: until,
         }
@@ -264,6 +306,48 @@ impl JointCurves {
         }
         (count, last)
     }
+}
+
+/// `|a(t) − r(t)| / |r(t)|` at the time `t` of both curves (matched as in [`relative_l2`];
+/// `None` where either has no output there or the reference is zero).
+fn relative_at(t_a: &[f64], a: &[f64], t_ref: &[f64], reference: &[f64], t: f64) -> Option<f64> {
+    let near = |ts: &[f64]| {
+        let i = ts.partition_point(|&x| x < t);
+        [i.checked_sub(1), Some(i)]
+            .into_iter()
+            .flatten()
+            .filter(|&i| i < ts.len())
+            .min_by(|&i, &j| (ts[i] - t).abs().total_cmp(&(ts[j] - t).abs()))
+    };
+    let (i, j) = (near(t_a)?, near(t_ref)?);
+    let gap = (t_a[i] - t).abs().max((t_ref[j] - t).abs());
+    (reference[j] != 0.0 && gap <= 1e-9 * t.abs().max(1e-12))
+        .then(|| (a[i] - reference[j]).abs() / reference[j].abs())
+}
+
+/// An optional CSV column of `text` by name (empty if absent or not all finite numbers).
+fn optional_csv_column(text: &str, name: &str) -> Vec<f64> {
+    let mut r = csv::ReaderBuilder::new()
+        .trim(csv::Trim::All)
+        .from_reader(text.as_bytes());
+    let Some(i) = r
+        .headers()
+        .ok()
+        .and_then(|h| h.iter().position(|h| h == name))
+    else {
+        return Vec::new();
+    };
+    let values: Option<Vec<f64>> = r
+        .records()
+        .map(|rec| {
+            rec.ok()?
+                .get(i)?
+                .parse::<f64>()
+                .ok()
+                .filter(|v| v.is_finite())
+        })
+        .collect();
+    values.unwrap_or_default()
 }
 
 /// Relative L2 difference of `a` against `reference` over the times of `a` that the reference
@@ -328,6 +412,25 @@ mod tests {
         assert!((e.contact_force.unwrap() - 0.1).abs() < 1e-12, "{e:?}");
         assert!((e.friction_force.unwrap() - 0.1).abs() < 1e-12);
         assert_eq!((e.compared_outputs, e.compared_until), (3, 2e-4));
+    }
+
+    #[test]
+    fn dissipated_energy_is_compared_where_the_reference_has_it() {
+        let json = r#"{"t":[0,1,2],"contact_force_norm":[0,1,1],"friction_force_norm":[0,1,1],
+                       "master_uy":[0,1,1],"dissipated":[0,1,2]}"#;
+        let r = JointCurves::parse_json(json, "f.json").unwrap();
+        let mut run = curves(&r.t, |x| x.min(1.0));
+        run.friction_force_norm = r.friction_force_norm.clone();
+        run.dissipated = vec![0.0, 1.0, 2.2];
+        let e = r.errors(&run);
+        let l2 = (0.04f64 / 5.0).sqrt();
+        assert!((e.dissipated.unwrap() - l2).abs() < 1e-12, "{e:?}");
+        assert!((e.dissipated_end.unwrap() - 0.1).abs() < 1e-12, "{e:?}");
+        let without = JointCurves::parse_csv(CSV, "f.csv").unwrap();
+        assert_eq!(without.errors(&run).dissipated, None);
+        let short = json.replace("[0,1,2]}", "[0,1]}");
+        let e = JointCurves::parse_json(&short, "f.json").unwrap_err();
+        assert!(e.to_string().contains("different lengths"), "{e}");
     }
 
     #[test]

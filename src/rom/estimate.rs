@@ -14,7 +14,8 @@
 //!   error model.
 //!
 //! Each part is a relative L2 error of a curve over the output times ([`super::compare`]):
-//! ‖f_c‖(t), ‖f_R‖(t) with friction, master u_y(t).
+//! ‖f_c‖(t), ‖f_R‖(t) with friction, master u_y(t), and with friction the dissipated energy
+//! D(t) (also its relative error at the end of the run).
 //!
 //! The estimator's setup, the integration check and the flexibility columns the estimate needs
 //! do not depend on the run, so [`run_estimated`] computes them on a second rayon job beside the
@@ -157,7 +158,25 @@ pub fn integration_errors_from(check: &Run, run: &Run, opts: &TransientOptions) 
             None
         },
         master_uy: diff(&a.master_uy, &b.master_uy),
+        dissipated: if opts.problem.friction {
+            diff(&a.dissipated, &b.dissipated)
+        } else {
+            None
+        },
+        dissipated_end: if opts.problem.friction {
+            end_difference(&a.dissipated, &b.dissipated).map(|d| d * scale)
+        } else {
+            None
+        },
     }
+}
+
+/// `|a(T) − b(T)| / |b(T)|` at the last output of the shorter curve (`None` if `b` is zero
+/// there).
+fn end_difference(a: &[f64], b: &[f64]) -> Option<f64> {
+    let n = a.len().min(b.len());
+    let (x, y) = (*a.get(n.checked_sub(1)?)?, b[n - 1]);
+    (y != 0.0).then(|| (x - y).abs() / y.abs())
 }
 
 /// Runs `second` as a job of rayon's pool while `main` runs on this thread, and returns both

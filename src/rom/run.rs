@@ -9,7 +9,7 @@ use std::time::Instant;
 use crate::error::{Error, RomError};
 use crate::integrate::{self as driver, integrate, Run, TransientOptions};
 use crate::model::Model;
-use crate::reduction::{build_basis, BasisOptions, JointFlexibility};
+use crate::reduction::{build_basis, BasisOptions, JointFlexibility, Quantities};
 use crate::rom::estimate::{run_estimated, RunEstimate};
 use crate::rom::file::RomFile;
 use crate::rom::spec::ModelSpec;
@@ -130,8 +130,8 @@ pub fn run_model(
             Ok(o)
         }
         ModelSpec::File(path) => run_file(model, path, opts, every),
-        &ModelSpec::Tolerance { tolerance, nu } => {
-            run_tolerance(model, tolerance, nu, opts, settings)
+        &ModelSpec::Tolerance { tolerance, nu, on } => {
+            run_tolerance(model, tolerance, nu, on, opts, settings)
         }
     }
 }
@@ -141,16 +141,20 @@ fn run_tolerance(
     model: &Model,
     tolerance: f64,
     nu: usize,
+    on: Option<Quantities>,
     opts: &TransientOptions,
     settings: &RunSettings,
 ) -> Result<ModelRun, Error> {
     let every = settings.keep_every;
     let mut topts = ToleranceOptions::new(tolerance);
     topts.nu = nu;
+    topts.quantities = on;
     topts.transient = opts.clone();
     topts.integration = settings.integration;
     let ToleranceModel {
         pairs,
+        tangential,
+        quantities,
         nu,
         setup_s,
         rom,
@@ -182,6 +186,8 @@ fn run_tolerance(
             tolerance,
             met,
             pairs,
+            tangential_pairs: tangential,
+            quantities,
             nu,
             setup_s,
             estimate_s,

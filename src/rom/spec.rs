@@ -8,7 +8,7 @@
 use std::path::PathBuf;
 
 use crate::error::{Error, RomError};
-use crate::reduction::BasisKind;
+use crate::reduction::{BasisKind, Quantities, Quantity};
 
 /// Which model to build and run.
 #[derive(Clone, Debug, PartialEq)]
@@ -44,6 +44,9 @@ pub enum ModelSpec {
         tolerance: f64,
         /// Fixed-interface modes ν to start from.
         nu: usize,
+        /// The quantities the tolerance holds for (`--tolerance-on`); `None`: all that the
+        /// run produces (‖f_R‖ and D need friction).
+        on: Option<Quantities>,
     },
     /// A reduced model written by `jointrom export` (schema `jointrom-rom`).
     File(PathBuf),
@@ -124,6 +127,30 @@ pub struct ModelFlags {
     /// TOL (in (0, 1); e.g. 1e-2): `--model adaptive`, the default with this flag.
     #[arg(long, allow_negative_numbers = true)]
     pub tolerance: Option<f64>,
+    /// What --tolerance holds for: a comma-separated list of fc (|f_c|(t)), fr (|f_R|(t)), uy
+    /// (the master's u_y(t)) and dissipation (the joint's dissipated energy D(t): over the run
+    /// and at its end). Default: all four (fc and uy with friction off).
+    #[arg(long, value_name = "LIST")]
+    pub tolerance_on: Option<String>,
+}
+
+/// The quantities of a `--tolerance-on` list (module docs of [`ModelFlags`]).
+///
+/// # Errors
+/// An empty list or an unknown name, naming `--tolerance-on`.
+pub fn parse_tolerance_on(list: &str) -> Result<Quantities, Error> {
+    let mut found = Vec::new();
+    for name in list.split(',').map(str::trim).filter(|n| !n.is_empty()) {
+        found.push(
+            Quantity::from_name(name).ok_or_else(|| RomError::ToleranceOnName {
+                name: crate::files::printable(name).to_string(),
+            })?,
+        );
+    }
+    if found.is_empty() {
+        return Err(RomError::ToleranceOnEmpty.into());
+    }
+    Ok(Quantities::of(&found))
 }
 
 impl ModelFlags {
@@ -152,6 +179,11 @@ impl ModelFlags {
             (None, None) => None,
         };
         let nu = self.nu;
+        let on = match (&self.tolerance_on, self.tolerance) {
+            (Some(_), None) => return Err(RomError::ToleranceOnWithout.into()),
+            (Some(list), Some(_)) => Some(parse_tolerance_on(list)?),
+            (None, _) => None,
+        };
         if let Some(tolerance) = self.tolerance {
             let named = match (&self.model, self.basis) {
                 (Some(m), _) => Some(format!("--model {m}")),
@@ -164,7 +196,7 @@ impl ModelFlags {
                         return Err(RomError::ToleranceAndG.into());
                     }
                     super::tolerance::check_tolerance(tolerance)?;
-                    Ok(ModelSpec::Tolerance { tolerance, nu })
+                    Ok(ModelSpec::Tolerance { tolerance, nu, on })
                 }
                 Some(_) => Err(RomError::ToleranceModel {
                     model: named.unwrap_or_default(),
@@ -225,6 +257,7 @@ mod tests {
             g,
             nu: DEFAULT_NU,
             tolerance,
+            tolerance_on: None,
         }
     }
 
@@ -252,7 +285,8 @@ mod tests {
             flags(None, None, Some(0.01)).spec(tvd.clone()).unwrap(),
             ModelSpec::Tolerance {
                 tolerance: 0.01,
-                nu: 10
+                nu: 10,
+                on: None
             }
         );
         assert_eq!(
@@ -286,6 +320,26 @@ mod tests {
             ..flags(Some("tvd"), None, None)
         };
         assert!(err(both).contains("--basis"));
+        let on = |list: &str, tol: Option<f64>| ModelFlags {
+            tolerance_on: Some(list.to_string()),
+            ..flags(None, None, tol)
+        };
+        assert!(
+            err(on("fc,bogus", Some(0.01))).contains("--tolerance-on: unknown quantity `bogus`")
+        );
+        assert!(err(on(" , ", Some(0.01))).contains("--tolerance-on: the list is empty"));
+        assert!(err(on("fc", None)).contains("--tolerance-on"));
+        assert_eq!(
+            on("fr, dissipation", Some(0.01)).spec(tvd.clone()).unwrap(),
+            ModelSpec::Tolerance {
+                tolerance: 0.01,
+                nu: 10,
+                on: Some(Quantities::of(&[
+                    Quantity::FrictionForce,
+                    Quantity::Dissipation
+                ]))
+            }
+        );
         assert!(flags(None, Some(2), None)
             .spec(ModelSpec::Full)
             .unwrap_err()

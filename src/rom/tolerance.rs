@@ -1,6 +1,16 @@
 //! Error-controlled reduction: a tolerance on the joint forces in, the smallest reduced model that
 //! meets it out, with the estimate of [`super::estimate`] attached to every reduced run.
 //!
+//! The tolerance holds for the quantities of [`ToleranceOptions::quantities`] — by default
+//! ‖f_c‖(t), ‖f_R‖(t), the master's u_y(t) and the dissipated energy D(t) (the last two need
+//! friction): the rounds below run until the reduction estimate of each is within TOL. The
+//! rules are written for ‖f_c‖; ‖f_R‖ and D add **tangential attachment modes**
+//! `K⁻¹ B_{t,k}ᵀ d_k` by the same selection on the tangential shares
+//! `e_{t,k} = Σ_t |p_{t,k} − p_{t,k}*|²` ([`Estimate::pair_tangential_error`]), first in the
+//! pair's main direction of friction, later across it, and only in rounds that add no normal
+//! modes (the friction cone follows the normal force). With ‖f_R‖ or D controlled the
+//! integration starts ten times tighter ([`integration_looseness_for`]).
+//!
 //! ## Why not the paper's w(g)
 //!
 //! Every TVD column is a static response to loads on the pairs that close, so the TVD span is the
@@ -71,8 +81,11 @@ use crate::integrate::{Run, TransientOptions};
 use crate::joint::statics::ContactOptions;
 use crate::model::Model;
 use crate::reduction::estimate::TRUNCATION_MODES;
+#[cfg(doc)]
+use crate::reduction::Estimate;
 use crate::reduction::{
-    craig_bampton, final_basis, modal_rotation, Estimate, JointFlexibility, DEFAULT_DROP_TOL,
+    craig_bampton, final_basis, modal_rotation, CurveErrors, JointFlexibility, Quantities,
+    Quantity, DEFAULT_DROP_TOL,
 };
 use crate::rom::estimate::{beside, loosened, run_estimated, RunEstimate};
 use crate::rom::statics::{reduced_contact_static_restarting, scaled_load, ReducedStatic};
@@ -85,7 +98,7 @@ pub const SELECTION_MARGIN: f64 = 0.5;
 /// Options of [`tolerance_model`].
 #[derive(Clone, Debug)]
 pub struct ToleranceOptions {
-    /// The tolerance on the relative L2 error of ‖f_c‖(t), in (0, 1).
+    /// The tolerance on the relative L2 errors of the controlled quantities, in (0, 1).
     pub tolerance: f64,
     /// Fixed-interface modes ν of the Craig–Bampton part.
     pub nu: usize,
@@ -96,6 +109,9 @@ pub struct ToleranceOptions {
     /// Whether the integration tolerances follow the tolerance ([`integration_looseness`]) or are
     /// `transient`'s as given.
     pub integration: IntegrationTolerances,
+    /// The quantities the tolerance holds for (`None`: all the run produces,
+    /// [`controlled_quantities`]).
+    pub quantities: Option<Quantities>,
 }
 
 /// Where the tolerance model's rtol and atol come from.
@@ -119,6 +135,23 @@ pub fn integration_looseness(tol: f64) -> f64 {
     (tol / 1e-4).clamp(1.0, 1e4)
 }
 
+/// [`integration_looseness`] for the quantities `on`: ten times tighter when ‖f_R‖ or D is
+/// controlled, `s = clamp(tol / 1e-3, 1, 1e4)`. The friction force is the quantity most
+/// sensitive to the integration: a sticking pair's force is `k_t` times an elastic stretch of
+/// 1e-6 mm, and at rtol 1e-6 the stick–slip transitions are resolved only to a few per cent of
+/// ‖f_R‖ (friction bar: the 1 % model's ‖f_R‖(t) moves by 1–2 % between rtol 1e-6 and 1e-7).
+/// A run that noisy would read its integration noise as reduction error — the quasi-static
+/// correction is smooth where the run rings — and the rounds would add attachment modes and
+/// fixed-interface modes that remove nothing.
+pub fn integration_looseness_for(tol: f64, on: Quantities) -> f64 {
+    let friction = on.contains(Quantity::FrictionForce) || on.contains(Quantity::Dissipation);
+    if friction {
+        (tol / 1e-3).clamp(1.0, 1e4)
+    } else {
+        integration_looseness(tol)
+    }
+}
+
 impl ToleranceOptions {
     /// ν = 10 (the paper), the default transient options, at most 8 rounds.
     pub fn new(tolerance: f64) -> ToleranceOptions {
@@ -128,6 +161,7 @@ impl ToleranceOptions {
             transient: TransientOptions::default(),
             max_rounds: 8,
             integration: IntegrationTolerances::FromTolerance,
+            quantities: None,
         }
     }
 }
@@ -137,14 +171,20 @@ impl ToleranceOptions {
 pub struct Round {
     /// Pairs whose attachment modes the basis held.
     pub pairs: usize,
+    /// Tangential attachment modes the basis held.
+    pub tangential_pairs: usize,
     /// Fixed-interface modes ν of the basis.
     pub nu: usize,
     /// Basis size r.
     pub basis_size: usize,
     /// The estimated relative L2 error of ‖f_c‖(t) (reduction part).
     pub estimate: Option<f64>,
+    /// The estimated relative L2 error of ‖f_R‖(t) (reduction part; `None` without friction).
+    pub friction_estimate: Option<f64>,
     /// Its joint part (what more pairs remove).
     pub joint: Option<f64>,
+    /// The joint part of the ‖f_R‖(t) estimate (what more tangential attachment modes remove).
+    pub joint_friction: Option<f64>,
     /// Its truncation part (what more fixed-interface modes remove).
     pub truncation: Option<f64>,
     /// Wall time of the round's run, s.
@@ -161,6 +201,11 @@ pub struct Round {
 pub struct ToleranceModel {
     /// The chosen pairs (indices into the model's joint pairs), ascending.
     pub pairs: Vec<usize>,
+    /// The pairs whose tangential attachment modes the basis holds, in the order added (a pair
+    /// twice: both tangential directions).
+    pub tangential: Vec<usize>,
+    /// The quantities the tolerance held for.
+    pub quantities: Quantities,
     /// The chosen number of fixed-interface modes ν.
     pub nu: usize,
     /// Wall time of the setup (the joint flexibility with its factorization and modes,
@@ -172,7 +217,7 @@ pub struct ToleranceModel {
     pub run: Run,
     /// Its estimate (reduction and integration parts).
     pub estimate: RunEstimate,
-    /// Whether the estimate (both parts) meets the tolerance.
+    /// Whether the estimates (both parts) of every controlled quantity meet the tolerance.
     pub met: bool,
     /// Every round, the last one the result.
     pub rounds: Vec<Round>,
@@ -195,6 +240,11 @@ pub struct ToleranceChoice {
     pub met: bool,
     /// The chosen pairs (indices into the model's joint pairs), ascending.
     pub pairs: Vec<usize>,
+    /// The pairs whose tangential attachment modes the basis holds, in the order added.
+    pub tangential_pairs: Vec<usize>,
+    /// The quantities the tolerance held for (`--tolerance-on`): names `fc`, `fr`, `uy`,
+    /// `dissipation`.
+    pub quantities: Quantities,
     /// The chosen number of fixed-interface modes ν.
     pub nu: usize,
     /// Wall time of the setup, s.
@@ -209,32 +259,34 @@ pub struct ToleranceChoice {
     pub atol: f64,
 }
 
-/// Builds the smallest Craig–Bampton + pair-attachment-mode model whose estimated ‖f_c‖(t)
-/// error meets `opts.tolerance` (module docs).
+/// Builds the smallest Craig–Bampton + pair-attachment-mode model whose estimated errors of the
+/// quantities `opts.quantities` meet `opts.tolerance` (module docs).
 ///
 /// # Errors
-/// A tolerance outside (0, 1) or not finite ([`RomError::Tolerance`] naming it), a failing basis, a
-/// run that does not finish or an estimate that cannot be made.
+/// A tolerance outside (0, 1) or not finite ([`RomError::Tolerance`] naming it), a quantity the
+/// run cannot produce ([`RomError::ToleranceOnFriction`]), a failing basis, a run that does not
+/// finish or an estimate that cannot be made.
 pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<ToleranceModel, Error> {
     let tol = opts.tolerance;
     check_tolerance(tol)?;
+    let on = controlled_quantities(opts.quantities, opts.transient.problem.friction)?;
     let start = Instant::now();
     let mut nu = opts.nu;
     let (flex, cb) = beside(|| JointFlexibility::new(model), || craig_bampton(model, nu));
     let (flex, mut cb) = (flex?, cb?);
     let setup_s = start.elapsed().as_secs_f64();
-    let mut pairs: Vec<usize> = Vec::new();
+    let mut chosen = Chosen::default();
     let mut rounds = Vec::new();
     // The Craig–Bampton round only ranks the pairs: looser tolerances (module docs).
     let mut ranking = true;
     // The integration tolerances: the user's, or the paper's times s (integration_looseness).
     let mut looseness = match opts.integration {
-        IntegrationTolerances::FromTolerance => integration_looseness(tol),
+        IntegrationTolerances::FromTolerance => integration_looseness_for(tol, on),
         IntegrationTolerances::Given => 1.0,
     };
     loop {
         let round_start = Instant::now();
-        let rom = reduced_on_pairs(model, &cb, &flex, &pairs)?;
+        let rom = reduced_on(model, &cb, &flex, &chosen)?;
         let basis_s = round_start.elapsed().as_secs_f64();
         let transient = loosened(
             &opts.transient,
@@ -253,14 +305,17 @@ pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<Toleran
         )?;
         let run = run.into_result()?;
         let estimate = estimate?;
-        let eta = estimate.reduction.contact_force.unwrap_or(0.0);
+        let eta = worst(&estimate.reduction, on);
         let d = &estimate.detail;
         rounds.push(Round {
-            pairs: pairs.len(),
+            pairs: chosen.pairs.len(),
+            tangential_pairs: chosen.tangential.len(),
             nu,
             basis_size: rom.dim(),
             estimate: estimate.reduction.contact_force,
+            friction_estimate: estimate.reduction.friction_force,
             joint: d.joint,
+            joint_friction: d.joint_friction,
             truncation: d.truncation,
             wall_s: run.wall_s,
             basis_s,
@@ -269,16 +324,10 @@ pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<Toleran
         });
         let mut changed = false;
         if eta > tol && rounds.len() < opts.max_rounds {
-            let part = SELECTION_MARGIN * tol;
-            if d.joint.unwrap_or(0.0) > part {
-                if let Some(add) = more_pairs(d, &pairs, tol, cb.ncols()) {
-                    pairs.extend(add);
-                    pairs.sort_unstable();
-                    changed = true;
-                }
-            }
+            changed = chosen.enrich(&estimate, on, tol, cb.ncols());
             // The truncated modes are driven by the run's contact forces: while those are wrong
             // the truncation part is too, so ν grows only once the joint part is within its share.
+            let part = SELECTION_MARGIN * tol;
             if !changed && d.truncation.unwrap_or(0.0) > part && nu + NU_STEP <= max_nu(model) {
                 nu += NU_STEP;
                 cb = craig_bampton(model, nu)?;
@@ -292,8 +341,8 @@ pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<Toleran
         }
         // The estimate misses the tolerance at loosened integration tolerances: the same model
         // again, ten times tighter (the reduction part is within its share, or the loop would
-        // have added pairs).
-        let total = estimate.total.contact_force.unwrap_or(0.0);
+        // have enriched the basis).
+        let total = worst(&estimate.total, on);
         if !changed && looseness > 1.0 && estimate.integration.is_some() && total > tol {
             looseness = (looseness / 10.0).max(1.0);
             continue;
@@ -302,12 +351,14 @@ pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<Toleran
             let offline_s = (round_start - start).as_secs_f64() + basis_s;
             let estimate_s = rounds.last().map_or(0.0, |r| r.estimate_s);
             return Ok(ToleranceModel {
-                pairs,
+                pairs: chosen.pairs,
+                tangential: chosen.tangential,
+                quantities: on,
                 nu,
                 setup_s,
                 rom,
                 run,
-                met: estimate.total.contact_force.unwrap_or(0.0) <= tol,
+                met: total <= tol,
                 estimate,
                 rounds,
                 offline_s,
@@ -316,6 +367,121 @@ pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<Toleran
             });
         }
     }
+}
+
+/// The quantities a tolerance model controls: `asked` (`None`: all the run produces), checked
+/// against the run (‖f_R‖ and D need friction).
+///
+/// # Errors
+/// [`RomError::ToleranceOnFriction`] for ‖f_R‖ or D asked of a run without friction.
+pub fn controlled_quantities(
+    asked: Option<Quantities>,
+    friction: bool,
+) -> Result<Quantities, Error> {
+    match asked {
+        None if friction => Ok(Quantities::ALL),
+        None => Ok(Quantities::ALL.without_friction()),
+        Some(q) if q.is_empty() => Err(RomError::ToleranceOnEmpty.into()),
+        Some(q) => match q.iter().find(|q| q.needs_friction() && !friction) {
+            Some(bad) => Err(RomError::ToleranceOnFriction {
+                name: bad.name(),
+                what: match bad {
+                    Quantity::FrictionForce => "friction force |f_R|",
+                    _ => "dissipated energy D",
+                },
+            }
+            .into()),
+            None => Ok(q),
+        },
+    }
+}
+
+/// The largest of the errors of the quantities `on` (0 for those not estimated).
+pub fn worst(errors: &CurveErrors, on: Quantities) -> f64 {
+    on.iter()
+        .map(|q| errors.of(q).unwrap_or(0.0))
+        .fold(0.0, f64::max)
+}
+
+/// The joint part of a tolerance model's basis: the pairs whose normal attachment modes it
+/// holds, and the tangential attachment modes (pair, direction) it holds.
+#[derive(Clone, Debug, Default)]
+struct Chosen {
+    /// Pairs with their normal attachment mode, ascending.
+    pairs: Vec<usize>,
+    /// Pairs with tangential attachment modes, in the order added (a pair at most twice: its
+    /// main direction of friction, then the one across it).
+    tangential: Vec<usize>,
+    /// The directions of `tangential`, unit vectors in the pairs' (t1, t2) planes.
+    directions: Vec<[f64; 2]>,
+}
+
+impl Chosen {
+    /// Adds the attachment modes the estimate of a round that missed `tol` asks for (module
+    /// docs, "Choosing S"): normal ones while the joint part of the ‖f_c‖ estimate (or of u_y)
+    /// exceeds its share and a controlled quantity depends on the normal forces, tangential ones
+    /// while the joint part of the ‖f_R‖ estimate exceeds its share and ‖f_R‖ or D is
+    /// controlled. Returns whether anything was added.
+    fn enrich(&mut self, estimate: &RunEstimate, on: Quantities, tol: f64, cb_size: usize) -> bool {
+        let d = &estimate.detail;
+        let part = SELECTION_MARGIN * tol;
+        let normal_matters = [
+            Quantity::ContactForce,
+            Quantity::FrictionForce,
+            Quantity::Dissipation,
+        ]
+        .into_iter()
+        .any(|q| on.contains(q));
+        let wants_normal = (normal_matters && d.joint.unwrap_or(0.0) > part)
+            || (on.contains(Quantity::MasterUy)
+                && estimate.reduction.master_uy.unwrap_or(0.0) > part);
+        let mut changed = false;
+        if wants_normal {
+            if let Some(add) = more_pairs(
+                &d.pair_error,
+                d.corrected_joint_norm2,
+                |k| self.pairs.contains(&k),
+                tol,
+                self.pairs.len().max(cb_size),
+            ) {
+                self.pairs.extend(add);
+                self.pairs.sort_unstable();
+                changed = true;
+            }
+        }
+        let friction_matters =
+            on.contains(Quantity::FrictionForce) || on.contains(Quantity::Dissipation);
+        // The cone of a pair's friction force is μ|p_n|: while the normal forces are being
+        // corrected, the tangential errors are theirs, so tangential modes wait for them.
+        if !changed && friction_matters && d.joint_friction.unwrap_or(0.0) > part {
+            let tangential = &self.tangential;
+            let held = |k: usize| tangential.iter().filter(|&&j| j == k).count();
+            if let Some(add) = more_pairs(
+                &d.pair_tangential_error,
+                d.corrected_joint_friction_norm2,
+                |k| held(k) >= 2,
+                tol,
+                self.tangential.len().max(cb_size),
+            ) {
+                let first: Vec<bool> = add.iter().map(|&k| held(k) == 0).collect();
+                for (k, first) in add.into_iter().zip(first) {
+                    let main = main_direction(d.pair_tangential_moment[k]);
+                    self.directions
+                        .push(if first { main } else { [-main[1], main[0]] });
+                    self.tangential.push(k);
+                }
+                changed = true;
+            }
+        }
+        changed
+    }
+}
+
+/// The principal direction of the moments `[Σ p_1², Σ p_1 p_2, Σ p_2²]` of a pair's tangential
+/// force (t1 when they vanish).
+fn main_direction(m: [f64; 3]) -> [f64; 2] {
+    let angle = 0.5 * (2.0 * m[1]).atan2(m[0] - m[2]);
+    [angle.cos(), angle.sin()]
 }
 
 /// The first round's run (Craig–Bampton alone) is at this many times looser rtol and atol: its
@@ -340,31 +506,61 @@ pub fn reduced_on_pairs(
     flex: &JointFlexibility,
     pairs: &[usize],
 ) -> Result<ReducedSystem, Error> {
-    let att = flex.attachment_modes(pairs);
-    let (phi, _) = final_basis(&[cb.as_ref(), att.as_ref()], &model.mass, DEFAULT_DROP_TOL)?;
+    let chosen = Chosen {
+        pairs: pairs.to_vec(),
+        ..Chosen::default()
+    };
+    reduced_on(model, cb, flex, &chosen)
+}
+
+/// The reduced system on Craig–Bampton plus the normal and tangential attachment modes of
+/// `chosen`.
+fn reduced_on(
+    model: &Model,
+    cb: &faer::Mat<f64>,
+    flex: &JointFlexibility,
+    chosen: &Chosen,
+) -> Result<ReducedSystem, Error> {
+    let att = flex.attachment_modes(&chosen.pairs);
+    let with_directions: Vec<(usize, [f64; 2])> = chosen
+        .tangential
+        .iter()
+        .copied()
+        .zip(chosen.directions.iter().copied())
+        .collect();
+    let tangential = flex.tangential_attachment_modes(&with_directions);
+    let (phi, _) = final_basis(
+        &[cb.as_ref(), att.as_ref(), tangential.as_ref()],
+        &model.mass,
+        DEFAULT_DROP_TOL,
+    )?;
     let (phi, _) = modal_rotation(model, phi)?;
     ReducedSystem::new(model, phi)
 }
 
-/// The pairs to add after a round whose estimate missed `tol` (module docs, step 3), at most
-/// `max(|S|, cb_size)` of them; `None` when no pair outside `pairs` carries any of the error.
-fn more_pairs(est: &Estimate, pairs: &[usize], tol: f64, cb_size: usize) -> Option<Vec<usize>> {
-    let mut cand: Vec<(usize, f64)> = est
-        .pair_error
+/// The pairs to add after a round whose estimate missed `tol` (module docs, step 3): ranked by
+/// their shares `errors` of the estimate (N², against the corrected curve's `norm2`), those not
+/// `held` already, at most `cap` of them; `None` when no pair outside carries any of the error.
+fn more_pairs(
+    errors: &[f64],
+    norm2: f64,
+    held: impl Fn(usize) -> bool,
+    tol: f64,
+    cap: usize,
+) -> Option<Vec<usize>> {
+    let mut cand: Vec<(usize, f64)> = errors
         .iter()
         .enumerate()
-        .filter(|(k, e)| **e > 0.0 && !pairs.contains(k))
+        .filter(|(k, e)| **e > 0.0 && !held(*k))
         .map(|(k, e)| (k, *e))
         .collect();
     if cand.is_empty() {
         return None;
     }
     cand.sort_by(|a, b| b.1.total_cmp(&a.1).then(a.0.cmp(&b.0)));
-    let allowed = (SELECTION_MARGIN * tol).powi(2) * est.corrected_joint_norm2;
+    let allowed = (SELECTION_MARGIN * tol).powi(2) * norm2;
     let mut left: f64 = cand.iter().map(|c| c.1).sum();
     let mut add = Vec::new();
-    // At most double the joint part per round, starting from the Craig–Bampton size.
-    let cap = pairs.len().max(cb_size);
     for (k, e) in cand {
         if left <= allowed || add.len() >= cap {
             break;

@@ -11,7 +11,8 @@
 //!    reference of every error below;
 //! 3. reduced transients: TVD with g = 0, the paper's sizes (friction bar 10, 25; multilayer
 //!    sheet 20, 60) and the a-priori g (smallest g with w(g) ≥ the threshold, eq. 26), plus the
-//!    competitors (plain POD, modes only, Joint Interface Modes, all joint DOF, and the POD of
+//!    competitors (plain POD, the secant TVD, modes only, Joint Interface Modes, all joint DOF,
+//!    and the POD of
 //!    200 displacement snapshots of the job's own full run, paper Section 5.2) and functional
 //!    (fixed-point) iteration next to Newton; every run under a wall-clock budget, so a method
 //!    that does not finish is a measured failure, not a hang; every reduced run carries its own
@@ -42,7 +43,10 @@ use serde::Serialize;
 
 use crate::error::{Error, StudyError};
 use crate::integrate::problem::{Iteration, OdeOptions, OdeStats};
-use crate::integrate::{integrate, ProblemOptions, Run, RunStatus, Scene, TransientOptions};
+use crate::integrate::{
+    integrate, ProblemOptions, Run, RunStatus, Scene, Trajectory, TransientOptions,
+};
+use crate::joint::{T1, T2};
 use crate::model::Model;
 use crate::reduction::{build_basis, snapshot_basis, BasisKind, BasisOptions, JointFlexibility};
 use crate::rom::compare::JointCurves;
@@ -124,6 +128,10 @@ pub struct RunRecord {
     pub error_uy: Option<f64>,
     /// Relative L2 error of ‖f_R‖(t).
     pub error_fr: Option<f64>,
+    /// Relative L2 error of the dissipated energy D(t).
+    pub error_d: Option<f64>,
+    /// Relative error of D at the end of the run.
+    pub error_d_end: Option<f64>,
     /// The run's own error estimate (reduced runs; [`crate::rom::estimate::RunEstimate`]),
     /// to set beside the true errors above.
     pub estimate: Option<RunEstimate>,
@@ -149,6 +157,26 @@ pub struct PaperAnchor {
     pub g: usize,
     /// CPU time in % of the full FE model.
     pub cpu_percent: f64,
+}
+
+/// The joint's hysteresis at one pair: its tangential force against its relative tangential
+/// displacement, both along the pair's main direction of friction (the principal direction of
+/// `Σ_t p_t p_tᵀ` in the full run).
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct Hysteresis {
+    /// The pair (index into the model's joint pairs): the one that dissipates most in the full
+    /// run.
+    pub pair: usize,
+    /// Its dissipated energy over the full run, `Σ ∫ p_t · ṡ dt` from the output states, N·mm.
+    pub dissipated: f64,
+    /// The direction, a unit vector in the pair's (t1, t2) plane.
+    pub direction: [f64; 2],
+    /// The full run: (relative tangential displacement (mm), tangential force (N)) per output.
+    #[serde(skip)]
+    pub full: Vec<(f64, f64)>,
+    /// The headline reduced model, likewise.
+    #[serde(skip)]
+    pub reduced: Vec<(f64, f64)>,
 }
 
 /// Everything the main job measured (written as `results.json`).
@@ -185,6 +213,9 @@ pub struct Report {
     pub headline: Option<usize>,
     /// Its tolerance.
     pub headline_tolerance: f64,
+    /// The joint's hysteresis at the pair that dissipates most, full run and headline model
+    /// (`None` without friction or a headline model).
+    pub hysteresis: Option<Hysteresis>,
     /// The paper's CPU ratios for this case (empty for other cases).
     pub paper_anchors: Vec<PaperAnchor>,
     /// Files written (relative to the report folder).
@@ -242,7 +273,12 @@ fn plans(case: &str, g_chosen: usize, pairs: usize, quick: bool) -> Vec<Plan> {
         })
         .collect();
     let competitor_g: Vec<usize> = if quick { vec![paper[0]] } else { paper.clone() };
-    for kind in [BasisKind::TvdPlain, BasisKind::Modes, BasisKind::Jim] {
+    for kind in [
+        BasisKind::TvdPlain,
+        BasisKind::TvdSecant,
+        BasisKind::Modes,
+        BasisKind::Jim,
+    ] {
         for &g in &competitor_g {
             out.push(Plan {
                 kind,
@@ -294,6 +330,8 @@ fn record(
         error_fc: None,
         error_uy: None,
         error_fr: None,
+        error_d: None,
+        error_d_end: None,
         estimate: None,
         estimate_note: None,
         tolerance: None,
@@ -453,14 +491,26 @@ pub fn run_main_job(
     // 2. The full reference and 3. the reduced runs.
     let span = (end_time, output_step);
     let mut snapshots = Vec::new();
-    let mut runs = full_runs(model, opts, span, &mut bar, &mut snapshots)?;
+    let mut full_states = None;
+    let mut runs = full_runs(
+        model,
+        opts,
+        span,
+        &mut bar,
+        &mut snapshots,
+        &mut full_states,
+    )?;
     let flex = JointFlexibility::new(model)?;
     reduced_runs(model, &flex, opts, &plan, span, &mut bar, &mut runs)?;
     snapshot_runs(model, &flex, opts, &snapshots, span, &mut bar, &mut runs);
-    let headline = tolerance_runs(model, opts, span, &mut bar, &mut runs);
+    let mut headline_states = None;
+    let headline = tolerance_runs(model, opts, span, &mut bar, &mut runs, &mut headline_states);
     bar.set_message("backbone of mode 1");
     let backbone = report_backbone(model, g_chosen, opts.quick);
     bar.finish_and_clear();
+    let hysteresis = full_states
+        .zip(headline_states)
+        .and_then(|(full, (rom, reduced))| hysteresis(model, &full, &rom, &reduced));
 
     // Errors, speed-ups, Pareto front.
     compare_to_full(&mut runs);
@@ -487,6 +537,7 @@ pub fn run_main_job(
         runs,
         headline,
         headline_tolerance: opts.headline_tolerance,
+        hysteresis,
         paper_anchors: anchors,
         files: Vec::new(),
         total_s: 0.0,
@@ -564,6 +615,7 @@ fn full_runs(
     span: (f64, f64),
     bar: &mut Tracker<'_>,
     snapshots: &mut Vec<Vec<f64>>,
+    states: &mut Option<Trajectory>,
 ) -> Result<Vec<RunRecord>, Error> {
     let problem = ProblemOptions::default();
     bar.set_message("full FE model, Newton");
@@ -573,20 +625,22 @@ fn full_runs(
     // Every k-th displacement state (about SNAPSHOTS) for the POD-snapshot competitor.
     let every = ((span.0 / span.1).ceil() as usize / SNAPSHOTS).max(1);
     let mut k = 0usize;
-    let full = Outcome::of_run(match full_sys {
-        Ok(s) => integrate(
-            s,
-            &Scene::of(model),
-            &transient_options(&problem, ode_options(false), span, opts.full_budget_s),
-            |_, q| {
-                if k % every == 0 {
-                    snapshots.push(q.to_vec());
-                }
-                k += 1;
-            },
-        ),
+    // The full run's states are kept for the joint's hysteresis.
+    let recorded = TransientOptions {
+        record: true,
+        ..transient_options(&problem, ode_options(false), span, opts.full_budget_s)
+    };
+    let mut full_run = match full_sys {
+        Ok(s) => integrate(s, &Scene::of(model), &recorded, |_, q| {
+            if k % every == 0 {
+                snapshots.push(q.to_vec());
+            }
+            k += 1;
+        }),
         Err(e) => Run::failed(e),
-    });
+    };
+    *states = full_run.trajectory.take();
+    let full = Outcome::of_run(full_run);
     if !full.ok() {
         return Err(StudyError::ReferenceFailed {
             t: full.t_reached,
@@ -791,6 +845,7 @@ fn tolerance_runs(
     span: (f64, f64),
     bar: &mut Tracker<'_>,
     runs: &mut Vec<RunRecord>,
+    headline_states: &mut Option<(ReducedSystem, Trajectory)>,
 ) -> Option<usize> {
     let mut headline = None;
     for tol in run_tolerances(opts) {
@@ -804,6 +859,16 @@ fn tolerance_runs(
         );
         let rec = match tolerance_model(model, &t_opts) {
             Ok(t) => {
+                if tol == opts.headline_tolerance {
+                    // The headline model's states for the joint's hysteresis: its run again,
+                    // recorded (the estimate consumed the first run's states).
+                    let again = TransientOptions {
+                        record: true,
+                        ..t.transient.clone()
+                    };
+                    let mut run = integrate(t.rom.clone(), &Scene::of(model), &again, |_, _| {});
+                    *headline_states = run.trajectory.take().map(|tr| (t.rom.clone(), tr));
+                }
                 let mut rec = record(
                     "adaptive",
                     Some(t.pairs.len()),
@@ -838,7 +903,7 @@ fn tolerance_runs(
     headline
 }
 
-/// Each finished reduced run's relative L2 errors of ‖f_c‖, ‖f_R‖ and u_y against the full run
+/// Each finished reduced run's relative L2 errors of ‖f_c‖, ‖f_R‖, u_y and D against the full run
 /// (`runs[0]`) and its CPU speed-up.
 fn compare_to_full(runs: &mut [RunRecord]) {
     let (full, cpu_ref) = (runs[0].curves.clone(), runs[0].cpu_s);
@@ -850,9 +915,85 @@ fn compare_to_full(runs: &mut [RunRecord]) {
         r.error_fc = e.contact_force;
         r.error_uy = e.master_uy;
         r.error_fr = e.friction_force;
+        r.error_d = e.dissipated;
+        r.error_d_end = e.dissipated_end;
         if r.cpu_s > 0.0 && cpu_ref.is_finite() {
             r.speedup = Some(cpu_ref / r.cpu_s);
             r.cpu_percent = Some(100.0 * r.cpu_s / cpu_ref);
         }
     }
+}
+
+/// The joint's hysteresis ([`Hysteresis`]) at the pair that dissipates most in the full run,
+/// from the full run's recorded states and the headline model's; `None` without friction.
+fn hysteresis(
+    model: &Model,
+    full: &Trajectory,
+    rom: &ReducedSystem,
+    reduced: &Trajectory,
+) -> Option<Hysteresis> {
+    let w = model.joint.pairs();
+    let outputs = full.p.len() / (3 * w).max(1);
+    if w == 0 || full.s.len() != 2 * w * outputs || outputs < 2 {
+        return None;
+    }
+    let force = |p: &[f64], j: usize, k: usize| {
+        let o = 3 * w * j + 3 * k;
+        [p[o + 1], p[o + 2]]
+    };
+    let mut dissipated = vec![0.0; w];
+    let mut moment = vec![[0.0; 3]; w];
+    for j in 0..outputs {
+        for k in 0..w {
+            let f = force(&full.p, j, k);
+            moment[k][0] += f[0] * f[0];
+            moment[k][1] += f[0] * f[1];
+            moment[k][2] += f[1] * f[1];
+            if j + 1 < outputs {
+                let f1 = force(&full.p, j + 1, k);
+                for c in 0..2 {
+                    let ds = full.s[2 * w * (j + 1) + 2 * k + c] - full.s[2 * w * j + 2 * k + c];
+                    dissipated[k] += 0.5 * (f[c] + f1[c]) * ds;
+                }
+            }
+        }
+    }
+    let pair = (0..w).max_by(|&a, &b| dissipated[a].total_cmp(&dissipated[b]))?;
+    if dissipated[pair] <= 0.0 {
+        return None;
+    }
+    let m = moment[pair];
+    let angle = 0.5 * (2.0 * m[1]).atan2(m[0] - m[2]);
+    let d = [angle.cos(), angle.sin()];
+    let along = |v: [f64; 2]| d[0] * v[0] + d[1] * v[1];
+    let n = model.dofs();
+    let slip =
+        |q: &[f64], c: usize| -> f64 { model.joint.row(3 * pair + c).map(|(i, v)| v * q[i]).sum() };
+    let full_curve = (0..outputs)
+        .map(|j| {
+            let q = &full.q[n * j..n * (j + 1)];
+            (
+                along([slip(q, T1), slip(q, T2)]),
+                along(force(&full.p, j, pair)),
+            )
+        })
+        .collect();
+    let r = rom.dim();
+    let mut u = vec![0.0; 3 * w];
+    let reduced_curve = (0..reduced.p.len() / (3 * w))
+        .map(|j| {
+            rom.joint_apply_into(&reduced.q[r * j..r * (j + 1)], &mut u);
+            (
+                along([u[3 * pair + T1], u[3 * pair + T2]]),
+                along(force(&reduced.p, j, pair)),
+            )
+        })
+        .collect();
+    Some(Hysteresis {
+        pair,
+        dissipated: dissipated[pair],
+        direction: d,
+        full: full_curve,
+        reduced: reduced_curve,
+    })
 }

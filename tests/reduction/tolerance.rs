@@ -8,7 +8,10 @@ use serde_json::Value;
 use jointrom::integrate::{integrate, TransientOptions};
 use jointrom::joint::statics::ContactOptions;
 use jointrom::model::contact_static_full;
-use jointrom::reduction::{build_basis, BasisKind, BasisOptions, JointFlexibility, RunStates};
+use jointrom::reduction::{
+    build_basis, BasisKind, BasisOptions, JointFlexibility, Quantities, Quantity, RunStates,
+};
+use jointrom::rom::compare::JointCurves;
 use jointrom::rom::estimate::{integration_errors, pair_law, run_estimated};
 use jointrom::rom::tolerance::{static_tolerance_model, tolerance_model, ToleranceOptions};
 use jointrom::system::{ReducedSystem, Scene};
@@ -82,32 +85,49 @@ fn static_tolerance_meets_the_full_model() {
 }
 
 /// The tolerance contract of `transient --tolerance 1e-2` on both built-in scenes with
-/// friction: the chosen model is within 1e-2 of the stored full run in ‖f_c‖(t), the estimate is
-/// honest (0.5 ≤ estimate / true error ≤ 10), the basis is within 16 + 0.6 w (multilayer:
-/// 0.7 w, see below), and the model
-/// keeps far fewer joint directions than all pairs.
+/// friction, for every quantity it controls by default — ‖f_c‖(t), ‖f_R‖(t), the master's u_y(t)
+/// and the dissipated energy D(t) (relative L2 and at the end) — against the stored full runs:
+/// each true error within 1e-2, each estimate honest (0.5 ≤ estimate / true error ≤ 10; the
+/// multilayer's u_y excepted, see below), the basis within 16 + 0.6 w, and far fewer joint
+/// directions than all pairs.
 #[test]
 fn tolerance_model_meets_the_stored_full_reference() {
     for name in ["friction_bar", "multilayer_sheet"] {
         let m = model(name);
-        let (_, reference) = reference_json(&format!("{name}_full_friction_on"));
+        let (path, _) = reference_json(&format!("{name}_full_friction_on"));
+        let reference = JointCurves::read(&path).unwrap();
         let t = tolerance_model(&m, &ToleranceOptions::new(1e-2)).unwrap();
-        let c = &t.run.curves;
-        let truth = rel_err(
-            &c.contact_force_norm,
-            &curve(&reference, "contact_force_norm"),
-        );
-        let est = t.estimate.total.contact_force.unwrap();
-        assert!(t.met, "{name}: tolerance reported not met (estimate {est})");
-        assert!(truth <= 1e-2, "{name}: true ‖f_c‖ error {truth}");
-        let eff = est / truth;
-        assert!(
-            (0.5..=10.0).contains(&eff),
-            "{name}: effectivity {eff} ({est} / {truth})"
-        );
-        // Issue 14's target, 16 + 0.6 w. Measured (2026-11-26, DKMQ sheets): friction bar
-        // 29 = 16 + 13; multilayer 48 = 16 + 32 (0.37 w) since a round at most doubles the
-        // joint part — without that cap the Craig–Bampton round took 63 pairs at once (0.77 w).
+        assert_eq!(t.quantities, Quantities::ALL);
+        let truth = reference.errors(&t.run.curves);
+        let est = &t.estimate.total;
+        assert!(t.met, "{name}: tolerance reported not met ({est:?})");
+        let pairs = [
+            ("fc", truth.contact_force, est.contact_force),
+            ("fr", truth.friction_force, est.friction_force),
+            ("uy", truth.master_uy, est.master_uy),
+            ("D", truth.dissipated, est.dissipated),
+            ("D(T)", truth.dissipated_end, est.dissipated_end),
+        ];
+        for (what, truth, est) in pairs {
+            let (truth, est) = (truth.unwrap(), est.unwrap());
+            assert!(truth <= 1e-2, "{name}: true {what} error {truth}");
+            assert!(est <= 1e-2, "{name}: estimated {what} error {est}");
+            let eff = est / truth;
+            // The multilayer's u_y error (4.6e-4) is the back-coupling of the truncated
+            // modes' force error into the global motion, which the first-order correction
+            // does not see (docs/theory/error-estimate.md): measured effectivity 0.1.
+            if name == "multilayer_sheet" && what == "uy" {
+                assert!(
+                    eff < 0.5,
+                    "{name}: the u_y estimate improved ({eff}): tighten this"
+                );
+                continue;
+            }
+            assert!(
+                (0.5..=10.0).contains(&eff),
+                "{name}: {what} effectivity {eff} ({est} / {truth})"
+            );
+        }
         let w = m.pair_count() as f64;
         assert!(
             (t.rom.dim() as f64) <= 16.0 + 0.6 * w,
@@ -116,6 +136,87 @@ fn tolerance_model_meets_the_stored_full_reference() {
         );
         assert!(t.pairs.len() < m.pair_count());
         assert!(t.offline_s > 0.0 && t.run.wall_s > 0.0 && t.estimate_s > 0.0);
+    }
+}
+
+/// `--tolerance-on fc` controls ‖f_c‖ alone: on the friction bar it keeps no tangential
+/// attachment modes, and its ‖f_R‖ is then the 3 % the normal-only model has — the estimate
+/// reports it within 0.5–10× (the stick correction of the tangential forces).
+#[test]
+fn friction_force_estimate_sees_the_missing_tangential_modes() {
+    let m = model("friction_bar");
+    let (path, _) = reference_json("friction_bar_full_friction_on");
+    let reference = JointCurves::read(&path).unwrap();
+    let mut opts = ToleranceOptions::new(1e-2);
+    opts.quantities = Some(Quantities::of(&[Quantity::ContactForce]));
+    let t = tolerance_model(&m, &opts).unwrap();
+    assert!(t.tangential.is_empty());
+    let truth = reference.errors(&t.run.curves).friction_force.unwrap();
+    let est = t.estimate.total.friction_force.unwrap();
+    assert!(
+        truth > 1e-2,
+        "the normal-only model should miss |f_R| ({truth})"
+    );
+    let eff = est / truth;
+    assert!(
+        (0.5..=10.0).contains(&eff),
+        "effectivity {eff} ({est} / {truth})"
+    );
+}
+
+/// Bad `--tolerance-on` lists are errors naming the flag.
+#[test]
+fn tolerance_on_bad_input_is_named() {
+    for (list, says) in [
+        ("fc,nope", "unknown quantity `nope`"),
+        (",", "the list is empty"),
+        ("", "the list is empty"),
+    ] {
+        let e = jointrom_err([
+            "transient",
+            "friction_bar",
+            "--tolerance",
+            "1e-2",
+            "--tolerance-on",
+            list,
+        ]);
+        assert!(
+            e.contains("--tolerance-on") && e.contains(says),
+            "{list}: {e}"
+        );
+    }
+    let e = jointrom_err(["transient", "friction_bar", "--tolerance-on", "fc"]);
+    assert!(
+        e.contains("--tolerance-on") && e.contains("--tolerance"),
+        "{e}"
+    );
+    let e = jointrom_err([
+        "static",
+        "friction_bar",
+        "--tolerance",
+        "1e-2",
+        "--tolerance-on",
+        "fr",
+    ]);
+    assert!(
+        e.contains("--tolerance-on") && e.contains("|f_c| only"),
+        "{e}"
+    );
+    for q in ["dissipation", "fr"] {
+        let e = jointrom_err([
+            "transient",
+            "friction_bar",
+            "--friction",
+            "off",
+            "--tolerance",
+            "1e-2",
+            "--tolerance-on",
+            q,
+        ]);
+        assert!(
+            e.contains(&format!("--tolerance-on {q}")) && e.contains("friction off"),
+            "{q}: {e}"
+        );
     }
 }
 

@@ -147,7 +147,7 @@ fn print_report(rep: &Report, dir: &Path) {
         );
     }
     println!(
-        "* headline reduced model (tolerance {:.0e} on |f_c|(t))",
+        "* headline reduced model (tolerance {:.0e} on |f_c|, |f_R|, u_y and D)",
         rep.headline_tolerance
     );
     println!("report: {}", dir.join("report.md").display());

@@ -54,8 +54,14 @@ pub fn run(a: StaticArgs) -> Result<(), Error> {
     let model = crate::common::load_model(&a.case)?;
     match spec {
         ModelSpec::Full => {}
-        ModelSpec::Tolerance { tolerance, nu } => {
-            return tolerance_static(&model, tolerance, nu, scale, a.json)
+        ModelSpec::Tolerance { tolerance, nu, on } => {
+            // Statics has one controlled quantity, ‖f_c‖.
+            let fc =
+                jointrom::reduction::Quantities::of(&[jointrom::reduction::Quantity::ContactForce]);
+            if on.is_some_and(|q| q != fc) {
+                return Err(RomError::ToleranceOnStatic.into());
+            }
+            return tolerance_static(&model, tolerance, nu, scale, a.json);
         }
         ModelSpec::Basis { kind, g, nu } => {
             return reduced_static(&model, kind, g, nu, scale, a.json)
