@@ -93,12 +93,26 @@ pub trait SecondOrderSystem {
     fn joint_normal_row_norms(&self) -> Option<Vec<f64>> {
         None
     }
-    /// `out = B_n q`: the normal gaps of all pairs (w values, mm).
-    fn joint_normal_apply_into(&self, q: &[f64], out: &mut [f64]);
+    /// `out = B_n q`: the normal gaps of all pairs (w values, mm). The default goes through
+    /// [`SecondOrderSystem::joint_apply_into`] with a scratch vector; a system that screens its
+    /// pairs overrides this and the next three methods with direct row products.
+    fn joint_normal_apply_into(&self, q: &[f64], out: &mut [f64]) {
+        let mut u = vec![0.0; 3 * self.pairs()];
+        self.joint_apply_into(q, &mut u);
+        for (o, g) in out.iter_mut().zip(u.iter().step_by(3)) {
+            *o = *g;
+        }
+    }
     /// Pair z's normal gap `(B q)_{3z}`, mm.
-    fn joint_normal_gap(&self, q: &[f64], z: usize) -> f64;
+    fn joint_normal_gap(&self, q: &[f64], z: usize) -> f64 {
+        self.joint_pair(q, z)[0]
+    }
     /// Pair z's kinematics `[(B q)_{3z}, (B q)_{3z+1}, (B q)_{3z+2}]` (gap, slip x, slip z; mm).
-    fn joint_pair(&self, q: &[f64], z: usize) -> [f64; 3];
+    fn joint_pair(&self, q: &[f64], z: usize) -> [f64; 3] {
+        let mut u = vec![0.0; 3 * self.pairs()];
+        self.joint_apply_into(q, &mut u);
+        [u[3 * z], u[3 * z + 1], u[3 * z + 2]]
+    }
     /// `out[3z..3z+3] = (B q)_{3z..3z+3}` for the pairs z in `pairs` (other entries untouched).
     fn joint_apply_pairs_into(&self, q: &[f64], pairs: &[usize], out: &mut [f64]) {
         for &z in pairs {
@@ -106,7 +120,13 @@ pub trait SecondOrderSystem {
         }
     }
     /// `out += Σ_{z ∈ pairs} B_zᵀ p_z` (the rows of the other pairs are skipped).
-    fn joint_transpose_add_pairs(&self, p: &[f64], pairs: &[usize], out: &mut [f64]);
+    fn joint_transpose_add_pairs(&self, p: &[f64], pairs: &[usize], out: &mut [f64]) {
+        let mut masked = vec![0.0; p.len()];
+        for &z in pairs {
+            masked[3 * z..3 * z + 3].copy_from_slice(&p[3 * z..3 * z + 3]);
+        }
+        self.joint_transpose_add(&masked, out);
+    }
     /// Factors `M + γ² (K + Bᵀ K_c B)`; `kc` holds one 3×3 row-major symmetric block per pair
     /// (N/mm). Errors if the matrix is not positive definite.
     fn newton_factor(&mut self, gamma: f64, kc: &[f64]) -> Result<(), Error>;
