@@ -11,6 +11,7 @@ use crate::error::{ElementError, Error};
 mod build;
 pub mod deck;
 mod nugget;
+pub mod tributary;
 
 pub use deck::DeckModel;
 
@@ -213,6 +214,10 @@ pub struct Mesh {
     /// Joint pairs, interface by interface in case-file order, within an interface sorted by
     /// (x, z).
     pub pairs: Vec<JointPair>,
+    /// Coincident node pairs of the joints left out of [`Mesh::pairs`]: fused by an area weld's
+    /// nugget, clamped or tied (a deck's: the CGAPs inside a nugget). Their share of the joint
+    /// surface is carried by the weld or the support, not by contact.
+    pub excluded: Vec<JointPair>,
     /// Material of all sheets and welds.
     pub material: Material,
     /// What the build could not do as asked and did otherwise (a weld whose automatic

@@ -358,6 +358,8 @@ pub fn load(map_path: &Path) -> Result<Model, Error> {
         joint,
         load: map.load,
         warnings: Vec::new(),
+        pair_areas: None,
+        pair_weights: None,
         contact: map.contact,
         end_time: map.end_time,
     })

@@ -17,6 +17,7 @@ mod contact;
 mod load;
 pub mod matrices;
 pub mod mtx;
+pub mod per_area;
 pub mod petsc;
 
 pub use contact::contact_static_full;
@@ -163,6 +164,16 @@ pub struct Model {
     /// What the reader noticed but did not refuse (a deck's ignored and unknown cards, unused
     /// grids, pairs fused by welds); empty for cases and matrices.
     pub warnings: Vec<String>,
+    /// Tributary area `A_i` of each pair on the joint surface, mm² (`crate::mesh::tributary`;
+    /// a matrix map's per-pair `area`): `None` where the model has none (a map without areas,
+    /// pairs that do not cover faces). With them the mesh-independent contact outputs (contact
+    /// area, pressure) are reported.
+    pub pair_areas: Option<Vec<f64>>,
+    /// The pair weights `w_i = √(A_i/Ā)` of a per-area contact law (`None`: the per-pair law,
+    /// all weights 1). [`Model::joint`]'s three rows of pair i carry `w_i`, so the scalar law
+    /// `k = κ·Ā` on the weighted kinematics `w_i·(g, u_t)` returns the force `w_i² κ Ā g =
+    /// κ A_i g` to the structure (module [`per_area`]).
+    pub pair_weights: Option<Vec<f64>>,
 }
 
 impl Model {
@@ -200,6 +211,7 @@ impl Model {
             })
             .collect();
         let node_ids = (1..=mesh.nodes.len() as u64).collect();
+        let (per_area, overlap) = (case.contact.per_area(), per_area::joints_overlap(&case));
         let parts = Parts {
             name: case.name.clone(),
             source: case.source.clone(),
@@ -208,10 +220,15 @@ impl Model {
             end_time: case.end_time,
             warnings: mesh.warnings.clone(),
         };
-        Model::assemble(mesh, pairs, node_ids, parts, |mesh| Origin::Case {
+        let mut model = Model::assemble(mesh, pairs, node_ids, parts, |mesh| Origin::Case {
             case: Box::new(case),
             mesh: Box::new(mesh),
-        })
+        })?;
+        model.set_mesh_areas();
+        if let Some(kappa) = per_area {
+            model.apply_case_per_area(kappa, overlap)?;
+        }
+        Ok(model)
     }
 
     /// Reads a NASTRAN deck ([`crate::case::nastran`]), builds its mesh and assembles K and M.
@@ -258,10 +275,12 @@ impl Model {
             warnings: built.warnings,
         };
         let deck_path = path.to_path_buf();
-        Model::assemble(mesh, pairs, built.grid_ids, parts, |mesh| Origin::Deck {
+        let mut model = Model::assemble(mesh, pairs, built.grid_ids, parts, |mesh| Origin::Deck {
             deck: deck_path,
             mesh: Box::new(mesh),
-        })
+        })?;
+        model.set_mesh_areas();
+        Ok(model)
     }
 
     /// Assembles a mesh into a model.
@@ -305,6 +324,8 @@ impl Model {
             contact: parts.contact,
             end_time: parts.end_time,
             warnings: parts.warnings,
+            pair_areas: None,
+            pair_weights: None,
             origin: origin(mesh),
             geometry,
             pairs,

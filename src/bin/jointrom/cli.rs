@@ -23,6 +23,35 @@ use crate::commands::{
 pub struct Cli {
     #[command(subcommand)]
     pub command: Command,
+    /// Contact stiffness per area `KN,KT` (N/mm³) for the model of any command: each joint
+    /// pair's normal and stick stiffness become KN·A and KT·A with A its tributary area on the
+    /// joint surface, in place of the per-pair values of the deck's PGAP (or the case's or the
+    /// map's contact block).
+    #[arg(long, global = true, value_name = "KN,KT")]
+    pub contact_per_area: Option<String>,
+}
+
+impl Cli {
+    /// `--contact-per-area KN,KT`: two positive finite numbers.
+    pub fn contact_per_area(&self) -> Result<Option<[f64; 2]>, Error> {
+        let Some(text) = &self.contact_per_area else {
+            return Ok(None);
+        };
+        let bad = || FlagError::Range {
+            flag: "contact-per-area",
+            need: "two positive stiffnesses per area `KN,KT` in N/mm³ (finite and > 0)",
+            got: format!("`{text}`"),
+        };
+        let values: Vec<f64> = text
+            .split(',')
+            .map(|v| v.trim().parse::<f64>())
+            .collect::<Result<_, _>>()
+            .map_err(|_| bad())?;
+        match values[..] {
+            [n, t] if n.is_finite() && n > 0.0 && t.is_finite() && t > 0.0 => Ok(Some([n, t])),
+            _ => Err(bad().into()),
+        }
+    }
 }
 
 #[derive(Subcommand)]

@@ -68,11 +68,22 @@ pub fn inputs() -> Vec<String> {
     INPUTS.lock().map(|v| v.clone()).unwrap_or_default()
 }
 
-/// Loads a case file, built-in scene or matrix map ([`Model::from_case_name`]) and records
-/// where its matrices came from.
+/// `--contact-per-area`, parsed once by the main function.
+static CONTACT_PER_AREA: Mutex<Option<[f64; 2]>> = Mutex::new(None);
+
+/// Sets the `--contact-per-area` values every [`load_model`] applies.
+pub fn set_contact_per_area(k: Option<[f64; 2]>) {
+    if let Ok(mut g) = CONTACT_PER_AREA.lock() {
+        *g = k;
+    }
+}
+
+/// Loads a case file, built-in scene or matrix map ([`Model::from_case_name_with`], with
+/// `--contact-per-area`) and records where its matrices came from.
 pub fn load_model(arg: &str) -> Result<Model, Error> {
     let start = std::time::Instant::now();
-    let model = Model::from_case_name(arg)?;
+    let per_area = CONTACT_PER_AREA.lock().ok().and_then(|g| *g);
+    let model = Model::from_case_name_with(arg, per_area, "--contact-per-area")?;
     if let Ok(mut g) = MODEL_S.lock() {
         *g = Some(g.unwrap_or(0.0) + start.elapsed().as_secs_f64());
     }

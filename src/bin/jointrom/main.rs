@@ -35,6 +35,10 @@ fn main() -> ExitCode {
     // Every output a failing command created is removed again: a failed export or report
     // leaves no partial files.
     jointrom::files::journal_start();
+    match cli.contact_per_area() {
+        Ok(k) => common::set_contact_per_area(k),
+        Err(e) => return fail(&e),
+    }
     match cli.command.run() {
         Ok(()) => {
             jointrom::files::journal_commit();

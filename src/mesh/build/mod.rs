@@ -60,7 +60,7 @@ pub(super) fn build(case: &Case) -> Result<Mesh, Error> {
         tied,
         nuggets: welds.nuggets,
     };
-    let pairs = sheets.joints(&case.joints, &supports, &nodes)?;
+    let (pairs, excluded) = sheets.joints(&case.joints, &supports, &nodes)?;
     // After the joints' and welds' own checks, which name the field more precisely.
     crate::case::validate::check_stacking(case, &ctx)?;
 
@@ -83,6 +83,7 @@ pub(super) fn build(case: &Case) -> Result<Mesh, Error> {
         clamped,
         tie,
         pairs,
+        excluded,
         material: Material {
             youngs_modulus: case.material.youngs_modulus,
             poisson_ratio: case.material.poisson_ratio,
