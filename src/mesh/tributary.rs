@@ -5,8 +5,9 @@
 //! # The rule: the consistent nodal area
 //!
 //! The joint surface is the set of the lower side's quadrilateral faces whose four corners are
-//! all joint nodes (lower nodes of pairs, or of coincident pairs left out because an area weld
-//! fuses them or a support holds them). Each face `e` gives
+//! all joint nodes — lower nodes of pairs, of coincident pairs left out because an area weld
+//! fuses them or a support holds them, or clamped or tied nodes (a deck has no pair there) —
+//! with at least one corner a pair's. Each face `e` gives
 //! its corner `a` the integral of the corner's bilinear shape function,
 //!
 //! ```text
@@ -49,28 +50,33 @@ pub struct Uncovered {
 }
 
 /// The tributary areas of `pairs` on the faces `shells` (nodes at `nodes`, mm), with
-/// `excluded` the coincident pairs left out of the joint (fused, clamped, tied); `Err` names the first pair on no face of the
+/// `excluded` the coincident pairs left out of the joint (fused, clamped, tied) and `held` the
+/// clamped and tied nodes; `Err` names the first pair on no face of the
 /// joint surface (module docs). A lower node shared by several pairs splits its area evenly.
 pub fn tributary_areas(
     nodes: &[[f64; 3]],
     shells: &[ShellElem],
     pairs: &[JointPair],
     excluded: &[JointPair],
+    held: &[usize],
 ) -> Result<Tributary, Uncovered> {
     // Per node: how many pairs have it as lower node, and whether a left-out pair does.
     let mut count = vec![0u32; nodes.len()];
-    let mut held = vec![false; nodes.len()];
+    let mut left_out = vec![false; nodes.len()];
     for p in pairs {
         count[p.lower] += 1;
     }
     for p in excluded {
-        held[p.lower] = true;
+        left_out[p.lower] = true;
     }
-    let joint = |n: usize| count[n] > 0 || held[n];
+    for &n in held {
+        left_out[n] = true;
+    }
+    let joint = |n: usize| count[n] > 0 || left_out[n];
     let mut node_area = vec![0.0; nodes.len()];
     let (mut total, mut excluded_area) = (0.0, 0.0);
     for shell in shells {
-        if !shell.nodes.iter().all(|&n| joint(n)) {
+        if !shell.nodes.iter().all(|&n| joint(n)) || shell.nodes.iter().all(|&n| count[n] == 0) {
             continue;
         }
         let shares = corner_areas(shell.nodes.map(|n| nodes[n]));

@@ -44,11 +44,13 @@ impl Model {
         &self,
     ) -> Option<Result<crate::mesh::tributary::Tributary, Uncovered>> {
         let mesh = self.mesh()?;
+        let held: Vec<usize> = mesh.clamped.iter().chain(&mesh.tie.slaves).copied().collect();
         Some(tributary_areas(
             &mesh.nodes,
             &mesh.shells,
             &mesh.pairs,
             &mesh.excluded,
+            &held,
         ))
     }
 

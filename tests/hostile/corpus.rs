@@ -331,6 +331,70 @@ fn case_files_values(fx: &Fixture) -> Vec<Hostile> {
             Fails("contact.normal_stiffness"),
         ),
         info_case(
+            "case-kn-both-ways",
+            "contact stiffness per pair and per area together",
+            edit(c, |v| {
+                v["contact"]["normal_stiffness_per_area"] = json!(160.0);
+            }),
+            Fails("contact.normal_stiffness_per_area"),
+        ),
+        info_case(
+            "case-kn-per-area-zero",
+            "zero contact stiffness per area",
+            edit(c, |v| {
+                v["contact"] = json!({"normal_stiffness_per_area": 0.0,
+                    "friction_coefficient": 0.25, "stick_stiffness_per_area": 160.0});
+            }),
+            Fails("contact.normal_stiffness_per_area"),
+        ),
+        info_case(
+            "case-kt-per-area-huge",
+            "stick stiffness per area out of range",
+            edit(c, |v| {
+                v["contact"] = json!({"normal_stiffness_per_area": 160.0,
+                    "friction_coefficient": 0.25, "stick_stiffness_per_area": 1e999});
+            }),
+            Fails("stick_stiffness_per_area"),
+        ),
+        info_case(
+            "case-stiffness-mixed-ways",
+            "normal stiffness per area, stick stiffness per pair",
+            edit(c, |v| {
+                v["contact"] = json!({"normal_stiffness_per_area": 160.0,
+                    "friction_coefficient": 0.25, "stick_stiffness": 1e4});
+            }),
+            Fails("stick_stiffness_per_area"),
+        ),
+        info_case(
+            "case-no-normal-stiffness",
+            "no normal stiffness either way",
+            remove(c, "/contact/normal_stiffness"),
+            Fails("contact.normal_stiffness"),
+        ),
+        info_case(
+            "case-per-area-sparse-points",
+            "stiffness per area on a joint of isolated explicit points",
+            edit(c, |v| {
+                v["contact"] = json!({"normal_stiffness_per_area": 160.0,
+                    "friction_coefficient": 0.25, "stick_stiffness_per_area": 160.0});
+                v["joints"][0]["points"] = json!([[50.0, 0.0], [80.0, 25.0]]);
+            }),
+            Fails("contact.normal_stiffness_per_area"),
+        ),
+        info_case(
+            "case-per-area-partial-points",
+            "stiffness per area on explicit points that cover part of the joint",
+            edit(c, |v| {
+                v["contact"] = json!({"normal_stiffness_per_area": 160.0,
+                    "friction_coefficient": 0.25, "stick_stiffness_per_area": 160.0});
+                let pts: Vec<Value> = (0..6)
+                    .flat_map(|i| (0..3).map(move |k| json!([70.0 + 5.0 * i as f64, 12.5 * k as f64])))
+                    .collect();
+                v["joints"][0]["points"] = json!(pts);
+            }),
+            Fails("cover"),
+        ),
+        info_case(
             "case-negative-mu",
             "negative friction coefficient",
             set(c, "/contact/friction_coefficient", json!(-0.25)),
@@ -867,6 +931,33 @@ fn maps(fx: &Fixture) -> Vec<Hostile> {
             Fails("normal_stiffness"),
         ),
         mk(
+            "map-per-area-no-areas",
+            "contact per area without pair areas",
+            edit(map, |v| {
+                v["contact"] = json!({"normal_stiffness_per_area": 160.0,
+                    "friction_coefficient": 0.25, "stick_stiffness_per_area": 160.0});
+            }),
+            Fails("pairs[0].area"),
+        ),
+        mk(
+            "map-pair-area-negative",
+            "a negative pair area",
+            edit(map, |v| {
+                let n = v["pairs"].as_array().map_or(0, |a| a.len());
+                for i in 0..n {
+                    v["pairs"][i]["area"] = json!(62.5);
+                }
+                v["pairs"][3]["area"] = json!(-1.0);
+            }),
+            Fails("pairs[3].area"),
+        ),
+        mk(
+            "map-pair-area-some",
+            "areas for some pairs only",
+            set(map, "/pairs/2/area", json!(62.5)),
+            Fails("pairs[0].area"),
+        ),
+        mk(
             "map-negative-end",
             "negative end time",
             set(map, "/end_time", json!(-1.0)),
@@ -1053,6 +1144,18 @@ fn flags(fx: &Fixture) -> Vec<Hostile> {
     use Expect::Fails;
     let stiff = set(&fx.case, "/contact/normal_stiffness", json!(1e15));
     vec![
+        flag(
+            "flag-contact-per-area-one",
+            "--contact-per-area with one value",
+            &["--contact-per-area", "160"],
+            Fails("--contact-per-area"),
+        ),
+        flag(
+            "flag-contact-per-area-negative",
+            "--contact-per-area with a negative value",
+            &["--contact-per-area=160,-1"],
+            Fails("--contact-per-area"),
+        ),
         flag(
             "flag-output-step-tiny",
             "--output-step 1e-300",
