@@ -52,7 +52,9 @@
 //!   a missing field's path names the field itself, the document root is `$`);
 //! - non-finite numbers; E, density, thickness, diameter, element counts, sheet lengths
 //!   (`x[1] > x[0]`, `z[1] > z[0]`), contact stiffnesses, ramp duration and end time that are
-//!   not positive; a negative friction coefficient; ν outside (−1, 0.5);
+//!   not positive; a negative friction coefficient; ν outside (−1, 0.5); a contact stiffness
+//!   given both per pair and per area, or neither, and the normal and stick stiffness given
+//!   different ways;
 //! - empty or duplicate sheet names, an unknown sheet name anywhere, a sheet listed twice;
 //! - a clamp or tie `x` that is not a node line of each listed sheet; no clamp at all; a node
 //!   that is both clamped and tied;
@@ -63,7 +65,9 @@
 //! - a joint whose sheets are the same, are declared twice, have a clearance
 //!   (`upper.y − lower.y ≠ (t_lower + t_upper)/2` within 1e-9 of the scale), do not overlap in
 //!   (x, z), or overlap without coinciding nodes; an explicit joint point that is not a node of
-//!   both sheets, is listed twice, or is clamped or tied; a joint left without pairs.
+//!   both sheets, is listed twice, or is clamped or tied; a joint left without pairs; with the
+//!   contact law per area, a pair on no face of the joint surface or pairs whose faces do not
+//!   cover the joints' overlap (`crate::model::per_area`).
 //!
 //! [`Case::from_json_str`] checks the material and each sheet's own fields; the other checks above
 //! need the node grids and run while `crate::mesh::Mesh::from_case` generates
@@ -360,7 +364,10 @@ impl ContactSpec {
 
     /// The per-area stiffnesses `[κ_n, κ_t]` (N/mm³) if the law is given per area.
     pub fn per_area(&self) -> Option<[f64; 2]> {
-        match (self.normal_stiffness_per_area, self.stick_stiffness_per_area) {
+        match (
+            self.normal_stiffness_per_area,
+            self.stick_stiffness_per_area,
+        ) {
             (Some(n), Some(t)) => Some([n, t]),
             _ => None,
         }

@@ -100,8 +100,16 @@ pub(crate) fn check_contact_load(
 fn check_stiffnesses(c: &ContactSpec, ctx: &Ctx) -> Result<(), Error> {
     let mut ways = [false; 2];
     for (i, (name, per_pair, per_area)) in [
-        ("normal_stiffness", c.normal_stiffness, c.normal_stiffness_per_area),
-        ("stick_stiffness", c.stick_stiffness, c.stick_stiffness_per_area),
+        (
+            "normal_stiffness",
+            c.normal_stiffness,
+            c.normal_stiffness_per_area,
+        ),
+        (
+            "stick_stiffness",
+            c.stick_stiffness,
+            c.stick_stiffness_per_area,
+        ),
     ]
     .into_iter()
     .enumerate()

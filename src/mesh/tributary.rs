@@ -7,7 +7,7 @@
 //! The joint surface is the set of the lower side's quadrilateral faces whose four corners are
 //! all joint nodes — lower nodes of pairs, of coincident pairs left out because an area weld
 //! fuses them or a support holds them, or clamped or tied nodes (a deck has no pair there) —
-//! with at least one corner a pair's. Each face `e` gives
+//! with at least one corner a pair's or a left-out pair's. Each face `e` gives
 //! its corner `a` the integral of the corner's bilinear shape function,
 //!
 //! ```text
@@ -60,9 +60,11 @@ pub fn tributary_areas(
     excluded: &[JointPair],
     held: &[usize],
 ) -> Result<Tributary, Uncovered> {
-    // Per node: how many pairs have it as lower node, and whether a left-out pair does.
+    // Per node: how many pairs have it as lower node, whether a left-out pair does, whether a
+    // support holds it.
     let mut count = vec![0u32; nodes.len()];
     let mut left_out = vec![false; nodes.len()];
+    let mut support = vec![false; nodes.len()];
     for p in pairs {
         count[p.lower] += 1;
     }
@@ -70,13 +72,16 @@ pub fn tributary_areas(
         left_out[p.lower] = true;
     }
     for &n in held {
-        left_out[n] = true;
+        support[n] = true;
     }
-    let joint = |n: usize| count[n] > 0 || left_out[n];
+    let coincident = |n: usize| count[n] > 0 || left_out[n];
     let mut node_area = vec![0.0; nodes.len()];
     let (mut total, mut excluded_area) = (0.0, 0.0);
     for shell in shells {
-        if !shell.nodes.iter().all(|&n| joint(n)) || shell.nodes.iter().all(|&n| count[n] == 0) {
+        let corners = shell.nodes;
+        if !corners.iter().all(|&n| coincident(n) || support[n])
+            || !corners.iter().any(|&n| coincident(n))
+        {
             continue;
         }
         let shares = corner_areas(shell.nodes.map(|n| nodes[n]));
@@ -92,7 +97,7 @@ pub fn tributary_areas(
     let mut areas = Vec::with_capacity(pairs.len());
     for (i, p) in pairs.iter().enumerate() {
         let a = node_area[p.lower] / f64::from(count[p.lower]);
-        if !(a > 0.0) {
+        if a.is_nan() || a <= 0.0 {
             return Err(Uncovered {
                 pair: i,
                 node: p.lower,

@@ -44,7 +44,12 @@ impl Model {
         &self,
     ) -> Option<Result<crate::mesh::tributary::Tributary, Uncovered>> {
         let mesh = self.mesh()?;
-        let held: Vec<usize> = mesh.clamped.iter().chain(&mesh.tie.slaves).copied().collect();
+        let held: Vec<usize> = mesh
+            .clamped
+            .iter()
+            .chain(&mesh.tie.slaves)
+            .copied()
+            .collect();
         Some(tributary_areas(
             &mesh.nodes,
             &mesh.shells,
@@ -104,7 +109,7 @@ impl Model {
                     field,
                     "the model has no pair areas: give each pair's `area` (mm²) in the matrix \
                      map"
-                        .into(),
+                    .into(),
                 ))
             }
         };

@@ -41,9 +41,20 @@ fn tributary_areas_sum_to_the_overlap() {
         let overlap = joints_overlap(&case);
         let model = Model::from_case(case).unwrap();
         let mesh = model.mesh().unwrap();
-        let held: Vec<usize> = mesh.clamped.iter().chain(&mesh.tie.slaves).copied().collect();
-        let t = tributary_areas(&mesh.nodes, &mesh.shells, &mesh.pairs, &mesh.excluded, &held)
-            .unwrap();
+        let held: Vec<usize> = mesh
+            .clamped
+            .iter()
+            .chain(&mesh.tie.slaves)
+            .copied()
+            .collect();
+        let t = tributary_areas(
+            &mesh.nodes,
+            &mesh.shells,
+            &mesh.pairs,
+            &mesh.excluded,
+            &held,
+        )
+        .unwrap();
         let sum: f64 = t.areas.iter().sum();
         assert!(
             (sum + t.excluded - overlap).abs() <= 1e-9 * overlap,
@@ -82,7 +93,10 @@ fn corner_areas_are_the_shape_function_integrals() {
     assert!((sum - 9.0).abs() < 1e-12, "{a:?}");
     assert!(a[0] > a[3] && a[1] > a[2], "{a:?}");
     // By hand: J = 3(3 − η)/4, ∫N_0 J = 2.5 mm², ∫N_3 J = 2 mm² (2×2 Gauss is exact here).
-    assert!((a[0] - 2.5).abs() < 1e-12 && (a[3] - 2.0).abs() < 1e-12, "{a:?}");
+    assert!(
+        (a[0] - 2.5).abs() < 1e-12 && (a[3] - 2.0).abs() < 1e-12,
+        "{a:?}"
+    );
 }
 
 /// A uniform penetration δ of the upper sheet gives the pressure κ·δ at every pair and the
@@ -117,7 +131,11 @@ fn uniform_penetration_gives_mesh_independent_pressure() {
                 m.contact_resultant
             );
             let pressure = KAPPA * delta;
-            for (i, (&p, a)) in forces.iter().zip(model.pair_areas.as_ref().unwrap()).enumerate() {
+            for (i, (&p, a)) in forces
+                .iter()
+                .zip(model.pair_areas.as_ref().unwrap())
+                .enumerate()
+            {
                 let pi = (model.pair_weight(i) * p).abs() / a;
                 assert!((pi - pressure).abs() <= 1e-12 * pressure, "pair {i}: {pi}");
             }
@@ -179,16 +197,27 @@ fn deck_areas_equal_the_case_areas() {
                 .pairs
                 .iter()
                 .zip(m.pair_areas.as_ref().unwrap())
-                .map(|(p, &a)| (m.geometry.nodes[p.lower].map(|x| (x * 1e6).round() as i64), a))
+                .map(|(p, &a)| {
+                    (
+                        m.geometry.nodes[p.lower].map(|x| (x * 1e6).round() as i64),
+                        a,
+                    )
+                })
                 .collect();
-            v.sort_by(|a, b| a.0.cmp(&b.0));
+            v.sort_by_key(|a| a.0);
             v
         };
         let (d, c) = (key(&deck), key(&case));
         assert_eq!(d.len(), c.len(), "{name}");
         for (a, b) in d.iter().zip(&c) {
             assert_eq!(a.0, b.0, "{name}");
-            assert!((a.1 - b.1).abs() <= 1e-9 * b.1, "{name} at {:?}: {} vs {}", a.0, a.1, b.1);
+            assert!(
+                (a.1 - b.1).abs() <= 1e-9 * b.1,
+                "{name} at {:?}: {} vs {}",
+                a.0,
+                a.1,
+                b.1
+            );
         }
         assert_eq!(deck.contact.normal_stiffness_per_area, Some(KAPPA));
         let rel = (deck.contact.normal_stiffness - case.contact.normal_stiffness).abs()

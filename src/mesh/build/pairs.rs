@@ -216,13 +216,9 @@ impl Sheets<'_> {
             check_clearance(ctx, &p, gl, gu)?;
             let overlap = overlap(ctx, &p, gl, gu)?;
             let mut found = match &joint.points {
-                None => coincident_pairs(
-                    [lower, upper],
-                    [gl, gu],
-                    &overlap,
-                    supports,
-                    &mut excluded,
-                ),
+                None => {
+                    coincident_pairs([lower, upper], [gl, gu], &overlap, supports, &mut excluded)
+                }
                 Some(points) => {
                     pairs_at_points(ctx, &p, points, ([lower, upper], [gl, gu]), supports)?
                 }
