@@ -51,8 +51,9 @@ pub struct DeckModel {
     pub shell_sources: Vec<(std::path::PathBuf, usize, i64)>,
 }
 
-/// Builds the mesh of a typed deck (see the module docs).
-pub fn build(deck: &Deck) -> Result<DeckModel, Error> {
+/// Builds the mesh of a typed deck (see the module docs), the area welds' neighbourhoods
+/// re-meshed by the rule `local_mesh` of a case file's welds (`crate::mesh::deck_patch`).
+pub fn build(deck: &Deck, local_mesh: crate::case::LocalMesh) -> Result<DeckModel, Error> {
     let mut warnings = deck.warnings.clone();
     let (nodes, grid_ids, index) = nodes(deck, &mut warnings)?;
     let material = material(deck)?;
@@ -65,8 +66,16 @@ pub fn build(deck: &Deck) -> Result<DeckModel, Error> {
     let tie = rigid_tie(deck, &index)?;
     let clamped = clamps(deck, &index, &tie)?;
     let mut beams = beams(deck, &index)?;
-    let (welds, align) = welds(deck, &index, &nodes, &shells, &sheets)?;
+    let (mut welds, align) = welds(deck, &index, &nodes, &shells, &sheets)?;
     beams.extend(align);
+    super::deck_patch::weld_patches(
+        &deck.cards.files[0].display().to_string(),
+        &mut welds,
+        (&nodes, &shells, &sheets.members),
+        (&clamped, &tie),
+        local_mesh,
+        &mut warnings,
+    )?;
     let (pairs, fused, contact) =
         pairs(deck, &index, &nodes, &welds, &clamped, &tie, &mut warnings)?;
     let masses = deck

@@ -10,6 +10,7 @@ use crate::error::{ElementError, Error};
 
 mod build;
 pub mod deck;
+mod deck_patch;
 mod nugget;
 pub mod tributary;
 
@@ -280,7 +281,10 @@ impl Mesh {
 
     /// Builds the mesh of a NASTRAN deck with its load, contact law and end time (see
     /// [`deck`]).
-    pub fn from_deck(deck: &crate::case::nastran::Deck) -> Result<DeckModel, Error> {
-        deck::build(deck)
+    pub fn from_deck(
+        deck: &crate::case::nastran::Deck,
+        local_mesh: crate::case::LocalMesh,
+    ) -> Result<DeckModel, Error> {
+        deck::build(deck, local_mesh)
     }
 }

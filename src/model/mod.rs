@@ -234,8 +234,17 @@ impl Model {
     /// Reads a NASTRAN deck ([`crate::case::nastran`]), builds its mesh and assembles K and M.
     /// Pair frames follow each CGAP's GA → GB direction ([`PairFrame::along`]).
     pub fn from_deck(path: &std::path::Path) -> Result<Model, Error> {
+        Model::from_deck_with(path, crate::case::LocalMesh::Auto)
+    }
+
+    /// [`Model::from_deck`] with the rule `local_mesh` for the area welds' neighbourhoods
+    /// (`auto`: a case file's default; `off`: the nugget on the deck's own shells).
+    pub fn from_deck_with(
+        path: &std::path::Path,
+        local_mesh: crate::case::LocalMesh,
+    ) -> Result<Model, Error> {
         let deck = crate::case::nastran::deck::read(path)?;
-        let built = Mesh::from_deck(&deck)?;
+        let built = Mesh::from_deck(&deck, local_mesh)?;
         let mesh = built.mesh;
         // Each CQUAD4's element first, so that a degenerate or warped one is named by its line.
         for (shell, (file, line, id)) in mesh.shells.iter().zip(&built.shell_sources) {
