@@ -42,12 +42,20 @@ fn uniform_lines(mut v: Vec<f64>) -> Option<Vec<f64>> {
 }
 
 /// Sheet `members` (shell indices) as a regular grid, if it is one (`name` for messages).
-fn regular(name: String, members: &[usize], shells: &[ShellElem], nodes: &[[f64; 3]]) -> Option<Regular> {
+fn regular(
+    name: String,
+    members: &[usize],
+    shells: &[ShellElem],
+    nodes: &[[f64; 3]],
+) -> Option<Regular> {
     let mut own: Vec<usize> = members.iter().flat_map(|&e| shells[e].nodes).collect();
     own.sort_unstable();
     own.dedup();
     let y = nodes[own[0]][1];
-    if own.iter().any(|&n| (nodes[n][1] - y).abs() > NODE_TOLERANCE) {
+    if own
+        .iter()
+        .any(|&n| (nodes[n][1] - y).abs() > NODE_TOLERANCE)
+    {
         return None;
     }
     let xs = uniform_lines(own.iter().map(|&n| nodes[n][0]).collect())?;

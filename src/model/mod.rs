@@ -21,6 +21,7 @@ pub mod per_area;
 pub mod petsc;
 
 pub use contact::contact_static_full;
+pub use load::LoadOptions;
 
 use std::path::PathBuf;
 

@@ -957,7 +957,7 @@ fn maps(fx: &Fixture) -> Vec<Hostile> {
         mk(
             "map-pair-area-some",
             "areas for some pairs only",
-            set(map, "/pairs/2/area", json!(62.5)),
+            edit(map, |v| v["pairs"][2]["area"] = json!(62.5)),
             Fails("pairs[0].area"),
         ),
         mk(

@@ -185,12 +185,11 @@ fn weighted_rows_are_the_springs_kappa_area() {
 fn deck_areas_equal_the_case_areas() {
     for name in ["friction_bar", "multilayer_sheet"] {
         let path = repo_path(&format!("cases/nastran/{name}.bdf"));
-        let deck = Model::from_case_name_with(
-            path.to_str().unwrap(),
-            Some([KAPPA, KAPPA]),
-            "--contact-per-area",
-        )
-        .unwrap();
+        let opts = jointrom::model::LoadOptions {
+            contact_per_area: Some([KAPPA, KAPPA]),
+            ..Default::default()
+        };
+        let deck = Model::from_case_name_with(path.to_str().unwrap(), &opts).unwrap();
         let case = Model::from_case(per_area(common::builtin_case(name))).unwrap();
         let key = |m: &Model| {
             let mut v: Vec<([i64; 3], f64)> = m

@@ -3,6 +3,7 @@
 use std::path::Path;
 use std::sync::Mutex;
 
+use jointrom::model::LoadOptions;
 use jointrom::{Error, Model};
 use serde_json::Value;
 
@@ -68,22 +69,26 @@ pub fn inputs() -> Vec<String> {
     INPUTS.lock().map(|v| v.clone()).unwrap_or_default()
 }
 
-/// `--contact-per-area`, parsed once by the main function.
-static CONTACT_PER_AREA: Mutex<Option<[f64; 2]>> = Mutex::new(None);
+/// `--contact-per-area` and `--deck-local-mesh`, parsed once by the main function.
+static LOAD_OPTIONS: Mutex<Option<LoadOptions>> = Mutex::new(None);
 
-/// Sets the `--contact-per-area` values every [`load_model`] applies.
-pub fn set_contact_per_area(k: Option<[f64; 2]>) {
-    if let Ok(mut g) = CONTACT_PER_AREA.lock() {
-        *g = k;
+/// Sets the options every [`load_model`] applies.
+pub fn set_load_options(opts: LoadOptions) {
+    if let Ok(mut g) = LOAD_OPTIONS.lock() {
+        *g = Some(opts);
     }
 }
 
-/// Loads a case file, built-in scene or matrix map ([`Model::from_case_name_with`], with
-/// `--contact-per-area`) and records where its matrices came from.
+/// Loads a case file, deck, built-in scene or matrix map ([`Model::from_case_name_with`], with
+/// `--contact-per-area` and `--deck-local-mesh`) and records where its matrices came from.
 pub fn load_model(arg: &str) -> Result<Model, Error> {
     let start = std::time::Instant::now();
-    let per_area = CONTACT_PER_AREA.lock().ok().and_then(|g| *g);
-    let model = Model::from_case_name_with(arg, per_area, "--contact-per-area")?;
+    let opts = LOAD_OPTIONS
+        .lock()
+        .ok()
+        .and_then(|g| *g)
+        .unwrap_or_default();
+    let model = Model::from_case_name_with(arg, &opts)?;
     if let Ok(mut g) = MODEL_S.lock() {
         *g = Some(g.unwrap_or(0.0) + start.elapsed().as_secs_f64());
     }

@@ -35,8 +35,8 @@ fn main() -> ExitCode {
     // Every output a failing command created is removed again: a failed export or report
     // leaves no partial files.
     jointrom::files::journal_start();
-    match cli.contact_per_area() {
-        Ok(k) => common::set_contact_per_area(k),
+    match cli.load_options() {
+        Ok(opts) => common::set_load_options(opts),
         Err(e) => return fail(&e),
     }
     match cli.command.run() {
