@@ -213,6 +213,9 @@ impl Slave {
             normal_stiffness: v[vr::K_N as usize],
             friction_coefficient: v[vr::MU as usize],
             stick_stiffness: v[vr::K_T as usize],
+            // A per-area model's k_n, k_t are those of a pair of mean tributary area (its
+            // joint operator carries each pair's share): the per-area values stay for reports.
+            ..self.rom.contact
         };
         // The options of `jointrom transient`, with the exported τ and the importer's rtol.
         let mut opts = TransientOptions::default();

@@ -52,7 +52,9 @@
 //!   a missing field's path names the field itself, the document root is `$`);
 //! - non-finite numbers; E, density, thickness, diameter, element counts, sheet lengths
 //!   (`x[1] > x[0]`, `z[1] > z[0]`), contact stiffnesses, ramp duration and end time that are
-//!   not positive; a negative friction coefficient; ν outside (−1, 0.5);
+//!   not positive; a negative friction coefficient; ν outside (−1, 0.5); a contact stiffness
+//!   given both per pair and per area, or neither, and the normal and stick stiffness given
+//!   different ways;
 //! - empty or duplicate sheet names, an unknown sheet name anywhere, a sheet listed twice;
 //! - a clamp or tie `x` that is not a node line of each listed sheet; no clamp at all; a node
 //!   that is both clamped and tied;
@@ -63,7 +65,9 @@
 //! - a joint whose sheets are the same, are declared twice, have a clearance
 //!   (`upper.y − lower.y ≠ (t_lower + t_upper)/2` within 1e-9 of the scale), do not overlap in
 //!   (x, z), or overlap without coinciding nodes; an explicit joint point that is not a node of
-//!   both sheets, is listed twice, or is clamped or tied; a joint left without pairs.
+//!   both sheets, is listed twice, or is clamped or tied; a joint left without pairs; with the
+//!   contact law per area, a pair on no face of the joint surface or pairs whose faces do not
+//!   cover the joints' overlap (`crate::model::per_area`).
 //!
 //! [`Case::from_json_str`] checks the material and each sheet's own fields; the other checks above
 //! need the node grids and run while `crate::mesh::Mesh::from_case` generates
@@ -301,16 +305,73 @@ pub struct JointSpec {
     pub points: Option<Vec<[f64; 2]>>,
 }
 
-/// Penalty contact and elastic–slip friction, the same for every node pair.
+/// Penalty contact and elastic–slip friction of every node pair.
+///
+/// The penalty stiffnesses are given either **per pair** (`normal_stiffness`, `stick_stiffness`,
+/// N/mm: the paper's node-to-node springs, whose interface stiffness grows with the pair count
+/// when the mesh is refined) or **per area** (`normal_stiffness_per_area`,
+/// `stick_stiffness_per_area`, N/mm³: a pressure per penetration, each pair's spring `κ·A_i`
+/// with `A_i` its tributary area on the joint surface, so the interface's stiffness `κ·A_joint`
+/// does not depend on the mesh; `crate::mesh::tributary`). Both stiffnesses are given the same
+/// way. In a built model ([`crate::Model::contact`]) the per-area law is resolved:
+/// `normal_stiffness = κ_n·Ā` and `stick_stiffness = κ_t·Ā` with Ā the mean tributary area of
+/// the pairs (the stiffness of a pair of mean area), the per-area values kept beside them.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ContactSpec {
-    /// Normal penalty stiffness of a closed pair, N/mm (> 0).
+    /// Normal penalty stiffness of a closed pair, N/mm (> 0). Absent (NaN) in a file that gives
+    /// `normal_stiffness_per_area` instead.
+    #[serde(default = "absent", skip_serializing_if = "is_absent")]
     pub normal_stiffness: f64,
     /// Coulomb friction coefficient μ, dimensionless (≥ 0).
     pub friction_coefficient: f64,
-    /// Tangential (stick) stiffness of a closed pair, N/mm (> 0).
+    /// Tangential (stick) stiffness of a closed pair, N/mm (> 0). Absent (NaN) in a file that
+    /// gives `stick_stiffness_per_area` instead.
+    #[serde(default = "absent", skip_serializing_if = "is_absent")]
     pub stick_stiffness: f64,
+    /// Normal penalty stiffness per unit contact area κ_n, N/mm³ (> 0): each pair's normal
+    /// stiffness is κ_n·A_i. An alternative to `normal_stiffness`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub normal_stiffness_per_area: Option<f64>,
+    /// Tangential (stick) stiffness per unit contact area κ_t, N/mm³ (> 0): each pair's stick
+    /// stiffness is κ_t·A_i. An alternative to `stick_stiffness`, given together with
+    /// `normal_stiffness_per_area`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stick_stiffness_per_area: Option<f64>,
+}
+
+/// A per-pair stiffness the file leaves out (it gives the per-area one).
+fn absent() -> f64 {
+    f64::NAN
+}
+
+fn is_absent(v: &f64) -> bool {
+    v.is_nan()
+}
+
+impl ContactSpec {
+    /// The paper's law with per-pair stiffnesses `k_n`, `k_t` (N/mm) and friction coefficient
+    /// `mu`.
+    pub fn per_pair(k_n: f64, mu: f64, k_t: f64) -> ContactSpec {
+        ContactSpec {
+            normal_stiffness: k_n,
+            friction_coefficient: mu,
+            stick_stiffness: k_t,
+            normal_stiffness_per_area: None,
+            stick_stiffness_per_area: None,
+        }
+    }
+
+    /// The per-area stiffnesses `[κ_n, κ_t]` (N/mm³) if the law is given per area.
+    pub fn per_area(&self) -> Option<[f64; 2]> {
+        match (
+            self.normal_stiffness_per_area,
+            self.stick_stiffness_per_area,
+        ) {
+            (Some(n), Some(t)) => Some([n, t]),
+            _ => None,
+        }
+    }
 }
 
 /// The load on the master node: constant components times a ramp in time.

@@ -69,7 +69,7 @@ pub(crate) fn check_contact_load(
     file: &str,
 ) -> Result<(), Error> {
     let ctx = &Ctx { file };
-    ctx.positive("contact.normal_stiffness", c.normal_stiffness, " N/mm")?;
+    check_stiffnesses(c, ctx)?;
     let mu = c.friction_coefficient;
     if !(mu.is_finite() && mu >= 0.0) {
         return Err(ctx.err(
@@ -77,7 +77,6 @@ pub(crate) fn check_contact_load(
             format!("must be finite and ≥ 0, got {mu}"),
         ));
     }
-    ctx.positive("contact.stick_stiffness", c.stick_stiffness, " N/mm")?;
     let m = &load.master;
     for (key, v, unit) in [
         ("fx", m.fx, " N"),
@@ -93,6 +92,63 @@ pub(crate) fn check_contact_load(
         .check("load.ramp")
         .map_err(|(path, reason)| ctx.err(path, reason))?;
     ctx.positive("end_time", end_time, " s")
+}
+
+/// The penalty stiffnesses of a contact block as a file gives them: each of the normal and the
+/// stick stiffness either per pair (N/mm) or per area (N/mm³), not both, positive and finite,
+/// and both given the same way.
+fn check_stiffnesses(c: &ContactSpec, ctx: &Ctx) -> Result<(), Error> {
+    let mut ways = [false; 2];
+    for (i, (name, per_pair, per_area)) in [
+        (
+            "normal_stiffness",
+            c.normal_stiffness,
+            c.normal_stiffness_per_area,
+        ),
+        (
+            "stick_stiffness",
+            c.stick_stiffness,
+            c.stick_stiffness_per_area,
+        ),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let pair_path = format!("contact.{name}");
+        let area_path = format!("contact.{name}_per_area");
+        match (per_pair.is_nan(), per_area) {
+            (false, Some(_)) => {
+                return Err(ctx.err(
+                    area_path,
+                    format!(
+                        "`{name}` (per pair, N/mm) and `{name}_per_area` (per area, N/mm³) are                          given together: give one of them"
+                    ),
+                ))
+            }
+            (true, None) => {
+                return Err(ctx.err(
+                    pair_path,
+                    format!(
+                        "missing: give `{name}` (per pair, N/mm) or `{name}_per_area` (per                          area, N/mm³)"
+                    ),
+                ))
+            }
+            (false, None) => ctx.positive(&pair_path, per_pair, " N/mm")?,
+            (true, Some(k)) => {
+                ctx.positive(&area_path, k, " N/mm³")?;
+                ways[i] = true;
+            }
+        }
+    }
+    if ways[0] != ways[1] {
+        return Err(ctx.err(
+            "contact.stick_stiffness_per_area",
+            "give both stiffnesses per area (`normal_stiffness_per_area` and \
+             `stick_stiffness_per_area`, N/mm³) or both per pair (N/mm): a pair's stick and \
+             normal springs share its tributary area",
+        ));
+    }
+    Ok(())
 }
 
 /// The longest element side a sheet may have, mm (1 km): sizes and coordinates derived from a

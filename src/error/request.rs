@@ -17,6 +17,14 @@ pub enum ModelError {
     /// `export-matrices`: no node owns the six master DOF.
     #[error("export-matrices: no node owns the six master DOF")]
     ExportNoMasterNode,
+    /// A contact law per area cannot be resolved on the model from `model`: `field` names the
+    /// file's field or the flag that asked for it.
+    #[error("{model}: `{field}`: {reason}")]
+    PerArea {
+        model: String,
+        field: String,
+        reason: String,
+    },
     /// A CGAP of the deck `file` joins two coincident nodes.
     #[error("{}: a degenerate CGAP", file.display())]
     DegenerateGap { file: PathBuf },

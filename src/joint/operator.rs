@@ -164,6 +164,15 @@ impl JointOperator {
         }
     }
 
+    /// Multiplies the three rows of pair k by `weights[k]` (w values, > 0): the weighted pair
+    /// kinematics of a contact law per area (`crate::model::per_area`).
+    pub fn weight_pairs(&mut self, weights: &[f64]) {
+        for (k, &w) in weights.iter().enumerate().take(self.pairs) {
+            let (a, b) = (self.row_ptr[3 * k], self.row_ptr[3 * k + 3]);
+            self.values[a..b].iter_mut().for_each(|v| *v *= w);
+        }
+    }
+
     /// Dense `B Φ` (3w × r) for a basis Φ (n × r).
     pub fn reduce(&self, phi: MatRef<'_, f64>) -> Mat<f64> {
         Mat::from_fn(self.rows(), phi.ncols(), |r, j| {

@@ -51,8 +51,9 @@ pub struct DeckModel {
     pub shell_sources: Vec<(std::path::PathBuf, usize, i64)>,
 }
 
-/// Builds the mesh of a typed deck (see the module docs).
-pub fn build(deck: &Deck) -> Result<DeckModel, Error> {
+/// Builds the mesh of a typed deck (see the module docs), the area welds' neighbourhoods
+/// re-meshed by the rule `local_mesh` of a case file's welds (`crate::mesh::deck_patch`).
+pub fn build(deck: &Deck, local_mesh: crate::case::LocalMesh) -> Result<DeckModel, Error> {
     let mut warnings = deck.warnings.clone();
     let (nodes, grid_ids, index) = nodes(deck, &mut warnings)?;
     let material = material(deck)?;
@@ -65,9 +66,18 @@ pub fn build(deck: &Deck) -> Result<DeckModel, Error> {
     let tie = rigid_tie(deck, &index)?;
     let clamped = clamps(deck, &index, &tie)?;
     let mut beams = beams(deck, &index)?;
-    let (welds, align) = welds(deck, &index, &nodes, &shells, &sheets)?;
+    let (mut welds, align) = welds(deck, &index, &nodes, &shells, &sheets)?;
     beams.extend(align);
-    let (pairs, contact) = pairs(deck, &index, &nodes, &welds, &clamped, &tie, &mut warnings)?;
+    super::deck_patch::weld_patches(
+        &deck.cards.files[0].display().to_string(),
+        &mut welds,
+        (&nodes, &shells, &sheets.members),
+        (&clamped, &tie),
+        local_mesh,
+        &mut warnings,
+    )?;
+    let (pairs, fused, contact) =
+        pairs(deck, &index, &nodes, &welds, &clamped, &tie, &mut warnings)?;
     let masses = deck
         .masses
         .iter()
@@ -90,6 +100,7 @@ pub fn build(deck: &Deck) -> Result<DeckModel, Error> {
             clamped,
             tie,
             pairs,
+            excluded: fused,
             material,
             warnings: Vec::new(),
         },
@@ -861,8 +872,9 @@ fn pairs(
     clamped: &[usize],
     tie: &RigidTie,
     warnings: &mut Vec<String>,
-) -> Result<(Vec<JointPair>, ContactSpec), Error> {
+) -> Result<(Vec<JointPair>, Vec<JointPair>, ContactSpec), Error> {
     let mut law: Option<(ContactSpec, i64)> = None;
+    let mut fused_pairs = Vec::new();
     let mut out = Vec::with_capacity(deck.gaps.len());
     let mut seen: BTreeMap<(usize, usize), i64> = BTreeMap::new();
     let mut fused = Vec::new();
@@ -872,11 +884,11 @@ fn pairs(
         let Some(p) = deck.pgaps.get(&g.pid) else {
             return Err(e(format!("PGAP {} is not defined", g.pid)));
         };
-        let spec = ContactSpec {
-            normal_stiffness: p.normal_stiffness,
-            friction_coefficient: p.friction_coefficient,
-            stick_stiffness: p.stick_stiffness,
-        };
+        let spec = ContactSpec::per_pair(
+            p.normal_stiffness,
+            p.friction_coefficient,
+            p.stick_stiffness,
+        );
         match &law {
             None => law = Some((spec, g.pid)),
             Some((l, pid)) if *l != spec => {
@@ -925,6 +937,7 @@ fn pairs(
         });
         if in_nugget {
             fused.push(g.id);
+            fused_pairs.push(JointPair { lower: a, upper: b });
             continue;
         }
         out.push(JointPair { lower: a, upper: b });
@@ -937,7 +950,7 @@ fn pairs(
         ));
     }
     match law {
-        Some((spec, _)) if !out.is_empty() => Ok((out, spec)),
+        Some((spec, _)) if !out.is_empty() => Ok((out, fused_pairs, spec)),
         _ => Err(deck_err(
             deck,
             "no CGAP pairs: jointrom's joints are node-to-node CGAP + PGAP pairs",

@@ -10,7 +10,9 @@ use crate::error::{ElementError, Error};
 
 mod build;
 pub mod deck;
+mod deck_patch;
 mod nugget;
+pub mod tributary;
 
 pub use deck::DeckModel;
 
@@ -213,6 +215,10 @@ pub struct Mesh {
     /// Joint pairs, interface by interface in case-file order, within an interface sorted by
     /// (x, z).
     pub pairs: Vec<JointPair>,
+    /// Coincident node pairs of the joints left out of [`Mesh::pairs`]: fused by an area weld's
+    /// nugget, clamped or tied (a deck's: the CGAPs inside a nugget). Their share of the joint
+    /// surface is carried by the weld or the support, not by contact.
+    pub excluded: Vec<JointPair>,
     /// Material of all sheets and welds.
     pub material: Material,
     /// What the build could not do as asked and did otherwise (a weld whose automatic
@@ -275,7 +281,10 @@ impl Mesh {
 
     /// Builds the mesh of a NASTRAN deck with its load, contact law and end time (see
     /// [`deck`]).
-    pub fn from_deck(deck: &crate::case::nastran::Deck) -> Result<DeckModel, Error> {
-        deck::build(deck)
+    pub fn from_deck(
+        deck: &crate::case::nastran::Deck,
+        local_mesh: crate::case::LocalMesh,
+    ) -> Result<DeckModel, Error> {
+        deck::build(deck, local_mesh)
     }
 }

@@ -18,4 +18,56 @@ impl Model {
         }
         Model::from_case(Case::load(arg)?)
     }
+
+    /// [`Model::from_case_name`] with the options a file does not carry (`opts`): for a deck
+    /// the rule of its area welds' neighbourhoods, and for any model the contact law per area
+    /// `[κ_n, κ_t]` (N/mm³) on the pairs' tributary areas in place of the stiffnesses the file
+    /// gives (a deck's PGAP, a case's or a map's contact block; `crate::model::per_area`; the
+    /// file's friction coefficient stays). Errors name the flags (`--contact-per-area`).
+    pub fn from_case_name_with(arg: &str, opts: &LoadOptions) -> Result<Model, Error> {
+        let field = "--contact-per-area";
+        let is_map = super::matrices::map_file(arg)?.is_some();
+        let is_deck = !is_map && crate::case::nastran::is_deck(arg);
+        let Some(kappa) = opts.contact_per_area else {
+            return if is_deck {
+                Model::from_deck_with(std::path::Path::new(arg), opts.deck_local_mesh)
+            } else {
+                Model::from_case_name(arg)
+            };
+        };
+        if is_map || is_deck {
+            let mut model = if is_deck {
+                Model::from_deck_with(std::path::Path::new(arg), opts.deck_local_mesh)?
+            } else {
+                Model::from_case_name(arg)?
+            };
+            if model.pair_weights.is_some() {
+                return Err(crate::error::ModelError::PerArea {
+                    model: model.source.clone(),
+                    field: field.to_string(),
+                    reason: "the map already gives its contact law per area".into(),
+                }
+                .into());
+            }
+            model.apply_contact_per_area(kappa, field)?;
+            return Ok(model);
+        }
+        let mut case = Case::load(arg)?;
+        case.contact.normal_stiffness = f64::NAN;
+        case.contact.stick_stiffness = f64::NAN;
+        case.contact.normal_stiffness_per_area = Some(kappa[0]);
+        case.contact.stick_stiffness_per_area = Some(kappa[1]);
+        Model::from_case(case)
+    }
+}
+
+/// What loading a model may be told beside its file (the CLI's `--contact-per-area`,
+/// `--deck-local-mesh`).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct LoadOptions {
+    /// The contact law per area `[κ_n, κ_t]`, N/mm³, in place of the file's stiffnesses.
+    pub contact_per_area: Option<[f64; 2]>,
+    /// How a deck's area welds re-mesh their neighbourhood (default `auto`, a case file's
+    /// rule; `off`: the nugget on the deck's own shells; a size in mm).
+    pub deck_local_mesh: crate::case::LocalMesh,
 }

@@ -25,10 +25,10 @@
 //! | `rigid_followers` | array of u64, optional | nodes tied rigidly (RBE2) to the master node; no rows of their own; shown in VTU as `u_m + θ_m × (x − x_m)` |
 //! | `fixed_rows` | array of rows, optional | rows removed from K and M before use (SPC'd DOF left in the export) |
 //! | `pair_frame` | object, optional | default `{ "normal", "t1", "t2" }` unit vectors for pairs that give none |
-//! | `pairs` | array | `{ "lower": id, "upper": id, "normal"?, "t1"?, "t2"? }`: node-to-node contact pairs, zero initial clearance, the normal pointing from lower to upper; `n, t1, t2` orthonormal |
+//! | `pairs` | array | `{ "lower": id, "upper": id, "normal"?, "t1"?, "t2"?, "area"? }`: node-to-node contact pairs, zero initial clearance, the normal pointing from lower to upper; `n, t1, t2` orthonormal; `area` the pair's tributary area (mm², every pair or none) |
 //! | `cells` | array, optional | display cells `{ "type": "quad4" \| "line2", "nodes": [ids], "group"?: i32, "size"?: mm }` |
 //! | `load` | object | as in a case file: `master` (`fx, fy, fz` N, `mx, my, mz` N·mm) and `ramp` |
-//! | `contact` | object | as in a case file: `normal_stiffness`, `friction_coefficient`, `stick_stiffness` |
+//! | `contact` | object | as in a case file: `normal_stiffness`, `friction_coefficient`, `stick_stiffness`, or per area `normal_stiffness_per_area`, `stick_stiffness_per_area` (N/mm³; the pairs then need their `area`) |
 //! | `end_time` | number | simulated span, s |
 //! | `max_pair_distance` | number, optional | mm; a pair whose nodes lie farther apart is refused (default 10 × the median pair distance, at least 10⁻³ × the bounding-box diagonal) |
 //! | `duplicates` | `"reject"` (default) \| `"sum"`, optional | an entry a MatrixMarket file gives twice: an error naming both lines, or added up |
@@ -185,6 +185,11 @@ pub struct MapPair {
     /// Second tangent (default: `pair_frame.t2`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub t2: Option<[f64; 3]>,
+    /// Tributary area of the pair on the joint surface, mm² (> 0; optional, but given for
+    /// every pair or none): a contact law per area needs it, and with it the contact area and
+    /// pressure are reported.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub area: Option<f64>,
 }
 
 /// Display cell kinds.
@@ -342,7 +347,9 @@ pub fn load(map_path: &Path) -> Result<Model, Error> {
         node_ids: map.nodes.iter().map(|nd| nd.id).collect(),
         followers,
     };
-    Ok(Model {
+    let pair_areas = reader.pair_areas()?;
+    let per_area = map.contact.per_area();
+    let mut model = Model {
         name: map.name,
         source: file,
         origin: Origin::Matrices {
@@ -358,9 +365,22 @@ pub fn load(map_path: &Path) -> Result<Model, Error> {
         joint,
         load: map.load,
         warnings: Vec::new(),
+        pair_areas,
+        pair_weights: None,
         contact: map.contact,
         end_time: map.end_time,
-    })
+    };
+    if let Some(kappa) = per_area {
+        if model.pair_areas.is_none() {
+            return Err(field_err(
+                &model.source,
+                "pairs[0].area",
+                "missing: a contact law per area needs each pair's tributary area (mm²)",
+            ));
+        }
+        model.apply_contact_per_area(kappa, "contact.normal_stiffness_per_area")?;
+    }
+    Ok(model)
 }
 
 /// Reads the map at `map_path` (named `file` in messages) and checks its schema, version, name,
@@ -613,6 +633,36 @@ impl MapReader<'_> {
     }
 
     /// The joint pairs with their frames.
+    /// The pairs' `area` values (mm²): all given, positive and finite, or none.
+    fn pair_areas(&self) -> Result<Option<Vec<f64>>, Error> {
+        let pairs = &self.map.pairs;
+        if pairs.iter().all(|p| p.area.is_none()) {
+            return Ok(None);
+        }
+        let mut areas = Vec::with_capacity(pairs.len());
+        for (k, p) in pairs.iter().enumerate() {
+            let path = format!("pairs[{k}].area");
+            match p.area {
+                Some(a) if a.is_finite() && a > 0.0 => areas.push(a),
+                Some(a) => {
+                    return Err(field_err(
+                        self.file,
+                        &path,
+                        format!("must be positive (finite and > 0), got {a} mm²"),
+                    ))
+                }
+                None => {
+                    return Err(field_err(
+                        self.file,
+                        &path,
+                        "missing: give every pair's tributary area (mm²) or none",
+                    ))
+                }
+            }
+        }
+        Ok(Some(areas))
+    }
+
     fn pairs(&self, dof_map: &DofMap) -> Result<Vec<PairFrame>, Error> {
         let map = self.map;
         if map.pairs.is_empty() {
@@ -933,6 +983,14 @@ pub fn write(model: &Model, dir: &Path) -> Result<Vec<PathBuf>, Error> {
             size: c.size,
         })
         .collect();
+    // A per-area law is written as the file gives it: κ_n, κ_t and the pairs' areas (the
+    // resolved per-pair values of a pair of mean area are not repeated).
+    let per_area = model.pair_weights.as_ref().and(model.contact.per_area());
+    let mut contact = model.contact;
+    if per_area.is_some() {
+        contact.normal_stiffness = f64::NAN;
+        contact.stick_stiffness = f64::NAN;
+    }
     let map = MatrixMap {
         schema: SCHEMA.to_string(),
         version: VERSION,
@@ -952,17 +1010,19 @@ pub fn write(model: &Model, dir: &Path) -> Result<Vec<PathBuf>, Error> {
         pairs: model
             .pairs
             .iter()
-            .map(|p| MapPair {
+            .enumerate()
+            .map(|(i, p)| MapPair {
                 lower: geo.node_ids[p.lower],
                 upper: geo.node_ids[p.upper],
                 normal: Some(p.normal),
                 t1: Some(p.t1),
                 t2: Some(p.t2),
+                area: per_area.and(model.pair_areas.as_ref().map(|a| a[i])),
             })
             .collect(),
         cells,
         load: model.load.clone(),
-        contact: model.contact,
+        contact,
         end_time: model.end_time,
         duplicates: None,
         max_pair_distance: None,

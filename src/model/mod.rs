@@ -17,9 +17,11 @@ mod contact;
 mod load;
 pub mod matrices;
 pub mod mtx;
+pub mod per_area;
 pub mod petsc;
 
 pub use contact::contact_static_full;
+pub use load::LoadOptions;
 
 use std::path::PathBuf;
 
@@ -163,6 +165,16 @@ pub struct Model {
     /// What the reader noticed but did not refuse (a deck's ignored and unknown cards, unused
     /// grids, pairs fused by welds); empty for cases and matrices.
     pub warnings: Vec<String>,
+    /// Tributary area `A_i` of each pair on the joint surface, mm² (`crate::mesh::tributary`;
+    /// a matrix map's per-pair `area`): `None` where the model has none (a map without areas,
+    /// pairs that do not cover faces). With them the mesh-independent contact outputs (contact
+    /// area, pressure) are reported.
+    pub pair_areas: Option<Vec<f64>>,
+    /// The pair weights `w_i = √(A_i/Ā)` of a per-area contact law (`None`: the per-pair law,
+    /// all weights 1). [`Model::joint`]'s three rows of pair i carry `w_i`, so the scalar law
+    /// `k = κ·Ā` on the weighted kinematics `w_i·(g, u_t)` returns the force `w_i² κ Ā g =
+    /// κ A_i g` to the structure (module [`per_area`]).
+    pub pair_weights: Option<Vec<f64>>,
 }
 
 impl Model {
@@ -200,6 +212,7 @@ impl Model {
             })
             .collect();
         let node_ids = (1..=mesh.nodes.len() as u64).collect();
+        let (per_area, overlap) = (case.contact.per_area(), per_area::joints_overlap(&case));
         let parts = Parts {
             name: case.name.clone(),
             source: case.source.clone(),
@@ -208,17 +221,31 @@ impl Model {
             end_time: case.end_time,
             warnings: mesh.warnings.clone(),
         };
-        Model::assemble(mesh, pairs, node_ids, parts, |mesh| Origin::Case {
+        let mut model = Model::assemble(mesh, pairs, node_ids, parts, |mesh| Origin::Case {
             case: Box::new(case),
             mesh: Box::new(mesh),
-        })
+        })?;
+        model.set_mesh_areas();
+        if let Some(kappa) = per_area {
+            model.apply_case_per_area(kappa, overlap)?;
+        }
+        Ok(model)
     }
 
     /// Reads a NASTRAN deck ([`crate::case::nastran`]), builds its mesh and assembles K and M.
     /// Pair frames follow each CGAP's GA → GB direction ([`PairFrame::along`]).
     pub fn from_deck(path: &std::path::Path) -> Result<Model, Error> {
+        Model::from_deck_with(path, crate::case::LocalMesh::Auto)
+    }
+
+    /// [`Model::from_deck`] with the rule `local_mesh` for the area welds' neighbourhoods
+    /// (`auto`: a case file's default; `off`: the nugget on the deck's own shells).
+    pub fn from_deck_with(
+        path: &std::path::Path,
+        local_mesh: crate::case::LocalMesh,
+    ) -> Result<Model, Error> {
         let deck = crate::case::nastran::deck::read(path)?;
-        let built = Mesh::from_deck(&deck)?;
+        let built = Mesh::from_deck(&deck, local_mesh)?;
         let mesh = built.mesh;
         // Each CQUAD4's element first, so that a degenerate or warped one is named by its line.
         for (shell, (file, line, id)) in mesh.shells.iter().zip(&built.shell_sources) {
@@ -258,10 +285,12 @@ impl Model {
             warnings: built.warnings,
         };
         let deck_path = path.to_path_buf();
-        Model::assemble(mesh, pairs, built.grid_ids, parts, |mesh| Origin::Deck {
+        let mut model = Model::assemble(mesh, pairs, built.grid_ids, parts, |mesh| Origin::Deck {
             deck: deck_path,
             mesh: Box::new(mesh),
-        })
+        })?;
+        model.set_mesh_areas();
+        Ok(model)
     }
 
     /// Assembles a mesh into a model.
@@ -305,6 +334,8 @@ impl Model {
             contact: parts.contact,
             end_time: parts.end_time,
             warnings: parts.warnings,
+            pair_areas: None,
+            pair_weights: None,
             origin: origin(mesh),
             geometry,
             pairs,

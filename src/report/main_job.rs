@@ -675,6 +675,20 @@ fn study_section(s: &mut String, rep: &Report) {
         "Full FE: ‖f_c‖ = {:.9} N, {} pairs in contact.\n",
         rep.study.full.contact_force_norm, rep.study.full.pairs_in_contact
     );
+    let m = &rep.study.full.measures;
+    let opt =
+        |v: Option<f64>, unit: &str| v.map_or("–".to_string(), |v| format!("{v:.4} {unit}"));
+    let _ = writeln!(
+        s,
+        "Mesh-independent measures of the full model's contact: resultant {:.4} N, contact area \
+         {}, peak pressure {}, largest penetration {} ({} of the sheet thickness).\n",
+        m.contact_resultant,
+        opt(m.contact_area, "mm²"),
+        opt(m.peak_pressure, "N/mm²"),
+        opt(m.max_penetration, "mm"),
+        m.max_penetration_per_thickness
+            .map_or("–".to_string(), |v| format!("{v:.2e}"))
+    );
     let _ = writeln!(
         s,
         "| basis | error g = 0 | error at max g | first g within 1e-2 | first g within 1e-4 |"

@@ -24,7 +24,7 @@
 //! | `reduced_loads` | 6 × r | `φ_d = Φᵀ e_d` for a unit master load along DOF d (= `master_rows`) |
 //! | `master_load` | object | final master load `fx, fy, fz` (N), `mx, my, mz` (N·mm) |
 //! | `load_ramp` | object | its time function (the case file's `load.ramp`) |
-//! | `contact` | object | `normal_stiffness` k_n, `stick_stiffness` k_t (N/mm), `friction_coefficient` μ |
+//! | `contact` | object | `normal_stiffness` k_n, `stick_stiffness` k_t (N/mm), `friction_coefficient` μ; a per-area model adds `normal_stiffness_per_area`, `stick_stiffness_per_area` (N/mm³; its k_n, k_t are those of a pair of mean area, the pairs' shares are in `BΦ`'s rows) |
 //! | `friction_relaxation_time` | s | τ of jointrom's viscoplastic slip memory (see `crate::joint::law`) |
 //! | `coordinate_size` | r | ‖Φ_j‖₂ per column over the full model's DOF (mm or rad per unit q): jointrom's tolerance scale (files without `field_dofs`: max |Φ_j|) |
 //! | `field_dofs` | count | n, the full model's DOF: with `coordinate_size` the error test measures the physical field as the full model's does (`crate::integrate::mechanical`, *The error test of a reduced model*; absent in older files: r, and the test is the coordinates' own) |

@@ -268,6 +268,9 @@ pub struct FullReference {
     pub master_displacement: [f64; 6],
     /// Solve time (s).
     pub solve_s: f64,
+    /// The mesh-independent measures of the contact state (resultant, area, peak pressure,
+    /// largest penetration; `crate::model::per_area`).
+    pub measures: crate::model::per_area::ContactMeasures,
 }
 
 /// First g at which a series is within a relative tolerance of the full value.
@@ -519,6 +522,7 @@ pub fn run_study(model: &Model, opts: &StudyOptions) -> Result<Study, Error> {
         pairs_in_contact: full.state.pairs_in_contact,
         master_displacement: full.master_displacement,
         solve_s: t0.elapsed().as_secs_f64(),
+        measures: model.contact_measures(&full.state.forces, &full.state.gaps),
     };
     if full_ref.contact_force_norm.is_nan() || full_ref.contact_force_norm <= 0.0 {
         return Err(StudyError::NoContact {

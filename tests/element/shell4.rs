@@ -308,6 +308,7 @@ fn strip(length: f64, width: f64, t: f64, nx: usize, nz: usize, material: Materi
             slaves: vec![],
         },
         pairs: vec![],
+        excluded: vec![],
         material,
         warnings: Vec::new(),
     }

@@ -179,7 +179,125 @@ pub fn corpus() -> Vec<Hostile> {
     v.extend(output_links());
     v.extend(decks());
     v.extend(sizes_and_crawls(fx));
+    v.extend(per_area(fx));
     v
+}
+
+/// Contact stiffness per area: the contact block, a map's pair areas, the flag.
+fn per_area(fx: &Fixture) -> Vec<Hostile> {
+    let (c, map, k, m) = (&fx.case, &fx.map, &fx.k, &fx.m);
+    use Expect::Fails;
+    let mk = |id, what, map2: String, expect| {
+        map_entry(id, what, fx, map2, k.clone(), m.clone(), expect)
+    };
+    vec![
+        info_case(
+            "case-kn-both-ways",
+            "contact stiffness per pair and per area together",
+            edit(c, |v| {
+                v["contact"]["normal_stiffness_per_area"] = json!(160.0);
+            }),
+            Fails("contact.normal_stiffness_per_area"),
+        ),
+        info_case(
+            "case-kn-per-area-zero",
+            "zero contact stiffness per area",
+            edit(c, |v| {
+                v["contact"] = json!({"normal_stiffness_per_area": 0.0,
+                    "friction_coefficient": 0.25, "stick_stiffness_per_area": 160.0});
+            }),
+            Fails("contact.normal_stiffness_per_area"),
+        ),
+        info_case(
+            "case-kt-per-area-huge",
+            "stick stiffness per area out of range",
+            edit(c, |v| {
+                v["contact"] = json!({"normal_stiffness_per_area": 160.0,
+                    "friction_coefficient": 0.25, "stick_stiffness_per_area": 123.25});
+            })
+            .replace("123.25", "1e999"),
+            Fails("stick_stiffness_per_area"),
+        ),
+        info_case(
+            "case-stiffness-mixed-ways",
+            "normal stiffness per area, stick stiffness per pair",
+            edit(c, |v| {
+                v["contact"] = json!({"normal_stiffness_per_area": 160.0,
+                    "friction_coefficient": 0.25, "stick_stiffness": 1e4});
+            }),
+            Fails("stick_stiffness_per_area"),
+        ),
+        info_case(
+            "case-no-normal-stiffness",
+            "no normal stiffness either way",
+            remove(c, "/contact/normal_stiffness"),
+            Fails("contact.normal_stiffness"),
+        ),
+        info_case(
+            "case-per-area-sparse-points",
+            "stiffness per area on a joint of isolated explicit points",
+            edit(c, |v| {
+                v["contact"] = json!({"normal_stiffness_per_area": 160.0,
+                    "friction_coefficient": 0.25, "stick_stiffness_per_area": 160.0});
+                v["joints"][0]["points"] = json!([[50.0, 0.0], [80.0, 25.0]]);
+            }),
+            Fails("contact.normal_stiffness_per_area"),
+        ),
+        info_case(
+            "case-per-area-partial-points",
+            "stiffness per area on explicit points that cover part of the joint",
+            edit(c, |v| {
+                v["contact"] = json!({"normal_stiffness_per_area": 160.0,
+                    "friction_coefficient": 0.25, "stick_stiffness_per_area": 160.0});
+                let pts: Vec<Value> = (0..6)
+                    .flat_map(|i| {
+                        (0..3).map(move |k| json!([70.0 + 5.0 * i as f64, 12.5 * k as f64]))
+                    })
+                    .collect();
+                v["joints"][0]["points"] = json!(pts);
+            }),
+            Fails("cover"),
+        ),
+        mk(
+            "map-per-area-no-areas",
+            "contact per area without pair areas",
+            edit(map, |v| {
+                v["contact"] = json!({"normal_stiffness_per_area": 160.0,
+                    "friction_coefficient": 0.25, "stick_stiffness_per_area": 160.0});
+            }),
+            Fails("pairs[0].area"),
+        ),
+        mk(
+            "map-pair-area-negative",
+            "a negative pair area",
+            edit(map, |v| {
+                let n = v["pairs"].as_array().map_or(0, |a| a.len());
+                for i in 0..n {
+                    v["pairs"][i]["area"] = json!(62.5);
+                }
+                v["pairs"][3]["area"] = json!(-1.0);
+            }),
+            Fails("pairs[3].area"),
+        ),
+        mk(
+            "map-pair-area-some",
+            "areas for some pairs only",
+            edit(map, |v| v["pairs"][2]["area"] = json!(62.5)),
+            Fails("pairs[0].area"),
+        ),
+        flag(
+            "flag-contact-per-area-one",
+            "--contact-per-area with one value",
+            &["--contact-per-area", "160"],
+            Fails("--contact-per-area"),
+        ),
+        flag(
+            "flag-contact-per-area-negative",
+            "--contact-per-area with a negative value",
+            &["--contact-per-area=160,-1"],
+            Fails("--contact-per-area"),
+        ),
+    ]
 }
 
 const CASE: &str = "{d}/case.json";

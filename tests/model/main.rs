@@ -8,5 +8,6 @@ mod contact_statics;
 mod deck;
 mod matrices;
 mod model;
+mod per_area;
 mod petsc;
 mod weld_targets;

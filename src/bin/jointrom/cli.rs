@@ -23,6 +23,64 @@ use crate::commands::{
 pub struct Cli {
     #[command(subcommand)]
     pub command: Command,
+    /// Contact stiffness per area `KN,KT` (N/mm³) for the model of any command: each joint
+    /// pair's normal and stick stiffness become KN·A and KT·A with A its tributary area on the
+    /// joint surface, in place of the per-pair values of the deck's PGAP (or the case's or the
+    /// map's contact block).
+    #[arg(long, global = true, value_name = "KN,KT")]
+    pub contact_per_area: Option<String>,
+    /// How a NASTRAN deck's CWELD area welds re-mesh their neighbourhood: `auto` (default, a
+    /// case file's rule: re-meshed where the shells do not resolve the nugget), `off` (the
+    /// nugget on the deck's own shells) or a shell size in mm.
+    #[arg(long, global = true, value_name = "auto|off|SIZE")]
+    pub deck_local_mesh: Option<String>,
+}
+
+impl Cli {
+    /// The model-loading options of the global flags.
+    pub fn load_options(&self) -> Result<jointrom::model::LoadOptions, Error> {
+        use jointrom::case::LocalMesh;
+        let deck_local_mesh = match self.deck_local_mesh.as_deref() {
+            None | Some("auto") => LocalMesh::Auto,
+            Some("off") => LocalMesh::Off,
+            Some(text) => match text.parse::<f64>() {
+                Ok(size) if size.is_finite() && size > 0.0 => LocalMesh::Size(size),
+                _ => {
+                    return Err(FlagError::Range {
+                        flag: "deck-local-mesh",
+                        need: "`auto`, `off` or a shell size in mm (finite and > 0)",
+                        got: format!("`{text}`"),
+                    }
+                    .into())
+                }
+            },
+        };
+        Ok(jointrom::model::LoadOptions {
+            contact_per_area: self.contact_per_area()?,
+            deck_local_mesh,
+        })
+    }
+
+    /// `--contact-per-area KN,KT`: two positive finite numbers.
+    pub fn contact_per_area(&self) -> Result<Option<[f64; 2]>, Error> {
+        let Some(text) = &self.contact_per_area else {
+            return Ok(None);
+        };
+        let bad = || FlagError::Range {
+            flag: "contact-per-area",
+            need: "two positive stiffnesses per area `KN,KT` in N/mm³ (finite and > 0)",
+            got: format!("`{text}`"),
+        };
+        let values: Vec<f64> = text
+            .split(',')
+            .map(|v| v.trim().parse::<f64>())
+            .collect::<Result<_, _>>()
+            .map_err(|_| bad())?;
+        match values[..] {
+            [n, t] if n.is_finite() && n > 0.0 && t.is_finite() && t > 0.0 => Ok(Some([n, t])),
+            _ => Err(bad().into()),
+        }
+    }
 }
 
 #[derive(Subcommand)]

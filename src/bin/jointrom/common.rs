@@ -3,6 +3,7 @@
 use std::path::Path;
 use std::sync::Mutex;
 
+use jointrom::model::LoadOptions;
 use jointrom::{Error, Model};
 use serde_json::Value;
 
@@ -68,11 +69,26 @@ pub fn inputs() -> Vec<String> {
     INPUTS.lock().map(|v| v.clone()).unwrap_or_default()
 }
 
-/// Loads a case file, built-in scene or matrix map ([`Model::from_case_name`]) and records
-/// where its matrices came from.
+/// `--contact-per-area` and `--deck-local-mesh`, parsed once by the main function.
+static LOAD_OPTIONS: Mutex<Option<LoadOptions>> = Mutex::new(None);
+
+/// Sets the options every [`load_model`] applies.
+pub fn set_load_options(opts: LoadOptions) {
+    if let Ok(mut g) = LOAD_OPTIONS.lock() {
+        *g = Some(opts);
+    }
+}
+
+/// Loads a case file, deck, built-in scene or matrix map ([`Model::from_case_name_with`], with
+/// `--contact-per-area` and `--deck-local-mesh`) and records where its matrices came from.
 pub fn load_model(arg: &str) -> Result<Model, Error> {
     let start = std::time::Instant::now();
-    let model = Model::from_case_name(arg)?;
+    let opts = LOAD_OPTIONS
+        .lock()
+        .ok()
+        .and_then(|g| *g)
+        .unwrap_or_default();
+    let model = Model::from_case_name_with(arg, &opts)?;
     if let Ok(mut g) = MODEL_S.lock() {
         *g = Some(g.unwrap_or(0.0) + start.elapsed().as_secs_f64());
     }

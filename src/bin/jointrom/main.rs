@@ -35,6 +35,10 @@ fn main() -> ExitCode {
     // Every output a failing command created is removed again: a failed export or report
     // leaves no partial files.
     jointrom::files::journal_start();
+    match cli.load_options() {
+        Ok(opts) => common::set_load_options(opts),
+        Err(e) => return fail(&e),
+    }
     match cli.command.run() {
         Ok(()) => {
             jointrom::files::journal_commit();

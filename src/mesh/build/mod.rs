@@ -60,7 +60,7 @@ pub(super) fn build(case: &Case) -> Result<Mesh, Error> {
         tied,
         nuggets: welds.nuggets,
     };
-    let pairs = sheets.joints(&case.joints, &supports, &nodes)?;
+    let (pairs, excluded) = sheets.joints(&case.joints, &supports, &nodes)?;
     // After the joints' and welds' own checks, which name the field more precisely.
     crate::case::validate::check_stacking(case, &ctx)?;
 
@@ -83,6 +83,7 @@ pub(super) fn build(case: &Case) -> Result<Mesh, Error> {
         clamped,
         tie,
         pairs,
+        excluded,
         material: Material {
             youngs_modulus: case.material.youngs_modulus,
             poisson_ratio: case.material.poisson_ratio,
@@ -343,4 +344,102 @@ impl Grid<'_> {
             self.lo[0], self.step[0], self.n[0], self.lo[1], self.step[1], self.n[1]
         )
     }
+}
+
+/// A deck's sheet whose shells form a regular grid: `n = [nx, nz]` shells of equal size over
+/// `[lo, hi]` (x, z; mm) at height `y` (mm), thickness mm.
+#[derive(Clone, Debug)]
+pub(crate) struct RegularSheet {
+    /// The sheet's name in messages.
+    pub name: String,
+    /// Lower corner (x, z), mm.
+    pub lo: [f64; 2],
+    /// Upper corner (x, z), mm.
+    pub hi: [f64; 2],
+    /// Shells along x and z.
+    pub n: [usize; 2],
+    /// Mid-surface height, mm.
+    pub y: f64,
+    /// Thickness, mm.
+    pub thickness: f64,
+}
+
+/// The re-meshed neighbourhood of a deck's area weld (`index`: its place among the deck's
+/// welds, centre (x, z) and diameter d in mm) on the regular sheets `stack` (in increasing y),
+/// by the rule of a case file's `local_mesh` (`crate::case::LocalMesh`): the same shells, the
+/// same nugget sampling. Numbering of the result: node (i, k) of `stack[j]` is
+/// `Σ_{l<j} (nx_l+1)(nz_l+1) + i (nz_j+1) + k`, shell (i, k) is `Σ_{l<j} nx_l nz_l + i nz_j + k`
+/// (the caller maps both to its own). An automatic neighbourhood that cannot be built is `None`
+/// with a warning; an explicit size that cannot be is an error naming `file`.
+pub(crate) fn regular_weld_patch(
+    file: &str,
+    stack: &[RegularSheet],
+    index: usize,
+    (centre, diameter): ([f64; 2], f64),
+    local_mesh: crate::case::LocalMesh,
+    warnings: &mut Vec<String>,
+) -> Result<Option<super::WeldPatch>, Error> {
+    use crate::case::{LocalMesh, WeldModel, WeldSpec};
+    let ctx = Ctx { file };
+    let mut first = 0;
+    let grids: Vec<Grid> = stack
+        .iter()
+        .map(|s| {
+            let grid = Grid {
+                name: &s.name,
+                lo: s.lo,
+                hi: s.hi,
+                step: [
+                    (s.hi[0] - s.lo[0]) / s.n[0] as f64,
+                    (s.hi[1] - s.lo[1]) / s.n[1] as f64,
+                ],
+                n: s.n,
+                y: s.y,
+                thickness: s.thickness,
+                first,
+            };
+            first += grid.node_count();
+            grid
+        })
+        .collect();
+    let names: HashMap<&str, usize> = grids.iter().enumerate().map(|(s, g)| (g.name, s)).collect();
+    let sheets = Sheets {
+        grids: &grids,
+        names: &names,
+        ctx: &ctx,
+    };
+    let weld = WeldSpec {
+        x: centre[0],
+        z: centre[1],
+        sheets: stack.iter().map(|s| s.name.clone()).collect(),
+        diameter,
+        model: WeldModel::Area,
+        local_mesh,
+    };
+    let all: Vec<usize> = (0..stack.len()).collect();
+    Ok(match local_mesh {
+        LocalMesh::Off => None,
+        LocalMesh::Size(size) => Some(sheets.weld_patch(index, &weld, &all, size)?),
+        LocalMesh::Auto => sheets.auto_patch(index, &weld, &all, warnings),
+    })
+}
+
+/// [`welds::check_patches`] for a deck's welds: a re-meshed neighbourhood may hold no clamped
+/// (`clamped`) or tied (`tied`) node of the `nodes` nodes and overlap no other weld's; an
+/// automatic one that does is dropped with a warning, an explicit one is an error naming `file`.
+pub(crate) fn check_deck_patches(
+    file: &str,
+    welds: &mut [WeldElem],
+    (nodes, clamped, tied): (usize, &[usize], &[usize]),
+    warnings: &mut Vec<String>,
+) -> Result<(), Error> {
+    let mut clamp_of = vec![None; nodes];
+    for &n in clamped {
+        clamp_of[n] = Some(0);
+    }
+    let mut held = vec![false; nodes];
+    for &n in tied {
+        held[n] = true;
+    }
+    check_patches(&Ctx { file }, welds, &clamp_of, &held, warnings)
 }

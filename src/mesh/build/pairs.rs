@@ -13,12 +13,14 @@ const CLEARANCE_TOLERANCE: f64 = 1e-9;
 
 /// The node pairs of a joint between sheets `[lower, upper]` in their overlap (the `None` case
 /// of `points`): every coincident pair neither of whose nodes is clamped or tied and that no
-/// area weld's nugget fuses, i-major over the lower sheet.
+/// area weld's nugget fuses, i-major over the lower sheet; the coincident pairs left out (fused,
+/// clamped or tied) go to `excluded`.
 fn coincident_pairs(
     [lower, upper]: [usize; 2],
     [gl, gu]: [&Grid; 2],
     overlap: &Rect,
     supports: &Supports,
+    excluded: &mut Vec<JointPair>,
 ) -> Vec<JointPair> {
     let mut found = Vec::new();
     for (i, k) in gl.nodes_in(overlap) {
@@ -26,8 +28,11 @@ fn coincident_pairs(
         let l = gl.index(i, k);
         if let Some(u) = gu.node_at(x, z) {
             let welded = supports.welded(lower, upper, [x, z]).is_some();
+            let pair = JointPair { lower: l, upper: u };
             if !supports.excluded(l) && !supports.excluded(u) && !welded {
-                found.push(JointPair { lower: l, upper: u });
+                found.push(pair);
+            } else {
+                excluded.push(pair);
             }
         }
     }
@@ -176,15 +181,16 @@ fn pairs_at_points(
 /// The joints pass of [`super::build`].
 impl Sheets<'_> {
     /// The joint pairs, joint by joint in case-file order, within a joint sorted by (x, z) of the
-    /// lower node in `nodes`.
+    /// lower node in `nodes`; and the coincident pairs left out (fused by a weld, clamped or tied).
     pub(super) fn joints(
         &self,
         joints: &[JointSpec],
         supports: &Supports,
         nodes: &[[f64; 3]],
-    ) -> Result<Vec<JointPair>, Error> {
+    ) -> Result<(Vec<JointPair>, Vec<JointPair>), Error> {
         let (grids, ctx) = (self.grids, self.ctx);
         let mut pairs = Vec::new();
+        let mut excluded = Vec::new();
         let mut declared: HashMap<(usize, usize), usize> = HashMap::new();
         for (j, joint) in joints.iter().enumerate() {
             let p = format!("joints[{j}]");
@@ -210,7 +216,9 @@ impl Sheets<'_> {
             check_clearance(ctx, &p, gl, gu)?;
             let overlap = overlap(ctx, &p, gl, gu)?;
             let mut found = match &joint.points {
-                None => coincident_pairs([lower, upper], [gl, gu], &overlap, supports),
+                None => {
+                    coincident_pairs([lower, upper], [gl, gu], &overlap, supports, &mut excluded)
+                }
                 Some(points) => {
                     pairs_at_points(ctx, &p, points, ([lower, upper], [gl, gu]), supports)?
                 }
@@ -231,6 +239,6 @@ impl Sheets<'_> {
             });
             pairs.extend(found);
         }
-        Ok(pairs)
+        Ok((pairs, excluded))
     }
 }

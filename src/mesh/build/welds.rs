@@ -278,7 +278,7 @@ impl Sheets<'_> {
     /// than d · [`LocalMesh::AUTO_UNRESOLVED_PER_DIAMETER`] and the neighbourhood is within the
     /// size limits; `None` otherwise (the nugget acts on the sheets' own shells), with a warning
     /// in `warnings` when the neighbourhood was wanted but cannot be built.
-    fn auto_patch(
+    pub(super) fn auto_patch(
         &self,
         w: usize,
         weld: &WeldSpec,
@@ -315,7 +315,7 @@ impl Sheets<'_> {
     /// [`PATCH_REACH`] · d around the centre, every shell cut into shells of at most `size`
     /// along each side, and the nugget sampled on those (`crate::element::weld_patch`
     /// condenses them).
-    fn weld_patch(
+    pub(super) fn weld_patch(
         &self,
         w: usize,
         weld: &WeldSpec,

@@ -74,10 +74,11 @@ pub fn run(a: StaticArgs) -> Result<(), Error> {
             ))
         }
     }
-    let v = if a.linear {
-        static_json(&model, scale)?
+    let (v, state) = if a.linear {
+        (static_json(&model, scale)?, None)
     } else {
-        contact_json(&model, scale)?
+        let (v, st) = contact_json(&model, scale)?;
+        (v, Some(st))
     };
     if a.json {
         print_json(&with_warnings(&model, v));
@@ -102,10 +103,13 @@ pub fn run(a: StaticArgs) -> Result<(), Error> {
             model.pair_count()
         );
     }
+    if let Some(st) = &state {
+        print_measures(&model, st);
+    }
     Ok(())
 }
 
-fn contact_json(model: &Model, scale: f64) -> Result<Value, Error> {
+fn contact_json(model: &Model, scale: f64) -> Result<(Value, contact::ContactState), Error> {
     let load = model.master_load().map(|v| v * scale);
     let sol =
         jointrom::model::contact_static_full(model, load, &contact::ContactOptions::default())?;
@@ -117,28 +121,61 @@ fn contact_json(model: &Model, scale: f64) -> Result<Value, Error> {
         "iterations": sol.state.iterations,
     });
     add_pair_forces(&mut v, model, &sol.state);
-    Ok(v)
+    Ok((v, sol.state))
 }
 
 /// Adds the contact state's `contact_force_norm`, `contact_force_total` (the resultant Σ|p|, N:
-/// unlike the norm, comparable between meshes of one scene), `pairs_in_contact` and
-/// `pair_forces` (`[x, y, z (mm) of the pair's lower node, p (N, compressive negative)]` per
-/// pair in contact) to the JSON object `v`.
+/// unlike the norm, comparable between meshes of one scene), `pairs_in_contact`, `pair_forces`
+/// (`[x, y, z (mm) of the pair's lower node, p (N, compressive negative)]` per pair in contact),
+/// the mesh-independent measures (`contact_resultant` N, `contact_area` mm², `peak_pressure`
+/// N/mm², `max_penetration` mm, `max_penetration_per_thickness`; `crate::model::per_area`) and
+/// the resolved `contact` law to the JSON object `v`.
 fn add_pair_forces(v: &mut Value, model: &Model, st: &contact::ContactState) {
     let pair_forces: Vec<[f64; 4]> = st
         .forces
         .iter()
         .zip(&model.pairs)
-        .filter(|(p, _)| **p != 0.0)
-        .map(|(p, pair)| {
+        .enumerate()
+        .filter(|(_, (p, _))| **p != 0.0)
+        .map(|(i, (p, pair))| {
             let [x, y, z] = model.geometry.nodes[pair.lower];
-            [x, y, z, *p]
+            [x, y, z, model.pair_weight(i) * *p]
         })
         .collect();
+    let m = model.contact_measures(&st.forces, &st.gaps);
     v["contact_force_norm"] = json!(st.contact_force_norm);
-    v["contact_force_total"] = json!(st.forces.iter().map(|p| p.abs()).sum::<f64>());
+    v["contact_force_total"] = json!(m.contact_resultant);
     v["pairs_in_contact"] = json!(st.pairs_in_contact);
     v["pair_forces"] = json!(pair_forces);
+    for (key, value) in [
+        ("contact_resultant", Some(m.contact_resultant)),
+        ("contact_area", m.contact_area),
+        ("peak_pressure", m.peak_pressure),
+        ("max_penetration", m.max_penetration),
+        (
+            "max_penetration_per_thickness",
+            m.max_penetration_per_thickness,
+        ),
+    ] {
+        v[key] = json!(value);
+    }
+    v["contact"] = json!(model.contact);
+}
+
+/// The text line of the mesh-independent contact measures.
+fn print_measures(model: &Model, st: &contact::ContactState) {
+    let m = model.contact_measures(&st.forces, &st.gaps);
+    let opt =
+        |v: Option<f64>, unit: &str| v.map_or("–".to_string(), |v| format!("{v:.6} {unit}"));
+    println!(
+        "  resultant {:.6} N, contact area {}, peak pressure {}, max penetration {} ({} of the sheet thickness)",
+        m.contact_resultant,
+        opt(m.contact_area, "mm²"),
+        opt(m.peak_pressure, "N/mm²"),
+        opt(m.max_penetration, "mm"),
+        m.max_penetration_per_thickness
+            .map_or("–".to_string(), |v| format!("{v:.3e}"))
+    );
 }
 
 fn tolerance_static(

@@ -204,6 +204,8 @@ pub fn run(a: TransientArgs) -> Result<(), Error> {
         "reference_error": reference_error,
         "curves": c,
         "energy_balance": c.balance(),
+        "joint_dissipated_energy": c.dissipated.last().copied().unwrap_or(0.0),
+        "contact": model.contact,
         "energy_check": c.energy_check(opts.energy_resolution()),
         "training": o.training,
         "profile": o.run.profile,
@@ -405,6 +407,7 @@ fn print_summary(a: &TransientArgs, name: &str, model: &Model, o: &ModelRun, tot
             "final: |f_c| {:.6e} N, |f_R| {:.6e} N, master uy {:.6e} mm",
             c.contact_force_norm[i], c.friction_force_norm[i], c.master_uy[i]
         );
+        println!("joint dissipated energy {:.6e} N·mm", c.dissipated[i]);
     }
     let pct = |v: Option<f64>| v.map_or("–".to_string(), |v| format!("{:.3} %", 100.0 * v));
     match &o.estimate {
