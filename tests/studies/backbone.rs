@@ -120,6 +120,8 @@ fn scene() -> Scene {
             normal_stiffness: K_N,
             friction_coefficient: MU,
             stick_stiffness: K_T,
+            normal_stiffness_per_area: None,
+            stick_stiffness_per_area: None,
         },
         end_time: 1.0,
     }
