@@ -473,18 +473,19 @@ impl RootGuard {
 mod tests {
     use super::*;
 
-    /// Curves of one output point with the given energies (N·mm).
+    /// Curves from rest (t = 0, every energy zero: the balance is counted from there) to one
+    /// output point with the given energies (N·mm).
     fn one(kinetic: f64, strain: f64, work: f64) -> Curves {
         Curves {
-            t: vec![0.1],
-            contact_force_norm: vec![0.0],
-            friction_force_norm: vec![0.0],
-            master_uy: vec![0.0],
-            kinetic: vec![kinetic],
-            strain: vec![strain],
-            pair: vec![0.0],
-            external_work: vec![work],
-            dissipated: vec![0.0],
+            t: vec![0.0, 0.1],
+            contact_force_norm: vec![0.0; 2],
+            friction_force_norm: vec![0.0; 2],
+            master_uy: vec![0.0; 2],
+            kinetic: vec![0.0, kinetic],
+            strain: vec![0.0, strain],
+            pair: vec![0.0; 2],
+            external_work: vec![0.0, work],
+            dissipated: vec![0.0; 2],
         }
     }
 
