@@ -163,6 +163,19 @@ impl ModelFlags {
         }
     }
 
+    /// [`ModelFlags::spec`] with the commands' default: the paper's a-priori TVD basis with
+    /// the flags' ν.
+    ///
+    /// # Errors
+    /// As [`ModelFlags::spec`].
+    pub fn spec_or_tvd(&self) -> Result<ModelSpec, Error> {
+        self.spec(ModelSpec::Basis {
+            kind: BasisKind::Tvd,
+            g: None,
+            nu: self.nu,
+        })
+    }
+
     /// The model the flags name; `default` when they name none (and give no `--tolerance`).
     /// POD models get [`DEFAULT_SNAPSHOTS`] and the run's end time for training: set them on
     /// the returned spec.

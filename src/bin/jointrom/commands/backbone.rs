@@ -7,7 +7,6 @@ use clap::Args;
 use serde_json::json;
 
 use jointrom::integrate::RunChoices;
-use jointrom::reduction::BasisKind;
 use jointrom::report::backbone as report;
 use jointrom::rom::{ModelFlags, ModelSpec};
 use jointrom::studies::backbone::{self, BackboneOptions};
@@ -109,11 +108,7 @@ pub fn run(a: BackboneArgs) -> Result<(), Error> {
     };
     opts.check()?;
     let model = crate::common::load_model(&a.case)?;
-    let spec = a.model.spec(ModelSpec::Basis {
-        kind: BasisKind::Tvd,
-        g: None,
-        nu: a.model.nu,
-    })?;
+    let spec = a.model.spec_or_tvd()?;
     if let ModelSpec::Pod { .. } | ModelSpec::File(_) = spec {
         return Err(jointrom::rom::spec::unsupported(
             "backbone",

@@ -7,9 +7,8 @@ use clap::Args;
 
 use jointrom::error::ReportError;
 use jointrom::integrate::TransientOptions;
-use jointrom::reduction::BasisKind;
 use jointrom::rom::file as export;
-use jointrom::rom::{build_rom, ModelFlags, ModelSpec};
+use jointrom::rom::{build_rom, ModelFlags};
 use jointrom::Error;
 
 #[derive(Args)]
@@ -88,11 +87,7 @@ fn write_outputs(a: &ExportArgs, file: &export::RomFile) -> Result<String, Error
 
 pub fn run(a: ExportArgs) -> Result<(), Error> {
     let model = crate::common::load_model(&a.case)?;
-    let spec = a.model.spec(ModelSpec::Basis {
-        kind: BasisKind::Tvd,
-        g: None,
-        nu: a.model.nu,
-    })?;
+    let spec = a.model.spec_or_tvd()?;
     let built = build_rom(&model, &spec, &TransientOptions::default(), "export")?;
     let file = export::RomFile::new(&model, &built.rom, built.info)?;
     let written = write_outputs(&a, &file)?;

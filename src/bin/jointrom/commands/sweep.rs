@@ -9,8 +9,7 @@ use serde_json::json;
 use crate::common::{positive, print_json};
 use jointrom::error::StudyError;
 use jointrom::integrate::TransientOptions;
-use jointrom::reduction::BasisKind;
-use jointrom::rom::{build_rom, ModelFlags, ModelSpec};
+use jointrom::rom::{build_rom, ModelFlags};
 use jointrom::studies::sweep::{self, SweepResult};
 use jointrom::Error;
 
@@ -51,11 +50,7 @@ pub fn run(a: SweepArgs) -> Result<(), Error> {
     }
     opts.budget_s = Some(positive("max-wall", a.max_wall)?);
     let t0 = Instant::now();
-    let spec = a.model.spec(ModelSpec::Basis {
-        kind: BasisKind::Tvd,
-        g: None,
-        nu: a.model.nu,
-    })?;
+    let spec = a.model.spec_or_tvd()?;
     let built = build_rom(&model, &spec, &opts, "sweep")?;
     let (kind, g_used, rom) = (built.info.kind, built.info.g, built.rom);
     let build_s = t0.elapsed().as_secs_f64();

@@ -9,7 +9,6 @@ use serde_json::{json, Value};
 
 use jointrom::error::{FlagError, RomError};
 use jointrom::integrate::{Curves, RunChoices, TransientOptions};
-use jointrom::reduction::BasisKind;
 use jointrom::rom::compare::{ReferenceCurves, ReferenceErrors};
 use jointrom::rom::spec::DEFAULT_SNAPSHOTS;
 use jointrom::rom::tolerance::{worst, IntegrationTolerances};
@@ -326,12 +325,7 @@ fn vtu_every(
 /// The model the flags name (default `tvd`, `adaptive` with `--tolerance`), with the POD
 /// training flags.
 fn model_spec(a: &TransientArgs) -> Result<ModelSpec, Error> {
-    let tvd = ModelSpec::Basis {
-        kind: BasisKind::Tvd,
-        g: None,
-        nu: a.model.nu,
-    };
-    let mut spec = a.model.spec(tvd)?;
+    let mut spec = a.model.spec_or_tvd()?;
     match &mut spec {
         ModelSpec::Pod {
             train_end,
