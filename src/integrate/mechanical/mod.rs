@@ -200,8 +200,6 @@ mod newton;
 mod refresh;
 mod screen;
 
-pub use screen::ScreenStats;
-
 /// Default [`ProblemOptions::velocity_scale`], 1/s: velocities are held to `atol · ω_ref` with
 /// ω_ref = 1e3 rad/s (160 Hz, between the friction bar's 1st and 2nd fixed-interface modes,
 /// 87 and 217 Hz). A mode of circular frequency ω and displacement error ε has a velocity error

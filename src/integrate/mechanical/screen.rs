@@ -33,7 +33,7 @@ pub(super) struct PairScreen {
     accels: Vec<f64>,
     /// The untracked pairs, ascending.
     untracked: Vec<usize>,
-    /// Whether the set must be rebuilt at the next setup (never built, a violation, a restart).
+    /// Whether the set must be rebuilt at the next setup (never built, or a late entry).
     stale: bool,
     /// The pairs whose membership changed at the last build (scratch, capacity w).
     moved: Vec<usize>,
@@ -45,9 +45,10 @@ pub(super) struct PairScreen {
 }
 
 /// Counters of the screening, for the run's statistics.
-#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
-pub struct ScreenStats {
-    /// Builds of the tracked set (each one product of the normal rows over all pairs).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(super) struct ScreenStats {
+    /// Builds of the tracked set (each three products of the normal rows over all pairs: gaps,
+    /// rates, accelerations).
     pub builds: u64,
     /// Pairs that joined the tracked set, summed.
     pub entries: u64,
@@ -117,16 +118,6 @@ impl PairScreen {
 }
 
 impl<S: SecondOrderSystem> MechanicalOde<S> {
-    /// Whether the run screens its pairs.
-    pub fn screening(&self) -> bool {
-        self.screen.is_some()
-    }
-
-    /// The screening's counters (`None` without screening).
-    pub fn screen_stats(&self) -> Option<ScreenStats> {
-        self.screen.as_ref().map(|s| s.stats)
-    }
-
     /// Adds the screening's counters to a run's statistics.
     pub fn add_screen_stats(&self, stats: &mut crate::integrate::problem::OdeStats) {
         if let Some(sc) = &self.screen {
