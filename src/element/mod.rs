@@ -11,6 +11,7 @@ mod shell4;
 mod weld;
 mod weld_cache;
 mod weld_patch;
+mod weld_slab;
 
 pub use beam2::Beam2;
 pub use shell4::Shell4;

@@ -56,18 +56,20 @@
 //! constraint among combinations of independent DOF, which the node-by-node elimination of the
 //! assembly does not express.
 //!
-//! A solid-like connector was measured too: the nugget as a slab between the mid-surfaces with
-//! steel's through-thickness shear and normal stiffness, integrated over the disc on the
-//! interpolated fields (the sheets bonded over the disc, like the solid model). It converges to
-//! the solid model (within 0.6 % on the first ten modes and the statics at 16× refinement) but
-//! locks on coarse meshes, where a 5 mm disc inside 5 × 12.5 mm shells bonds whole elements
-//! (+7 % on the first mode, +26 % on the tenth at the default mesh). The RBE3 + beam weld does
-//! not lock; what it leaves out is the fused disc's composite stiffness, which makes its
-//! converged limit 1–5 % softer than the solid in the modes where the sheets move against each
-//! other (docs/validation/welds.md). With a re-meshed neighbourhood (a weld's `local_mesh`,
-//! [`super::weld_patch`]) the slab no longer locks, and that is the model used there — by
-//! default (`"auto"`) wherever the sheets' shells do not resolve the nugget; this module's RBE3
-//! + beam weld is what `"off"`, a NASTRAN CWELD and sheets fine enough for the nugget get.
+//! # Which weld where
+//!
+//! The solid-like connector — the nugget as a bonded slab between the mid-surfaces
+//! ([`super::weld_slab`]: the sheets fused over the disc, like the solid model) — converges to
+//! the solid model but locks on coarse meshes, where a 5 mm disc inside 5 × 12.5 mm shells bonds
+//! whole elements (+7 % on the first mode, +26 % on the tenth at the default mesh). The RBE3 +
+//! beam weld does not lock; what it leaves out is the fused disc's composite stiffness, which
+//! makes its converged limit 1–5 % softer than the solid in the modes where the sheets move
+//! against each other, and the bonded disc's prying contact at the nugget's rim
+//! (docs/validation/welds.md). So `"local_mesh": "auto"` (the default) re-meshes the
+//! neighbourhood with the slab inside ([`super::weld_patch`]) where the sheets' shells do not
+//! resolve the nugget, and puts the slab on the sheets' own shells where they do; this module's
+//! RBE3 + beam weld is what `"off"` gets, and shells too coarse for the nugget whose
+//! neighbourhood cannot be re-meshed.
 //!
 //! # Mass
 //!
@@ -81,7 +83,7 @@ use faer::{Mat, Side};
 
 use super::{Beam2, Material};
 use crate::error::{ElementError, Error, WeldLayerProblem};
-use crate::mesh::{NuggetLayer, WeldElem, WeldPatch};
+use crate::mesh::{NuggetLayer, OwnShellNugget, WeldElem, WeldPatch};
 
 /// An area spot weld through a stack of sheets (see the module docs). Its matrices are on the
 /// DOF of [`Weld::nodes`], 6 per node `[ux, uy, uz, rx, ry, rz]`.
@@ -93,15 +95,19 @@ pub struct Weld {
     maps: Vec<Mat<f64>>,
     /// Connector beams between consecutive reference points.
     beams: Vec<Beam2>,
-    /// With a re-meshed neighbourhood ([`super::weld_patch`]): the condensed stiffness and mass
-    /// on the DOF of `nodes` (and no maps or beams of its own).
+    /// With a re-meshed neighbourhood ([`super::weld_patch`]) the condensed stiffness and mass,
+    /// with the bonded slab on the sheets' own shells ([`super::weld_slab`]) its stiffness and
+    /// no mass, on the DOF of `nodes` (and no maps or beams of its own).
     condensed: Option<Arc<(Mat<f64>, Mat<f64>)>>,
 }
 
 impl Weld {
-    /// Builds the interpolation constraints and connector beams of `weld`. Errors ([`Error::Element`]) if a layer has too few points for a
-    /// rigid fit (collinear or fewer than three) or a connector beam is invalid.
-    pub fn new(weld: &WeldElem, material: Material) -> Result<Weld, Error> {
+    /// Builds `weld` on the mesh's node positions `coords` (mm): its re-meshed neighbourhood's
+    /// condensation, the bonded slab on the sheets' own shells, or the interpolation constraints
+    /// and connector beams (the weld's [`OwnShellNugget`]). Errors ([`Error::Element`]) if a
+    /// layer has too few points for a rigid fit (collinear or fewer than three), a connector beam
+    /// is invalid, or a shell under the slab is degenerate.
+    pub fn new(weld: &WeldElem, coords: &[[f64; 3]], material: Material) -> Result<Weld, Error> {
         if let Some(patch) = &weld.patch {
             let c = super::weld_patch::condense(weld, patch, material)?;
             return Ok(Weld {
@@ -109,6 +115,16 @@ impl Weld {
                 maps: Vec::new(),
                 beams: Vec::new(),
                 condensed: Some(Arc::new((c.stiffness, c.mass))),
+            });
+        }
+        if weld.own_shells == OwnShellNugget::BondedSlab {
+            let (nodes, k) = super::weld_slab::on_own_shells(weld, coords, material)?;
+            let dofs = k.nrows();
+            return Ok(Weld {
+                nodes,
+                maps: Vec::new(),
+                beams: Vec::new(),
+                condensed: Some(Arc::new((k, Mat::zeros(dofs, dofs)))),
             });
         }
         let mut touched: Vec<usize> = weld
@@ -160,7 +176,7 @@ impl Weld {
         let mut out: Vec<Weld> = Vec::with_capacity(welds.len());
         for w in welds {
             let Some(patch) = &w.patch else {
-                out.push(Weld::new(w, material)?);
+                out.push(Weld::new(w, nodes, material)?);
                 continue;
             };
             let retained = super::weld_patch::retained_nodes(patch);
@@ -171,7 +187,7 @@ impl Weld {
                     let c = match super::weld_cache::load(&key) {
                         Some(km) => Arc::new(km),
                         None => {
-                            let c = Weld::new(w, material)?
+                            let c = Weld::new(w, nodes, material)?
                                 .condensed
                                 .expect("a weld with a neighbourhood is condensed");
                             super::weld_cache::store(&key, &c.0, &c.1);
@@ -199,7 +215,8 @@ impl Weld {
 
     /// `T_ℓ` of layer `layer` (lower to upper): the reference point's `[u_c, θ_c]` (mm, rad) as a
     /// 6 × 6N map of the nodes' DOF; `None` for a weld with a re-meshed neighbourhood (its
-    /// reference points live on the small shells) or past the last layer.
+    /// reference points live on the small shells) or a bonded slab (none), or past the last
+    /// layer.
     pub fn reference_map(&self, layer: usize) -> Option<&Mat<f64>> {
         self.maps.get(layer)
     }

@@ -29,23 +29,12 @@
 //! # The nugget: a bonded slab
 //!
 //! With the neighbourhood resolved, the nugget is what the converged solid model has: the two
-//! sheets fused over the disc. Between consecutive sheets (mid-surfaces L = 0.5 mm apart) it is
-//! a slab of the sheets' material whose strains follow from the two mid-surfaces' interpolated
-//! fields (lower `A`, upper `B`; `ū_y` their mean):
-//!
-//! ```text
-//! γ_x = (u_x^B − u_x^A)/L + ∂ū_y/∂x,   γ_z = (u_z^B − u_z^A)/L + ∂ū_y/∂z,   ε_y = (u_y^B − u_y^A)/L
-//! U   = ½ ∫_disc L (G γ_x² + E ε_y² + G γ_z²) dA            (the nugget's sampling points)
-//! ```
-//!
-//! Rigid motions give no strain (a rotation θ about z: `(u_x^B − u_x^A)/L = −θ`, `∂ū_y/∂x = θ`),
-//! so the six rigid-body modes stay. Measured (friction bar, fixed-interface frequencies against
-//! the converged solid of `scripts/solid_reference.py`): on the sheets' own shells this slab
-//! locks on coarse meshes (+26 % on f10 at the paper's mesh: a 5 mm disc inside 5 × 12.5 mm
-//! shells bonds whole shells), and the RBE3 + beam weld of `super::weld` converges to a limit
-//! 4–5 % soft in f7–f10 (it ties only the disc's mean rigid motion, not the fused disc's
-//! composite bending); on the re-meshed neighbourhood the slab neither locks nor leaves that
-//! out (docs/validation/welds.md).
+//! sheets fused over the disc, the bonded slab of [`super::weld_slab`], integrated on the small
+//! shells. On the sheets' own coarse shells this slab locks (+26 % on f10 at the paper's mesh: a
+//! 5 mm disc inside 5 × 12.5 mm shells bonds whole shells), and the RBE3 + beam weld of
+//! `super::weld` converges to a limit 4–5 % soft in f7–f10 (it ties only the disc's mean rigid
+//! motion, not the fused disc's composite bending); on the re-meshed neighbourhood the slab
+//! neither locks nor leaves that out (docs/validation/welds.md).
 //!
 //! # Condensation
 //!
@@ -314,8 +303,8 @@ fn shape_derivatives(layer: &PatchLayer, p: [f64; 2]) -> ([f64; 4], [f64; 4]) {
     )
 }
 
-/// The nugget between two consecutive sheets as a bonded slab (module docs, *The nugget*),
-/// integrated by the nugget's sampling points, added to `k`.
+/// The nugget between two consecutive sheets as a bonded slab ([`super::weld_slab`]),
+/// integrated by the nugget's sampling points on the small shells, added to `k`.
 fn add_slab(
     k: &mut Blocks,
     roles: &[Role],
@@ -325,58 +314,18 @@ fn add_slab(
     index: usize,
 ) -> Result<(), Error> {
     let (lower, upper) = (&nugget[0], &nugget[1]);
+    super::weld_slab::check_layers(index, lower, upper)?;
     let gap = upper.y - lower.y;
-    let same = lower.points.len() == upper.points.len()
-        && lower
-            .points
-            .iter()
-            .zip(&upper.points)
-            .all(|(a, b)| a.xz == b.xz && a.weight == b.weight);
-    if !same || gap.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
-        return Err(ElementError::InWeld {
-            index,
-            source: Box::new(ElementError::NuggetSampling {
-                lower: lower.sheet,
-                upper: upper.sheet,
-            }),
-        }
-        .into());
-    }
-    let e = material.youngs_modulus;
-    let g = e / (2.0 * (1.0 + material.poisson_ratio));
-    let modulus = [g, e, g];
     let mut ke = Mat::<f64>::zeros(48, 48);
     for (pa, pb) in lower.points.iter().zip(&upper.points) {
-        let (dxa, dza) = shape_derivatives(&layers[0], pa.xz);
-        let (dxb, dzb) = shape_derivatives(&layers[1], pb.xz);
-        // Strain rows γ_x, ε_y, γ_z over the 8 nodes' 6 DOF (lower sheet's nodes first).
-        let mut b = [[0.0f64; 48]; 3];
-        for a in 0..4 {
-            let (lo, up) = (6 * a, 6 * (a + 4));
-            let (na, nb) = (pa.shape[a], pb.shape[a]);
-            b[0][lo] -= na / gap;
-            b[0][up] += nb / gap;
-            b[0][lo + 1] += 0.5 * dxa[a];
-            b[0][up + 1] += 0.5 * dxb[a];
-            b[1][lo + 1] -= na / gap;
-            b[1][up + 1] += nb / gap;
-            b[2][lo + 2] -= na / gap;
-            b[2][up + 2] += nb / gap;
-            b[2][lo + 1] += 0.5 * dza[a];
-            b[2][up + 1] += 0.5 * dzb[a];
-        }
         ke.fill(0.0);
-        for (row, m) in b.iter().zip(modulus) {
-            let w = pa.weight * gap * m;
-            for (x, &bx) in row.iter().enumerate() {
-                if bx == 0.0 {
-                    continue;
-                }
-                for (y, &by) in row.iter().enumerate() {
-                    ke[(x, y)] += w * bx * by;
-                }
-            }
-        }
+        super::weld_slab::add_point(
+            &mut ke,
+            (pa, shape_derivatives(&layers[0], pa.xz)),
+            (pb, shape_derivatives(&layers[1], pb.xz)),
+            gap,
+            material,
+        );
         let r: Vec<Role> = pa
             .nodes
             .iter()

@@ -102,6 +102,10 @@ pub enum ElementError {
     /// A weld's nugget is sampled differently on the sheets `lower` and `upper`.
     #[error("the nugget is not sampled alike on sheets {lower} and {upper}")]
     NuggetSampling { lower: usize, upper: usize },
+    /// A shell under a weld's nugget is degenerate (its isoparametric map has no inverse at a
+    /// sampling point), so the bonded slab cannot be integrated on it.
+    #[error("the shell of sheet {sheet} at (x, z) = ({x}, {z}) mm under the nugget is degenerate")]
+    DegenerateNuggetShell { sheet: usize, x: f64, z: f64 },
     /// A weld's re-meshed neighbourhood has an internal stiffness that does not factor.
     #[error("the re-meshed neighbourhood's internal stiffness: linear algebra: {source}")]
     NeighbourhoodStiffness {

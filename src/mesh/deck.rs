@@ -24,7 +24,9 @@ use std::collections::{BTreeMap, BTreeSet, HashMap};
 use std::rc::Rc;
 
 use super::nugget;
-use super::{BeamElem, JointPair, Material, Mesh, PointMass, RigidTie, ShellElem, WeldElem};
+use super::{
+    BeamElem, JointPair, Material, Mesh, OwnShellNugget, PointMass, RigidTie, ShellElem, WeldElem,
+};
 use crate::case::nastran::cards::Position;
 use crate::case::nastran::deck::{Location, WeldAttach};
 use crate::case::nastran::Deck;
@@ -857,6 +859,7 @@ fn welds(
             diameter: d,
             layers,
             patch: None,
+            own_shells: OwnShellNugget::Rbe3,
         });
     }
     Ok((out, beams))

@@ -188,15 +188,16 @@ pub(super) fn weld_patches(
             continue;
         };
         let sheets: Vec<RegularSheet> = grids.iter().map(|g| g.sheet.clone()).collect();
-        let Some(mut patch) = regular_weld_patch(
+        let (patch, own_shells) = regular_weld_patch(
             file,
             &sheets,
             weld.index,
             (weld.centre, weld.diameter),
             local_mesh,
             warnings,
-        )?
-        else {
+        )?;
+        weld.own_shells = own_shells;
+        let Some(mut patch) = patch else {
             continue;
         };
         // The synthetic numbering back to the deck's nodes and shells.

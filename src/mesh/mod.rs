@@ -51,6 +51,22 @@ pub struct WeldElem {
     pub layers: Vec<NuggetLayer>,
     /// The re-meshed neighbourhood of the nugget (a weld's `local_mesh`), if any.
     pub patch: Option<WeldPatch>,
+    /// Without a neighbourhood: how the nugget acts on the sheets' own shells.
+    pub own_shells: OwnShellNugget,
+}
+
+/// How an area weld without a re-meshed neighbourhood acts on the sheets' own shells
+/// (`crate::element::Weld`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum OwnShellNugget {
+    /// RBE3 interpolation on each sheet and a connector beam between the reference points:
+    /// `"local_mesh": "off"`, and shells too coarse for the nugget whose neighbourhood cannot be
+    /// re-meshed (where the bonded slab would lock).
+    #[default]
+    Rbe3,
+    /// The sheets bonded over the disc (the slab of the re-meshed neighbourhood, on the sheets'
+    /// own shells): `"auto"` where every welded sheet's shells resolve the nugget.
+    BondedSlab,
 }
 
 /// The cell `[j, j + 1]` of the ascending node `lines` (at least two) containing `v` — the

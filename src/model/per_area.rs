@@ -183,6 +183,30 @@ pub struct ContactMeasures {
     pub max_penetration_per_thickness: Option<f64>,
 }
 
+impl ContactMeasures {
+    /// The measures as one line of text, `digits` significant decimals: "resultant … N, contact
+    /// area …, peak pressure …, largest penetration … (… of the sheet thickness)" (– where a
+    /// measure is not defined).
+    pub fn describe(&self, digits: usize) -> String {
+        let opt = |v: Option<f64>, unit: &str| {
+            v.map_or("–".to_string(), |v| format!("{v:.digits$} {unit}"))
+        };
+        format!(
+            "resultant {:.digits$} N, contact area {}, peak pressure {}, largest penetration {} \
+             ({} of the sheet thickness)",
+            self.contact_resultant,
+            opt(self.contact_area, "mm²"),
+            opt(self.peak_pressure, "N/mm²"),
+            opt(self.max_penetration, "mm"),
+            self.max_penetration_per_thickness
+                .map_or("–".to_string(), |v| format!(
+                    "{v:.prec$e}",
+                    prec = digits.min(6) / 2
+                )),
+        )
+    }
+}
+
 impl Model {
     /// The pair weight `w_i` (1 for the per-pair law).
     #[inline]

@@ -3,6 +3,7 @@
 
 use serde_json::{json, Value};
 
+use crate::mesh::OwnShellNugget;
 use crate::model::Model;
 
 /// The `info --json` document (also part of `run`'s results.json).
@@ -31,6 +32,14 @@ pub fn info_json(model: &Model) -> Value {
         "resolved_welds": model
             .mesh()
             .map_or(0, |m| m.welds.iter().filter(|w| w.patch.is_some()).count()),
+        // Area welds bonded over the disc on the sheets' own shells (`local_mesh` auto on shells
+        // that resolve the nugget).
+        "bonded_welds": model.mesh().map_or(0, |m| {
+            m.welds
+                .iter()
+                .filter(|w| w.patch.is_none() && w.own_shells == OwnShellNugget::BondedSlab)
+                .count()
+        }),
         "clamped_nodes": model
             .dof_map
             .nodes

@@ -159,7 +159,8 @@ impl JointCurves {
             .map(|c| c.with_dissipated(optional_csv_column(text, "dissipated")))
     }
 
-    /// Parses the compact JSON form (`cases/reference/compact.py`).
+    /// Parses the compact JSON form (`cases/reference/compact.py`): the curves at the top level,
+    /// or under `curves` as `jointrom transient --json` writes them.
     pub fn parse_json(text: &str, what: &str) -> Result<JointCurves, Error> {
         let bad = |problem: ReferenceProblem| -> Error {
             RomError::Reference {
@@ -168,8 +169,11 @@ impl JointCurves {
             }
             .into()
         };
-        let v: serde_json::Value =
+        let mut v: serde_json::Value =
             serde_json::from_str(text).map_err(|e| bad(ReferenceProblem::Json(e)))?;
+        if v.get("t").is_none() && v.get("curves").is_some_and(|c| c.get("t").is_some()) {
+            v = v["curves"].take();
+        }
         let arr = |name: &'static str| -> Result<Vec<f64>, Error> {
             v[name]
                 .as_array()
@@ -428,6 +432,10 @@ mod tests {
         assert!((e.dissipated_end.unwrap() - 0.1).abs() < 1e-12, "{e:?}");
         let without = JointCurves::parse_csv(CSV, "f.csv").unwrap();
         assert_eq!(without.errors(&run).dissipated, None);
+        // A `jointrom transient --json` document: the same curves under `curves`.
+        let run_json = format!(r#"{{"case":"c","status":"ok","curves":{json}}}"#);
+        let nested = JointCurves::parse_json(&run_json, "run.json").unwrap();
+        assert_eq!((&nested.t, &nested.dissipated), (&r.t, &r.dissipated));
         let short = json.replace("[0,1,2]}", "[0,1]}");
         let e = JointCurves::parse_json(&short, "f.json").unwrap_err();
         assert!(e.to_string().contains("different lengths"), "{e}");

@@ -369,8 +369,9 @@ pub(crate) struct RegularSheet {
 /// by the rule of a case file's `local_mesh` (`crate::case::LocalMesh`): the same shells, the
 /// same nugget sampling. Numbering of the result: node (i, k) of `stack[j]` is
 /// `Σ_{l<j} (nx_l+1)(nz_l+1) + i (nz_j+1) + k`, shell (i, k) is `Σ_{l<j} nx_l nz_l + i nz_j + k`
-/// (the caller maps both to its own). An automatic neighbourhood that cannot be built is `None`
-/// with a warning; an explicit size that cannot be is an error naming `file`.
+/// (the caller maps both to its own). Without a neighbourhood, how the nugget acts on the
+/// sheets' own shells (the case file's rule). An automatic neighbourhood that cannot be built is
+/// `None` with a warning; an explicit size that cannot be is an error naming `file`.
 pub(crate) fn regular_weld_patch(
     file: &str,
     stack: &[RegularSheet],
@@ -378,8 +379,8 @@ pub(crate) fn regular_weld_patch(
     (centre, diameter): ([f64; 2], f64),
     local_mesh: crate::case::LocalMesh,
     warnings: &mut Vec<String>,
-) -> Result<Option<super::WeldPatch>, Error> {
-    use crate::case::{LocalMesh, WeldModel, WeldSpec};
+) -> Result<(Option<super::WeldPatch>, super::OwnShellNugget), Error> {
+    use crate::case::{WeldModel, WeldSpec};
     let ctx = Ctx { file };
     let mut first = 0;
     let grids: Vec<Grid> = stack
@@ -417,11 +418,7 @@ pub(crate) fn regular_weld_patch(
         local_mesh,
     };
     let all: Vec<usize> = (0..stack.len()).collect();
-    Ok(match local_mesh {
-        LocalMesh::Off => None,
-        LocalMesh::Size(size) => Some(sheets.weld_patch(index, &weld, &all, size)?),
-        LocalMesh::Auto => sheets.auto_patch(index, &weld, &all, warnings),
-    })
+    sheets.neighbourhood(index, &weld, &all, warnings)
 }
 
 /// [`welds::check_patches`] for a deck's welds: a re-meshed neighbourhood may hold no clamped

@@ -8,7 +8,7 @@ use crate::case::validate::Ctx;
 use crate::case::{LocalMesh, WeldModel, WeldSpec};
 use crate::error::Error;
 use crate::mesh::nugget;
-use crate::mesh::{BeamElem, PatchLayer, WeldElem, WeldPatch};
+use crate::mesh::{BeamElem, OwnShellNugget, PatchLayer, WeldElem, WeldPatch};
 
 /// A weld's re-meshed neighbourhood (`local_mesh`) may neither hold a clamped or tied node
 /// (the small shells would not be held with it) nor overlap another weld's. An explicit size
@@ -170,11 +170,8 @@ impl Sheets<'_> {
                 WeldModel::Point => out.beams.extend(self.point_weld(weld, &p, &stack)?),
                 WeldModel::Area => {
                     let mut elem = self.area_weld(w, weld, &stack)?;
-                    elem.patch = match weld.local_mesh {
-                        LocalMesh::Off => None,
-                        LocalMesh::Size(size) => Some(self.weld_patch(w, weld, &stack, size)?),
-                        LocalMesh::Auto => self.auto_patch(w, weld, &stack, &mut out.warnings),
-                    };
+                    (elem.patch, elem.own_shells) =
+                        self.neighbourhood(w, weld, &stack, &mut out.warnings)?;
                     out.nuggets.push(Nugget {
                         index: w,
                         centre: elem.centre,
@@ -270,6 +267,43 @@ impl Sheets<'_> {
             diameter: weld.diameter,
             layers,
             patch: None,
+            own_shells: OwnShellNugget::Rbe3,
+        })
+    }
+
+    /// How area weld `welds[w]` meets the sheets of `stack` under its `local_mesh`: the
+    /// re-meshed neighbourhood, if any, and otherwise how the nugget acts on the sheets' own
+    /// shells — the bonded slab under `"auto"` where every welded sheet's shells resolve the
+    /// nugget ([`Sheets::resolves_nugget`]), else the RBE3 weld.
+    pub(super) fn neighbourhood(
+        &self,
+        w: usize,
+        weld: &WeldSpec,
+        stack: &[usize],
+        warnings: &mut Vec<String>,
+    ) -> Result<(Option<WeldPatch>, OwnShellNugget), Error> {
+        Ok(match weld.local_mesh {
+            LocalMesh::Off => (None, OwnShellNugget::Rbe3),
+            LocalMesh::Size(size) => (
+                Some(self.weld_patch(w, weld, stack, size)?),
+                OwnShellNugget::Rbe3,
+            ),
+            LocalMesh::Auto if self.resolves_nugget(weld.diameter, stack) => {
+                (None, OwnShellNugget::BondedSlab)
+            }
+            LocalMesh::Auto => (
+                self.auto_patch(w, weld, stack, warnings),
+                OwnShellNugget::Rbe3,
+            ),
+        })
+    }
+
+    /// Whether the shells of every sheet of `stack` resolve a nugget of `diameter` (mm): no side
+    /// longer than d · [`LocalMesh::AUTO_UNRESOLVED_PER_DIAMETER`].
+    fn resolves_nugget(&self, diameter: f64, stack: &[usize]) -> bool {
+        stack.iter().all(|&s| {
+            let step = self.grids[s].step;
+            step[0].max(step[1]) <= LocalMesh::AUTO_UNRESOLVED_PER_DIAMETER * diameter
         })
     }
 
@@ -285,15 +319,10 @@ impl Sheets<'_> {
         stack: &[usize],
         warnings: &mut Vec<String>,
     ) -> Option<WeldPatch> {
-        let d = weld.diameter;
-        let unresolved = stack.iter().any(|&s| {
-            let step = self.grids[s].step;
-            step[0].max(step[1]) > LocalMesh::AUTO_UNRESOLVED_PER_DIAMETER * d
-        });
-        if !unresolved {
+        if self.resolves_nugget(weld.diameter, stack) {
             return None;
         }
-        let size = LocalMesh::AUTO_SIZE_PER_DIAMETER * d;
+        let size = LocalMesh::AUTO_SIZE_PER_DIAMETER * weld.diameter;
         match self.weld_patch(w, weld, stack, size) {
             Ok(mut patch) => {
                 patch.automatic = true;

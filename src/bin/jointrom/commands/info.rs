@@ -30,12 +30,14 @@ pub fn run(a: InfoArgs) -> Result<(), Error> {
         println!("joint DOF       {}", model.joint_dofs());
         println!("nodes           {}", model.geometry.nodes.len());
         println!(
-            "elements        {} ({} Shell4, {} Beam2, {} Weld; {} with a re-meshed neighbourhood)",
+            "elements        {} ({} Shell4, {} Beam2, {} Weld; {} with a re-meshed neighbourhood, \
+             {} bonded on the sheets' shells)",
             v["elements"],
             cell_count(&model, true),
             cell_count(&model, false),
             area_welds(&model),
-            v["resolved_welds"]
+            v["resolved_welds"],
+            v["bonded_welds"]
         );
     }
     Ok(())

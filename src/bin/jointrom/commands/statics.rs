@@ -165,17 +165,7 @@ fn add_pair_forces(v: &mut Value, model: &Model, st: &contact::ContactState) {
 /// The text line of the mesh-independent contact measures.
 fn print_measures(model: &Model, st: &contact::ContactState) {
     let m = model.contact_measures(&st.forces, &st.gaps);
-    let opt =
-        |v: Option<f64>, unit: &str| v.map_or("–".to_string(), |v| format!("{v:.6} {unit}"));
-    println!(
-        "  resultant {:.6} N, contact area {}, peak pressure {}, max penetration {} ({} of the sheet thickness)",
-        m.contact_resultant,
-        opt(m.contact_area, "mm²"),
-        opt(m.peak_pressure, "N/mm²"),
-        opt(m.max_penetration, "mm"),
-        m.max_penetration_per_thickness
-            .map_or("–".to_string(), |v| format!("{v:.3e}"))
-    );
+    println!("  {}", m.describe(6));
 }
 
 fn tolerance_static(
