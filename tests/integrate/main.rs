@@ -4,6 +4,7 @@
 #[path = "../common/mod.rs"]
 mod common;
 
+mod arkode;
 mod cvode;
 mod friction;
 mod refresh;
