@@ -243,7 +243,7 @@ fn dirk_run_gives_the_bdf_curves_on_the_reduced_friction_bar() {
     let scene = Scene::of(&model);
     let bdf = common::until(0.02);
     let b = run(rom.clone(), &scene, &bdf).expect("BDF run");
-    for table in [DirkTable::Kvaerno423, DirkTable::Esdirk324] {
+    for table in [DirkTable::Ark324Dirk, DirkTable::Esdirk324] {
         let mut o = bdf.clone();
         o.ode.method = Method::Dirk(table);
         let d = run(rom.clone(), &scene, &o).expect("DIRK run");

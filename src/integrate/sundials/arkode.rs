@@ -22,8 +22,9 @@
 //! true accuracy, but each step costs ~12 right-hand sides, ~7 Newton iterations and ~0.5
 //! Newton setups (every stage is a nonlinear solve across the contact law's kinks, and
 //! convergence failures are frequent), so BDF2 stays 2–2.5× cheaper; the fourth-order tables'
-//! steps collapse and their errors grow to 10–100 % (their embedded error estimates miss the
-//! stiff penalty and slip-relaxation components, whose stage values lose the tables' order).
+//! steps collapse and they miss by up to 16 % (likely order reduction: their stage order is
+//! below the method's, and on the stiff penalty and slip-relaxation components the embedded
+//! estimate stops tracking the error).
 //!
 //! # What it shares with [`super::Cvode`]
 //! The trampolines (`callbacks`: panics caught, NaN/Inf recoverable), the boxed problem as

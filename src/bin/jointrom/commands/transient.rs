@@ -62,8 +62,8 @@ pub struct TransientArgs {
     /// accurate diagonally implicit Runge–Kutta method of ARKODE, table --dirk-table).
     #[arg(long, value_enum, default_value_t = MethodKind::Bdf)]
     method: MethodKind,
-    /// `--method dirk`: ARKODE's Butcher table, e.g. SDIRK_5_3_4 (default), ARK436L2SA_DIRK_6_3_4,
-    /// KVAERNO_4_2_3, TRBDF2_3_3_2 (with or without the `ARKODE_` prefix).
+    /// `--method dirk`: ARKODE's Butcher table, e.g. ARK324L2SA_DIRK_4_2_3 (default: the cheapest
+    /// measured), ESDIRK324L2SA_4_2_3, KVAERNO_4_2_3, SDIRK_5_3_4 (with or without `ARKODE_`).
     #[arg(long)]
     dirk_table: Option<String>,
     /// Maximum BDF order (1–5).
@@ -350,7 +350,7 @@ fn method(a: &TransientArgs) -> Result<Method, Error> {
             }
             let table = match &a.dirk_table {
                 Some(name) => dirk_table_flag("dirk-table", name)?,
-                None => DirkTable::Sdirk534,
+                None => DirkTable::Ark324Dirk,
             };
             Ok(Method::Dirk(table))
         }
