@@ -121,10 +121,10 @@ pub enum DirkTable {
     /// Kværnø's ESDIRK: 4 stages, order 3 (embedding 2).
     #[serde(rename = "ARKODE_KVAERNO_4_2_3")]
     Kvaerno423,
-    /// The implicit part of Kennedy–Carpenter's ARK3(2)4L[2]SA: 4 stages, order 3.
+    /// The implicit part of Kennedy–Carpenter's `ARK3(2)4L[2]SA`: 4 stages, order 3.
     #[serde(rename = "ARKODE_ARK324L2SA_DIRK_4_2_3")]
     Ark324Dirk,
-    /// Kennedy–Carpenter's ESDIRK3(2)4L[2]SA: 4 stages, order 3.
+    /// Kennedy–Carpenter's `ESDIRK3(2)4L[2]SA`: 4 stages, order 3.
     #[serde(rename = "ARKODE_ESDIRK324L2SA_4_2_3")]
     Esdirk324,
     /// Hairer–Wanner's SDIRK: 5 stages, order 4 (embedding 3).
@@ -133,16 +133,16 @@ pub enum DirkTable {
     /// Kværnø's ESDIRK: 5 stages, order 4 (embedding 3).
     #[serde(rename = "ARKODE_KVAERNO_5_3_4")]
     Kvaerno534,
-    /// The implicit part of Kennedy–Carpenter's ARK4(3)6L[2]SA: 6 stages, order 4.
+    /// The implicit part of Kennedy–Carpenter's `ARK4(3)6L[2]SA`: 6 stages, order 4.
     #[serde(rename = "ARKODE_ARK436L2SA_DIRK_6_3_4")]
     Ark436Dirk,
-    /// Kennedy–Carpenter's ESDIRK4(3)6L[2]SA: 6 stages, order 4.
+    /// Kennedy–Carpenter's `ESDIRK4(3)6L[2]SA`: 6 stages, order 4.
     #[serde(rename = "ARKODE_ESDIRK436L2SA_6_3_4")]
     Esdirk436,
     /// Kværnø's ESDIRK: 7 stages, order 5 (embedding 4).
     #[serde(rename = "ARKODE_KVAERNO_7_4_5")]
     Kvaerno745,
-    /// The implicit part of Kennedy–Carpenter's ARK5(4)8L[2]SA: 8 stages, order 5.
+    /// The implicit part of Kennedy–Carpenter's `ARK5(4)8L[2]SA`: 8 stages, order 5.
     #[serde(rename = "ARKODE_ARK548L2SA_DIRK_8_4_5")]
     Ark548Dirk,
 }

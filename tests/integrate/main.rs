@@ -7,6 +7,7 @@ mod common;
 mod arkode;
 mod cvode;
 mod friction;
+mod method;
 mod refresh;
 mod screen;
 mod stepper;
