@@ -6,7 +6,8 @@
 //!    install if none holds `sundials/sundials_config.h`, or if the version found is not 6.x.
 //! 2. Runs bindgen on `vendor-headers/jointrom_sundials.h`, keeping only the items declared in
 //!    that header and in the SUNDIALS headers it adds (`sundials_version.h`, `cvode_diag.h`,
-//!    `cvode_bandpre.h`) plus the version macros; the types they use (`N_Vector`,
+//!    `cvode_bandpre.h`, ARKODE's `arkode.h`, `arkode_ls.h`, `arkode_arkstep.h` and its Butcher
+//!    tables) plus the version macros; the types they use (`N_Vector`,
 //!    `sunindextype`, ...) are not generated but taken from `sundials-sys`, so they stay
 //!    compatible. Output: `$OUT_DIR/jointrom_sundials.rs`, included by `src/sundials/ffi.rs`.
 //! 3. Compiles `vendor-headers/jointrom_sundials.c` with `cc` into a static library. Its
@@ -129,6 +130,9 @@ fn generate_bindings(extra_include: Option<&Path>, out: &Path) {
         .allowlist_file(r".*[/\\]sundials[/\\]sundials_version\.h")
         .allowlist_file(r".*[/\\]cvode[/\\]cvode_diag\.h")
         .allowlist_file(r".*[/\\]cvode[/\\]cvode_bandpre\.h")
+        .allowlist_file(
+            r".*[/\\]arkode[/\\]arkode(_arkstep|_ls|_butcher|_butcher_dirk|_butcher_erk)?\.h",
+        )
         .allowlist_var("SUNDIALS_VERSION_(MAJOR|MINOR|PATCH)")
         .allowlist_recursively(false)
         .parse_callbacks(Box::new(IntMacrosAsCInt))

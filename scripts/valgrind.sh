@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Runs the CVODE wrapper's tests (tests/integrate/cvode.rs, i.e. the `cvode::` tests of the
+# Runs the SUNDIALS wrapper's tests (tests/integrate/cvode.rs and arkode.rs, i.e. the `cvode::` and `arkode::` tests of the
 # `integrate` test binary) under valgrind's memcheck: fails on any invalid access, use of
 # uninitialised memory or *definite* leak (e.g. a SUNDIALS object not freed, a custom linear
 # solver's content leaked by a missing ops.free).
@@ -25,7 +25,7 @@ if ! command -v valgrind >/dev/null; then
 fi
 
 target=integrate
-default_filter=(cvode::)
+default_filter=(cvode:: arkode::)
 if [[ "${1-}" == "--test" ]]; then
     if [[ "${2-}" != "fmu" ]]; then
         echo "--test takes fmu (the default is the integrate binary's cvode:: tests)" >&2

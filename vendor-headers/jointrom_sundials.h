@@ -9,7 +9,11 @@
  * cvode.h (which includes cvode_ls.h and cvode_proj.h). It lacks:
  *   - sundials_version.h: the run-time version of the library actually linked;
  *   - cvode_diag.h:       CVDiag, CVODE's diagonal approximate-Jacobian linear solver;
- *   - cvode_bandpre.h:    CVBandPrecInit, the banded difference-quotient preconditioner.
+ *   - cvode_bandpre.h:    CVBandPrecInit, the banded difference-quotient preconditioner;
+ *   - arkode_arkstep.h:   ARKODE's ARKStep (additive Runge-Kutta) integrator with the
+ *                         ARKODE core (arkode.h), its linear-solver interface (arkode_ls.h)
+ *                         and the Butcher tables (arkode_butcher*.h): the implicit (DIRK)
+ *                         alternative to CVODE's BDF.
  * The version macros (SUNDIALS_VERSION_MAJOR/MINOR/PATCH of sundials_config.h) are
  * exported by sundials-sys too; they are generated here again so that the crate can check
  * at compile time that both binding runs saw the same SUNDIALS.
@@ -22,6 +26,7 @@
 #include <sundials/sundials_version.h>
 #include <cvode/cvode_diag.h>
 #include <cvode/cvode_bandpre.h>
+#include <arkode/arkode_arkstep.h>
 
 #ifdef __cplusplus
 extern "C" {

@@ -2,7 +2,8 @@
 //! mechanical problem of any [`crate::system::SecondOrderSystem`] with contact and friction
 //! ([`mechanical`]), the one driver loop with deadline, observer and a typed [`RunStatus`]
 //! ([`driver`]), the same run advanced from outside for co-simulation ([`stepper`]), and SUNDIALS
-//! CVODE beneath (`sundials`, crate-private, the crate's only `unsafe`; [`Cvode`] re-exported).
+//! CVODE (or ARKODE's ARKStep as a DIRK method) beneath (`sundials`, crate-private, the crate's
+//! only `unsafe`; [`Cvode`], [`Arkode`] and [`Integrator`] re-exported).
 
 pub mod driver;
 pub mod mechanical;
@@ -18,4 +19,4 @@ pub use driver::{
 };
 pub use mechanical::{EnergySample, MechanicalOde, ProblemOptions};
 pub use stepper::Stepper;
-pub use sundials::Cvode;
+pub use sundials::{Arkode, Cvode, Integrator};

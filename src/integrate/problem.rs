@@ -1,5 +1,6 @@
 //! The integrator-neutral boundary between a first-order ODE problem `y' = F(t, y)` and a time
-//! integrator (CVODE in `crate::integrate::sundials`, wrapped by [`crate::integrate::Cvode`]).
+//! integrator (CVODE or ARKODE's ARKStep in `crate::integrate::sundials`, wrapped by
+//! [`crate::integrate::Cvode`] and [`crate::integrate::Arkode`]).
 //!
 //! A problem is data plus pure functions of `(t, y)`: the right-hand side, optional event
 //! (root) functions, and optionally its own Newton linear solver for the matrix `I − γ J`
@@ -94,7 +95,8 @@ pub trait OdeProblem {
     }
 }
 
-/// Linear multistep family.
+/// Integration method: CVODE's linear multistep families or an implicit Runge–Kutta method of
+/// ARKODE's ARKStep.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Method {
@@ -102,6 +104,120 @@ pub enum Method {
     Bdf,
     /// Adams–Moulton, orders 1–12.
     Adams,
+    /// A diagonally implicit Runge–Kutta method (ARKODE's ARKStep, implicit only) with the
+    /// given Butcher table; the table fixes the order ([`OdeOptions::max_order`] is unused).
+    Dirk(DirkTable),
+}
+
+/// The DIRK Butcher tables of ARKODE 5.4 offered by [`Method::Dirk`]: all L-stable and stiffly
+/// accurate (the last stage is the step's solution, so the unresolved stiff modes of an
+/// undamped structure are damped as by BDF2 and the stage values satisfy the differential
+/// equation). Named `ARKODE_<name>_<stages>_<embedding order>_<order>` as in ARKODE.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+pub enum DirkTable {
+    /// TR-BDF2: 3 stages, order 2 (embedding 3).
+    #[serde(rename = "ARKODE_TRBDF2_3_3_2")]
+    Trbdf2,
+    /// Kværnø's ESDIRK: 4 stages, order 3 (embedding 2).
+    #[serde(rename = "ARKODE_KVAERNO_4_2_3")]
+    Kvaerno423,
+    /// The implicit part of Kennedy–Carpenter's `ARK3(2)4L[2]SA`: 4 stages, order 3.
+    #[serde(rename = "ARKODE_ARK324L2SA_DIRK_4_2_3")]
+    Ark324Dirk,
+    /// Kennedy–Carpenter's `ESDIRK3(2)4L[2]SA`: 4 stages, order 3.
+    #[serde(rename = "ARKODE_ESDIRK324L2SA_4_2_3")]
+    Esdirk324,
+    /// Hairer–Wanner's SDIRK: 5 stages, order 4 (embedding 3).
+    #[serde(rename = "ARKODE_SDIRK_5_3_4")]
+    Sdirk534,
+    /// Kværnø's ESDIRK: 5 stages, order 4 (embedding 3).
+    #[serde(rename = "ARKODE_KVAERNO_5_3_4")]
+    Kvaerno534,
+    /// The implicit part of Kennedy–Carpenter's `ARK4(3)6L[2]SA`: 6 stages, order 4.
+    #[serde(rename = "ARKODE_ARK436L2SA_DIRK_6_3_4")]
+    Ark436Dirk,
+    /// Kennedy–Carpenter's `ESDIRK4(3)6L[2]SA`: 6 stages, order 4.
+    #[serde(rename = "ARKODE_ESDIRK436L2SA_6_3_4")]
+    Esdirk436,
+    /// Kværnø's ESDIRK: 7 stages, order 5 (embedding 4).
+    #[serde(rename = "ARKODE_KVAERNO_7_4_5")]
+    Kvaerno745,
+    /// The implicit part of Kennedy–Carpenter's `ARK5(4)8L[2]SA`: 8 stages, order 5.
+    #[serde(rename = "ARKODE_ARK548L2SA_DIRK_8_4_5")]
+    Ark548Dirk,
+}
+
+/// The names [`DirkTable::from_name`] accepts (without ARKODE's `ARKODE_` prefix), for
+/// messages.
+pub const DIRK_TABLE_NAMES: &str = "TRBDF2_3_3_2, KVAERNO_4_2_3, ARK324L2SA_DIRK_4_2_3, \
+     SDIRK_5_3_4, KVAERNO_5_3_4, ARK436L2SA_DIRK_6_3_4, KVAERNO_7_4_5, ARK548L2SA_DIRK_8_4_5, \
+     ESDIRK324L2SA_4_2_3, ESDIRK436L2SA_6_3_4";
+
+impl DirkTable {
+    /// Every table, in the order of ARKODE's table numbers.
+    pub const ALL: [DirkTable; 10] = [
+        DirkTable::Trbdf2,
+        DirkTable::Kvaerno423,
+        DirkTable::Ark324Dirk,
+        DirkTable::Sdirk534,
+        DirkTable::Kvaerno534,
+        DirkTable::Ark436Dirk,
+        DirkTable::Kvaerno745,
+        DirkTable::Ark548Dirk,
+        DirkTable::Esdirk324,
+        DirkTable::Esdirk436,
+    ];
+
+    /// ARKODE's name of the table (`ARKStepSetTableName`), e.g. `ARKODE_SDIRK_5_3_4`.
+    pub fn name(self) -> &'static str {
+        match self {
+            DirkTable::Trbdf2 => "ARKODE_TRBDF2_3_3_2",
+            DirkTable::Kvaerno423 => "ARKODE_KVAERNO_4_2_3",
+            DirkTable::Ark324Dirk => "ARKODE_ARK324L2SA_DIRK_4_2_3",
+            DirkTable::Esdirk324 => "ARKODE_ESDIRK324L2SA_4_2_3",
+            DirkTable::Sdirk534 => "ARKODE_SDIRK_5_3_4",
+            DirkTable::Kvaerno534 => "ARKODE_KVAERNO_5_3_4",
+            DirkTable::Ark436Dirk => "ARKODE_ARK436L2SA_DIRK_6_3_4",
+            DirkTable::Esdirk436 => "ARKODE_ESDIRK436L2SA_6_3_4",
+            DirkTable::Kvaerno745 => "ARKODE_KVAERNO_7_4_5",
+            DirkTable::Ark548Dirk => "ARKODE_ARK548L2SA_DIRK_8_4_5",
+        }
+    }
+
+    /// The method's order of accuracy (the last number of the name).
+    pub fn order(self) -> usize {
+        match self {
+            DirkTable::Trbdf2 => 2,
+            DirkTable::Kvaerno423 | DirkTable::Ark324Dirk | DirkTable::Esdirk324 => 3,
+            DirkTable::Sdirk534
+            | DirkTable::Kvaerno534
+            | DirkTable::Ark436Dirk
+            | DirkTable::Esdirk436 => 4,
+            DirkTable::Kvaerno745 | DirkTable::Ark548Dirk => 5,
+        }
+    }
+
+    /// The table named `name`: ARKODE's name, with or without its `ARKODE_` prefix, in any
+    /// case (`sdirk_5_3_4`, `ARKODE_SDIRK_5_3_4`); `None` for any other name.
+    pub fn from_name(name: &str) -> Option<DirkTable> {
+        let upper = name.trim().to_ascii_uppercase();
+        let full = if upper.starts_with("ARKODE_") {
+            upper
+        } else {
+            format!("ARKODE_{upper}")
+        };
+        DirkTable::ALL.into_iter().find(|t| t.name() == full)
+    }
+}
+
+impl Method {
+    /// The method's order for error laws: BDF's and Adams' `max_order`, a DIRK table's own.
+    pub fn order(self, max_order: usize) -> usize {
+        match self {
+            Method::Bdf | Method::Adams => max_order,
+            Method::Dirk(t) => t.order(),
+        }
+    }
 }
 
 /// Linear solver inside Newton's iteration.
@@ -130,7 +246,7 @@ pub enum Iteration {
 /// off, no maximum step, event tolerance decided by the integrator.
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct OdeOptions {
-    /// Multistep family.
+    /// Integration method (CVODE's BDF or Adams, or an ARKODE DIRK table).
     pub method: Method,
     /// Nonlinear iteration.
     pub iteration: Iteration,

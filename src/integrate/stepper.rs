@@ -45,14 +45,14 @@
 use super::driver::{non_finite, RootGuard};
 use super::mechanical::{EnergySample, MechanicalOde, ProblemOptions};
 use super::problem::{OdeOptions, OdeProblem, OdeStats};
-use super::sundials::Cvode;
+use super::sundials::Integrator;
 use crate::case::ContactSpec;
 use crate::error::{Error, IntegrationError};
 use crate::system::SecondOrderSystem;
 
 /// A mechanical run advanced from outside (see the module docs).
 pub struct Stepper<S: SecondOrderSystem> {
-    cv: Cvode<MechanicalOde<S>>,
+    cv: Integrator<MechanicalOde<S>>,
     roots: RootGuard,
     /// The load changed since CVODE's history was built: re-initialise before the next step.
     restart: bool,
@@ -86,7 +86,7 @@ impl<S: SecondOrderSystem> Stepper<S> {
         let mut mech = MechanicalOde::new(system, contact, problem)?;
         let y = mech.initial_state();
         let last = mech.sample(t0, &y);
-        let cv = Cvode::new(mech, t0, &y, ode)?;
+        let cv = Integrator::new(mech, t0, &y, ode)?;
         Ok(Stepper {
             cv,
             roots: RootGuard::new(),

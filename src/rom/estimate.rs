@@ -53,6 +53,17 @@ pub const INTEGRATION_CHECK_FACTOR: f64 = 2.0;
 /// error ([`integration_errors`]).
 pub const INTEGRATION_ORDER_EXPONENT: f64 = 2.0 / 3.0;
 
+/// The exponent of the global error law `tol^e` of the run's method: BDF's
+/// [`INTEGRATION_ORDER_EXPONENT`], and 1 for a DIRK pair (ARKODE propagates the order-p
+/// solution and controls the embedded order-(p−1) estimate, `~h^p`, so `h ∝ tol^(1/p)` and the
+/// global error `~h^p ∝ tol`: tolerance-proportional, whatever the order).
+pub fn integration_order_exponent(opts: &TransientOptions) -> f64 {
+    match opts.ode.method {
+        crate::integrate::problem::Method::Dirk(_) => 1.0,
+        _ => INTEGRATION_ORDER_EXPONENT,
+    }
+}
+
 /// The error estimate of a reduced run: the reduction error (the quasi-static joint correction,
 /// [`crate::reduction::estimate`]) and the integration error, combined as independent errors.
 #[derive(Clone, Debug, Serialize)]
@@ -73,7 +84,8 @@ pub struct RunEstimate {
 
 /// The integration part of a run's error estimate: the relative L2 differences `D` of its curves
 /// from a re-run of the same system at `F`× its rtol and atol ([`check_factor`]), divided by
-/// `|F^(2/3) − 1|` (BDF2, [`INTEGRATION_ORDER_EXPONENT`]).
+/// `|F^(2/3) − 1|` (BDF2, [`INTEGRATION_ORDER_EXPONENT`]; `|F − 1|` for a DIRK method,
+/// [`integration_order_exponent`]).
 ///
 /// ## Which re-run, and the division
 ///
@@ -148,7 +160,7 @@ pub fn integration_check_run(
 /// with the same `opts`).
 pub fn integration_errors_from(check: &Run, run: &Run, opts: &TransientOptions) -> CurveErrors {
     let (a, b) = (&check.curves, &run.curves);
-    let scale = 1.0 / (check_factor(opts).powf(INTEGRATION_ORDER_EXPONENT) - 1.0).abs();
+    let scale = 1.0 / (check_factor(opts).powf(integration_order_exponent(opts)) - 1.0).abs();
     let diff = |x: &[f64], y: &[f64]| relative_l2(&a.t, x, &b.t, y).map(|d| d * scale);
     CurveErrors {
         contact_force: diff(&a.contact_force_norm, &b.contact_force_norm),

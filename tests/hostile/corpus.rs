@@ -174,6 +174,7 @@ pub fn corpus() -> Vec<Hostile> {
     v.extend(maps(fx));
     v.extend(rom_files(fx));
     v.extend(flags(fx));
+    v.extend(method_flags());
     v.extend(variants(fx));
     v.extend(outputs(fx));
     v.extend(output_links());
@@ -1165,6 +1166,59 @@ fn flag(id: &'static str, what: &'static str, extra: &[&str], expect: Expect) ->
     let mut args: Vec<&str> = FB_ROM.to_vec();
     args.extend_from_slice(extra);
     entry(id, "flag", what, &args, expect)
+}
+
+/// The integration method's flags: an unknown DIRK table, and flags of one method given to the
+/// other.
+fn method_flags() -> Vec<Hostile> {
+    use Expect::Fails;
+    vec![
+        flag(
+            "flag-dirk-table-unknown",
+            "--method dirk --dirk-table RK4",
+            &[
+                "--method",
+                "dirk",
+                "--dirk-table",
+                "RK4",
+                "--end-time",
+                "0.001",
+            ],
+            Fails("--dirk-table"),
+        ),
+        flag(
+            "flag-dirk-table-without-dirk",
+            "--dirk-table SDIRK_5_3_4 with BDF",
+            &["--dirk-table", "SDIRK_5_3_4", "--end-time", "0.001"],
+            Fails("--dirk-table"),
+        ),
+        flag(
+            "flag-dirk-max-order",
+            "--method dirk --max-order 2",
+            &[
+                "--method",
+                "dirk",
+                "--max-order",
+                "2",
+                "--end-time",
+                "0.001",
+            ],
+            Fails("--max-order"),
+        ),
+        flag(
+            "flag-dirk-functional",
+            "--method dirk --iteration functional",
+            &[
+                "--method",
+                "dirk",
+                "--iteration",
+                "functional",
+                "--end-time",
+                "0.001",
+            ],
+            Fails("--iteration"),
+        ),
+    ]
 }
 
 fn flags(fx: &Fixture) -> Vec<Hostile> {

@@ -11,13 +11,13 @@ use jointrom::integrate::Cvode;
 use jointrom::Error;
 
 /// ω of the test oscillator, rad/s (100 Hz).
-const OMEGA: f64 = 2.0 * PI * 100.0;
+pub(super) const OMEGA: f64 = 2.0 * PI * 100.0;
 
 /// `y' = A y` with a dense `A`, and its own Newton solver: Gaussian elimination with partial
 /// pivoting of `I − γ A`, factored in `newton_setup` with the γ given there (like CVODE's dense
 /// solver, which factors at setup and reuses the factors until the next setup).
 #[derive(Clone)]
-struct Linear {
+pub(super) struct Linear {
     n: usize,
     /// Row-major n × n.
     a: Vec<f64>,
@@ -27,13 +27,13 @@ struct Linear {
     /// Solve with the γ passed to `newton_solve` (refactor) instead of the setup's.
     use_current_gamma: bool,
     setup_gamma: f64,
-    rhs_calls: u64,
-    setups: u64,
-    solves: u64,
+    pub(super) rhs_calls: u64,
+    pub(super) setups: u64,
+    pub(super) solves: u64,
 }
 
 impl Linear {
-    fn new(n: usize, a: Vec<f64>) -> Self {
+    pub(super) fn new(n: usize, a: Vec<f64>) -> Self {
         assert_eq!(a.len(), n * n);
         Linear {
             n,
@@ -49,7 +49,7 @@ impl Linear {
     }
 
     /// Undamped oscillator x'' = −ω² x as y = [x, v].
-    fn oscillator() -> Self {
+    pub(super) fn oscillator() -> Self {
         Linear::new(2, vec![0.0, 1.0, -OMEGA * OMEGA, 0.0])
     }
 
@@ -500,7 +500,7 @@ fn stiff_problem_defeats_functional_iteration() {
 
 /// What a test problem does wrong, and when.
 #[derive(Clone, Copy, PartialEq)]
-enum Fault {
+pub(super) enum Fault {
     /// Panics in the named callback once t > 1e-3.
     PanicRhs,
     PanicNewtonSolve,
@@ -517,7 +517,7 @@ enum Fault {
     FatalRhs,
 }
 
-struct Faulty {
+pub(super) struct Faulty {
     inner: Linear,
     fault: Fault,
     calls: u64,
@@ -525,7 +525,7 @@ struct Faulty {
 }
 
 impl Faulty {
-    fn new(fault: Fault) -> Self {
+    pub(super) fn new(fault: Fault) -> Self {
         Faulty {
             inner: Linear::oscillator(),
             fault,

@@ -4,8 +4,10 @@
 #[path = "../common/mod.rs"]
 mod common;
 
+mod arkode;
 mod cvode;
 mod friction;
+mod method;
 mod refresh;
 mod screen;
 mod stepper;

@@ -24,3 +24,12 @@ impl OnOff {
         }
     }
 }
+
+/// `--method`: CVODE's BDF (the default) or an ARKODE DIRK method (`--dirk-table`).
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum MethodKind {
+    #[value(name = "bdf")]
+    Bdf,
+    #[value(name = "dirk")]
+    Dirk,
+}

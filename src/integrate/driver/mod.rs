@@ -15,7 +15,7 @@ use std::time::{Duration, Instant};
 
 use super::mechanical::MechanicalOde;
 use super::problem::{CallbackError, OdeProblem, OdeStats, Stop};
-use super::sundials::Cvode;
+use super::sundials::Integrator;
 use crate::error::Error;
 use crate::system::{Scene, SecondOrderSystem};
 
@@ -23,7 +23,9 @@ mod options;
 mod outcome;
 mod stall;
 
-pub use options::{positive_flag, InitialState, RunChoices, RunHook, TransientOptions};
+pub use options::{
+    dirk_table_flag, positive_flag, InitialState, RunChoices, RunHook, TransientOptions,
+};
 pub use outcome::{
     Curves, EnergyCheck, Profile, Run, RunStatus, Trajectory, ENERGY_BALANCE_TOLERANCE,
 };
@@ -236,7 +238,7 @@ impl<P: OdeProblem> OdeProblem for Deadline<P> {
 
 /// The state of one run between setup and the end.
 struct Driver<S: SecondOrderSystem> {
-    cv: Cvode<Deadline<MechanicalOde<S>>>,
+    cv: Integrator<Deadline<MechanicalOde<S>>>,
     dim: usize,
     end: f64,
     output_step: f64,
@@ -299,7 +301,7 @@ impl<S: SecondOrderSystem> Driver<S> {
             profile: opts.profile.then(Profile::default),
             hook: opts.hook.clone(),
         };
-        let cv = Cvode::new(problem, 0.0, &y0, &opts.ode)?;
+        let cv = Integrator::new(problem, 0.0, &y0, &opts.ode)?;
         Ok(Driver {
             cv,
             dim,
@@ -310,7 +312,7 @@ impl<S: SecondOrderSystem> Driver<S> {
             y0,
             roots: RootGuard::watched(stall::StallWatch::new(
                 0.0,
-                opts.ode.max_order,
+                opts.ode.method.order(opts.ode.max_order),
                 opts.problem.velocity_scale,
             )),
         })
@@ -435,7 +437,7 @@ impl RootGuard {
     /// Integrates `cv` to `tout`, re-initialising at every root.
     pub(super) fn advance_to<P: OdeProblem>(
         &mut self,
-        cv: &mut Cvode<P>,
+        cv: &mut Integrator<P>,
         tout: f64,
     ) -> Result<(), Error> {
         loop {

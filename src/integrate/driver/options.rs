@@ -6,7 +6,7 @@ use serde::Serialize;
 
 use crate::error::{Error, FlagError};
 use crate::integrate::mechanical::{ProblemOptions, DEFAULT_MAX_ORDER};
-use crate::integrate::problem::{Iteration, OdeOptions};
+use crate::integrate::problem::{DirkTable, Iteration, OdeOptions, DIRK_TABLE_NAMES};
 
 /// Options of [`integrate`](super::integrate). Defaults: the integrator's defaults ([`OdeOptions::default`]: BDF,
 /// Newton with the structured solve, rtol 1e-8, atol 1e-6 — the paper's Table 1) except the
@@ -120,6 +120,20 @@ pub fn positive_flag(flag: &'static str, v: f64) -> Result<f64, Error> {
     } else {
         Err(FlagError::NotPositive { flag, value: v }.into())
     }
+}
+
+/// The DIRK table named by the value of the command-line flag `--{flag}` (ARKODE's name, with
+/// or without `ARKODE_`, any case), or the error naming the flag and listing the tables.
+pub fn dirk_table_flag(flag: &'static str, name: &str) -> Result<DirkTable, Error> {
+    DirkTable::from_name(name).ok_or_else(|| {
+        FlagError::Unknown {
+            flag,
+            what: "DIRK table",
+            value: name.to_string(),
+            valid: DIRK_TABLE_NAMES,
+        }
+        .into()
+    })
 }
 
 /// The choices of a run a user makes — `jointrom transient`'s flags and the Python package's

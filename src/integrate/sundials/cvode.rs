@@ -76,12 +76,12 @@ enum Linear {
 }
 
 /// Owns the boxed [`Shared`] state whose address CVODE holds as `user_data`.
-struct SharedBox<P> {
+pub(super) struct SharedBox<P> {
     ptr: NonNull<Shared<P>>,
 }
 
 impl<P> SharedBox<P> {
-    fn new(shared: Shared<P>) -> Self {
+    pub(super) fn new(shared: Shared<P>) -> Self {
         Self {
             ptr: NonNull::from(Box::leak(Box::new(shared))),
         }
@@ -89,21 +89,21 @@ impl<P> SharedBox<P> {
 
     /// The shared state. Valid while no CVODE call is under way (callbacks only run inside
     /// methods taking `&mut Cvode`, which hold no reference from here across the call).
-    fn get(&self) -> &Shared<P> {
+    pub(super) fn get(&self) -> &Shared<P> {
         // SAFETY: the pointer came from Box::leak and is freed only in Drop / into_inner.
         unsafe { self.ptr.as_ref() }
     }
 
-    fn get_mut(&mut self) -> &mut Shared<P> {
+    pub(super) fn get_mut(&mut self) -> &mut Shared<P> {
         // SAFETY: as in `get`; `&mut self` excludes other Rust references.
         unsafe { self.ptr.as_mut() }
     }
 
-    fn as_user_data(&self) -> *mut c_void {
+    pub(super) fn as_user_data(&self) -> *mut c_void {
         self.ptr.as_ptr().cast()
     }
 
-    fn into_inner(self) -> Shared<P> {
+    pub(super) fn into_inner(self) -> Shared<P> {
         let this = std::mem::ManuallyDrop::new(self);
         // SAFETY: the pointer came from Box::leak; `Drop` will not run for `this`.
         *unsafe { Box::from_raw(this.ptr.as_ptr()) }
@@ -183,7 +183,8 @@ impl<P: OdeProblem> Cvode<P> {
         let y = SerialVector::from_slice(&context, y0)?;
         let lmm = match opts.method {
             Method::Bdf => CV_BDF,
-            Method::Adams => CV_ADAMS,
+            // `validate` refused a DIRK method.
+            Method::Adams | Method::Dirk(_) => CV_ADAMS,
         };
         // SAFETY: the context is live; CVodeCreate returns new memory created in it, or null,
         // which only `mem` frees.
@@ -775,7 +776,7 @@ impl<P: OdeProblem> Cvode<P> {
 }
 
 /// The error for a callback failure.
-fn callback_error(f: Failure, outcome: CallbackOutcome) -> Error {
+pub(super) fn callback_error(f: Failure, outcome: CallbackOutcome) -> Error {
     Error::Callback {
         callback: f.callback,
         message: f.message,
@@ -785,7 +786,7 @@ fn callback_error(f: Failure, outcome: CallbackOutcome) -> Error {
 }
 
 /// Checks a state: finite `t`, `y` of length `n` with finite entries.
-fn check_state(what: &'static str, t: f64, y: &[f64], n: usize) -> Result<(), Error> {
+pub(super) fn check_state(what: &'static str, t: f64, y: &[f64], n: usize) -> Result<(), Error> {
     if !t.is_finite() {
         return Err(IntegrationError::TimeNotFinite {
             function: what,
@@ -840,6 +841,13 @@ fn validate<P: OdeProblem>(problem: &P, t0: f64, y0: &[f64], o: &OdeOptions) -> 
     let max = match o.method {
         Method::Bdf => 5,
         Method::Adams => 12,
+        Method::Dirk(t) => {
+            return bad(
+                "method",
+                t.name().into(),
+                "BDF or Adams for CVODE (a DIRK method runs on ARKODE: Arkode / Integrator)",
+            )
+        }
     };
     if o.max_order == 0 || o.max_order > max {
         return bad(

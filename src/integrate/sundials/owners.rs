@@ -1,5 +1,6 @@
-//! [`Owned`]: the RAII owner of one SUNDIALS object used by [`super::Cvode`] — the CVODE memory,
-//! a nonlinear solver, a linear solver or a matrix. It frees its object in `Drop` with the free
+//! [`Owned`]: the RAII owner of one SUNDIALS object used by [`super::Cvode`] and
+//! [`super::Arkode`] — the CVODE or ARKStep memory, a nonlinear solver, a linear solver or a
+//! matrix. It frees its object in `Drop` with the free
 //! function of the object's kind ([`SundialsObject`]) and holds a [`Context`] clone, so the
 //! `SUNContext` outlives every object created in it.
 //!
@@ -17,6 +18,8 @@ use sundials_sys::{
     _generic_SUNLinearSolver, _generic_SUNMatrix, _generic_SUNNonlinearSolver, CVodeFree,
     SUNLinSolFree, SUNMatDestroy, SUNNonlinSolFree,
 };
+
+use super::ffi::ARKStepFree;
 
 use super::{sundials_error, Context, CvodeFlag};
 use crate::Error;
@@ -43,6 +46,9 @@ pub(crate) trait SundialsObject: sealed::Sealed {
 /// CVODE's integrator memory (`CVodeCreate`), freed with `CVodeFree`.
 pub(crate) enum CvodeMemory {}
 
+/// ARKODE's ARKStep memory (`ARKStepCreate`), freed with `ARKStepFree`.
+pub(crate) enum ArkodeMemory {}
+
 /// A `SUNNonlinearSolver` owned by jointrom (attached with `CVodeSetNonlinearSolver`, which
 /// leaves freeing it to the caller), freed with `SUNNonlinSolFree`.
 pub(crate) enum NonlinearSolver {}
@@ -55,6 +61,7 @@ pub(crate) enum LinearSolver {}
 pub(crate) enum Matrix {}
 
 impl sealed::Sealed for CvodeMemory {}
+impl sealed::Sealed for ArkodeMemory {}
 impl sealed::Sealed for NonlinearSolver {}
 impl sealed::Sealed for LinearSolver {}
 impl sealed::Sealed for Matrix {}
@@ -67,6 +74,19 @@ impl SundialsObject for CvodeMemory {
         // SAFETY: by the trait's contract `raw` is live CVODE memory owned by the caller.
         // CVodeFree frees it and only nulls our local copy of the pointer.
         unsafe { CVodeFree(&mut raw) };
+        0
+    }
+}
+
+impl SundialsObject for ArkodeMemory {
+    type Raw = c_void;
+
+    unsafe fn free(raw: *mut c_void) -> c_int {
+        let mut raw = raw;
+        // SAFETY: by the trait's contract `raw` is live ARKStep memory owned by the caller.
+        // ARKStepFree frees it (with its nonlinear solver, which ARKStep created) and only
+        // nulls our local copy of the pointer.
+        unsafe { ARKStepFree(&mut raw) };
         0
     }
 }

@@ -8,6 +8,8 @@ use clap::Args;
 use serde_json::{json, Value};
 
 use jointrom::error::{FlagError, RomError};
+use jointrom::integrate::driver::dirk_table_flag;
+use jointrom::integrate::problem::{DirkTable, Method};
 use jointrom::integrate::{Curves, RunChoices, TransientOptions};
 use jointrom::rom::compare::{ReferenceCurves, ReferenceErrors};
 use jointrom::rom::spec::DEFAULT_SNAPSHOTS;
@@ -17,7 +19,7 @@ use jointrom::{Error, Model};
 
 use jointrom::studies::stability::IterKind;
 
-use crate::args::OnOff;
+use crate::args::{MethodKind, OnOff};
 use crate::common::{create_dir, positive, print_json, write_file};
 
 #[derive(Args)]
@@ -56,6 +58,14 @@ pub struct TransientArgs {
     /// Velocity tolerance per displacement tolerance, 1/s.
     #[arg(long)]
     velocity_scale: Option<f64>,
+    /// Integration method: bdf (CVODE's BDF, the paper's) or dirk (an L-stable, stiffly
+    /// accurate diagonally implicit Runge–Kutta method of ARKODE, table --dirk-table).
+    #[arg(long, value_enum, default_value_t = MethodKind::Bdf)]
+    method: MethodKind,
+    /// `--method dirk`: ARKODE's Butcher table, e.g. ARK324L2SA_DIRK_4_2_3 (default: the cheapest
+    /// measured), ESDIRK324L2SA_4_2_3, KVAERNO_4_2_3, SDIRK_5_3_4 (with or without `ARKODE_`).
+    #[arg(long)]
+    dirk_table: Option<String>,
     /// Maximum BDF order (1–5).
     #[arg(long)]
     max_order: Option<usize>,
@@ -268,6 +278,7 @@ fn transient_options(a: &TransientArgs) -> Result<TransientOptions, Error> {
     if let Some(s) = a.stab_lim_det {
         o.ode.stab_lim_det = s.is_on();
     }
+    o.ode.method = method(a)?;
     o.profile = a.profile;
     o.problem.screen = a.screen == OnOff::On;
     if let Some(r) = &a.refresh {
@@ -299,6 +310,51 @@ fn transient_options(a: &TransientArgs) -> Result<TransientOptions, Error> {
         o.ode.step_growth = g;
     }
     Ok(o)
+}
+
+/// `--method` and `--dirk-table` (BDF's flags `--max-order`, `--stab-lim-det on` and
+/// `--iteration functional` refused with a DIRK method, `--dirk-table` without one).
+fn method(a: &TransientArgs) -> Result<Method, Error> {
+    match a.method {
+        MethodKind::Bdf => match &a.dirk_table {
+            Some(t) => Err(FlagError::Value {
+                flag: "dirk-table",
+                value: t.clone(),
+                need: "only with --method dirk",
+            }
+            .into()),
+            None => Ok(Method::Bdf),
+        },
+        MethodKind::Dirk => {
+            let refuse = |flag, value: String| {
+                Err(FlagError::Value {
+                    flag,
+                    value,
+                    need: "only with --method bdf (a DIRK table fixes its order and stability)",
+                }
+                .into())
+            };
+            if let Some(k) = a.max_order {
+                return refuse("max-order", k.to_string());
+            }
+            if a.stab_lim_det == Some(OnOff::On) {
+                return refuse("stab-lim-det", "on".into());
+            }
+            if a.iteration == IterKind::Functional {
+                return Err(FlagError::Value {
+                    flag: "iteration",
+                    value: "functional".into(),
+                    need: "newton with --method dirk",
+                }
+                .into());
+            }
+            let table = match &a.dirk_table {
+                Some(name) => dirk_table_flag("dirk-table", name)?,
+                None => DirkTable::Ark324Dirk,
+            };
+            Ok(Method::Dirk(table))
+        }
+    }
 }
 
 /// `--vtu`: every how many outputs a frame is kept (`None` without `--vtu`).
