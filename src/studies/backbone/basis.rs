@@ -28,9 +28,9 @@
 //!    B_z K⁻¹ B_zᵀ)⁻¹` they also span the stiffened structure's responses to the pair forces.
 //!    The open pairs' columns add no static response the closed pairs' do not, but shapes of
 //!    the joint region between them: measured on the friction bar and the multilayer sheet, a
-//!    basis with the closed pairs' columns alone dissipated 3–13 % more per cycle than the
-//!    full model, with every pair's 1–7 % (docs/validation/backbone.md) — the slipping joint's
-//!    local dynamics need them. They are what makes the model large (r ≈ Φ_TOL + 2–3 w).
+//!    basis with the closed pairs' columns alone dissipated up to 13 % more per cycle than the
+//!    full model, with every pair's up to 7 % (docs/validation/backbone.md) — the slipping
+//!    joint's local dynamics need them. They are what makes the model large (r ≈ Φ_TOL + 2–3 w).
 //!
 //! The columns are M-orthonormalised after Φ_TOL (dependent ones dropped,
 //! [`crate::reduction::final_basis`]) and rotated to the reduced eigenbasis.
