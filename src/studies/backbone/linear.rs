@@ -285,3 +285,48 @@ pub fn reduced_modes(
 fn dot(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The sparse `K + Σ k b bᵀ` equals the dense sum entry by entry, its pattern sorted.
+    #[test]
+    fn stiffened_equals_the_dense_sum() {
+        let model = Model::from_case_name("friction_bar").unwrap();
+        let rows: Vec<(usize, f64)> = [
+            (0, 2.0),
+            (1, 3.0),
+            (2, 5.0),
+            (3 * 7, 7.0),
+            (3 * 7 + 2, 11.0),
+        ]
+        .into_iter()
+        .collect();
+        let a = stiffened(&model, &rows);
+        let mut dense = model.stiffness.to_dense();
+        for &(r, kr) in &rows {
+            let b: Vec<(usize, f64)> = model.joint.row(r).collect();
+            for &(j, bj) in &b {
+                for &(i, bi) in &b {
+                    dense[(i, j)] += kr * bi * bj;
+                }
+            }
+        }
+        let got = a.to_dense();
+        let scale = model.stiffness.inf_norm();
+        for j in 0..a.n {
+            let col = &a.row_idx[a.col_ptr[j]..a.col_ptr[j + 1]];
+            assert!(col.windows(2).all(|w| w[0] < w[1]), "column {j} unsorted");
+            for i in 0..a.n {
+                assert!(
+                    (got[(i, j)] - dense[(i, j)]).abs() <= 1e-14 * scale,
+                    "({i}, {j}): {} vs {}",
+                    got[(i, j)],
+                    dense[(i, j)]
+                );
+            }
+        }
+        assert!(a.row_idx.len() > model.stiffness.row_idx.len());
+    }
+}
