@@ -117,6 +117,21 @@ pub fn markdown(b: &Backbone) -> String {
         if b.friction { "on" } else { "off" },
         b.ring_down_cpu_s
     );
+    if let (Some(r0), Some(w)) = (b.tolerance_model_size, b.attachment_pairs) {
+        let _ = writeln!(
+            s,
+            "The tolerance model (r = {r0}) enriched for the backbone: the full model's \
+             equilibrium, linearised modes (stuck and slipped) and the attachment modes of its \
+             {w} pairs. Full model's linearisation: {}.\n",
+            b.modes
+                .iter()
+                .filter_map(|m| m
+                    .full_linear_frequency_hz
+                    .map(|f| format!("mode {} {f:.3} Hz", m.mode)))
+                .collect::<Vec<_>>()
+                .join(", ")
+        );
+    }
     s.push_str(
         "| mode | f_lin (Hz) | A (mm) | Ā first cycle (mm) | f (Hz) | f / f_lin | ζ | CPU (s) |\n\
          |---:|---:|---:|---:|---:|---:|---:|---:|\n",

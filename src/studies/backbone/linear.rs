@@ -23,6 +23,7 @@ use faer::Mat;
 
 use crate::error::Error;
 use crate::joint::statics::ContactOptions;
+use crate::linalg::sparse::column_pattern;
 use crate::linalg::{dense_modes, lowest_modes, SymCsc};
 use crate::model::{contact_static_full, Model};
 use crate::rom::statics::{reduced_contact_static_restarting, scaled_load};
@@ -126,43 +127,53 @@ fn stuck_rows(model: &Model, eq: &Equilibrium, friction: bool) -> Vec<(usize, f6
     out
 }
 
-/// `K + Σ k_i b_i b_iᵀ` over `rows` of the model's joint operator, sparse.
+/// `K + Σ k_i b_i b_iᵀ` over `rows` of the model's joint operator, sparse: the pattern of K
+/// joined with each row's `b bᵀ` ([`column_pattern`]), then the values added in place.
 fn stiffened(model: &Model, rows: &[(usize, f64)]) -> SymCsc {
     let k = &model.stiffness;
     let n = k.n;
-    let mut cols: Vec<Vec<(usize, f64)>> = (0..n)
-        .map(|j| {
-            (k.col_ptr[j]..k.col_ptr[j + 1])
-                .map(|p| (k.row_idx[p], k.values[p]))
-                .collect()
-        })
+    let b: Vec<(f64, Vec<(usize, f64)>)> = rows
+        .iter()
+        .map(|&(r, kr)| (kr, model.joint.row(r).collect()))
         .collect();
-    for &(r, kr) in rows {
-        let b: Vec<(usize, f64)> = model.joint.row(r).collect();
-        for &(j, bj) in &b {
-            cols[j].extend(b.iter().map(|&(i, bi)| (i, kr * bi * bj)));
+    // Per column j, the rows of b that touch it.
+    let mut touching: Vec<Vec<usize>> = vec![Vec::new(); n];
+    for (i, (_, row)) in b.iter().enumerate() {
+        for &(j, _) in row {
+            touching[j].push(i);
         }
     }
-    let mut col_ptr = vec![0];
-    let (mut row_idx, mut values) = (Vec::new(), Vec::new());
-    for mut c in cols {
-        c.sort_by_key(|e| e.0);
-        for (i, v) in c {
-            if row_idx.len() > *col_ptr.last().expect("non-empty") && row_idx.last() == Some(&i) {
-                *values.last_mut().expect("non-empty") += v;
-            } else {
-                row_idx.push(i);
-                values.push(v);
-            }
+    let (col_ptr, row_idx) = column_pattern(n, |j, out| {
+        out.extend_from_slice(&k.row_idx[k.col_ptr[j]..k.col_ptr[j + 1]]);
+        for &i in &touching[j] {
+            out.extend(b[i].1.iter().map(|e| e.0));
         }
-        col_ptr.push(row_idx.len());
-    }
-    SymCsc {
+    });
+    let mut a = SymCsc {
         n,
+        values: vec![0.0; row_idx.len()],
         col_ptr,
         row_idx,
-        values,
+    };
+    let add = |a: &mut SymCsc, i: usize, j: usize, v: f64| {
+        let rows = &a.row_idx[a.col_ptr[j]..a.col_ptr[j + 1]];
+        if let Ok(p) = rows.binary_search(&i) {
+            a.values[a.col_ptr[j] + p] += v;
+        }
+    };
+    for j in 0..n {
+        for p in k.col_ptr[j]..k.col_ptr[j + 1] {
+            add(&mut a, k.row_idx[p], j, k.values[p]);
+        }
     }
+    for (kr, row) in &b {
+        for &(j, bj) in row {
+            for &(i, bi) in row {
+                add(&mut a, i, j, kr * bi * bj);
+            }
+        }
+    }
+    a
 }
 
 /// A dense symmetric matrix as [`SymCsc`] (every entry stored).
@@ -273,4 +284,49 @@ pub fn reduced_modes(
 
 fn dot(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The sparse `K + Σ k b bᵀ` equals the dense sum entry by entry, its pattern sorted.
+    #[test]
+    fn stiffened_equals_the_dense_sum() {
+        let model = Model::from_case_name("friction_bar").unwrap();
+        let rows: Vec<(usize, f64)> = [
+            (0, 2.0),
+            (1, 3.0),
+            (2, 5.0),
+            (3 * 7, 7.0),
+            (3 * 7 + 2, 11.0),
+        ]
+        .into_iter()
+        .collect();
+        let a = stiffened(&model, &rows);
+        let mut dense = model.stiffness.to_dense();
+        for &(r, kr) in &rows {
+            let b: Vec<(usize, f64)> = model.joint.row(r).collect();
+            for &(j, bj) in &b {
+                for &(i, bi) in &b {
+                    dense[(i, j)] += kr * bi * bj;
+                }
+            }
+        }
+        let got = a.to_dense();
+        let scale = model.stiffness.inf_norm();
+        for j in 0..a.n {
+            let col = &a.row_idx[a.col_ptr[j]..a.col_ptr[j + 1]];
+            assert!(col.windows(2).all(|w| w[0] < w[1]), "column {j} unsorted");
+            for i in 0..a.n {
+                assert!(
+                    (got[(i, j)] - dense[(i, j)]).abs() <= 1e-14 * scale,
+                    "({i}, {j}): {} vs {}",
+                    got[(i, j)],
+                    dense[(i, j)]
+                );
+            }
+        }
+        assert!(a.row_idx.len() > model.stiffness.row_idx.len());
+    }
 }

@@ -31,6 +31,7 @@
 //! coordinate that stops decaying like one mode: the extracted frequency then drifts from cycle
 //! to cycle. Both are reported, not hidden.
 
+pub mod basis;
 pub mod extract;
 pub mod linear;
 
@@ -38,12 +39,13 @@ use std::time::Instant;
 
 use serde::Serialize;
 
-use crate::error::{Error, FlagError, StudyError};
+use crate::error::{Error, FlagError, RomError, StudyError};
 use crate::integrate::{integrate, InitialState, RunStatus, TransientOptions};
 use crate::model::Model;
 use crate::rom::{build_rom, ModelSpec};
 use crate::system::{FullSystem, Scene, SecondOrderSystem};
 
+pub use basis::{backbone_model, BackboneModel};
 pub use extract::{cycles, Cycle, Samples};
 pub use linear::{
     full_equilibrium, full_modes, reduced_equilibrium, reduced_modes, Equilibrium, LinearMode,
@@ -184,6 +186,9 @@ pub struct ModeBackbone {
     pub mode: usize,
     /// The linearised model's frequency, Hz.
     pub linear_frequency_hz: f64,
+    /// With `--tolerance`: the full model's linearised frequency, Hz (the reference of
+    /// `linear_frequency_hz`, which the enrichment makes equal to it up to rounding).
+    pub full_linear_frequency_hz: Option<f64>,
     /// The master's displacement in the (1 mm) shape `[ux, uy, uz (mm), rx, ry, rz (rad)]`.
     pub shape_master: [f64; 6],
     /// `ψᵀMψ` of the 1 mm shape, t.
@@ -199,6 +204,10 @@ pub struct Backbone {
     pub model: String,
     /// Its size: DOF of the full model, r of a reduced one.
     pub model_size: usize,
+    /// With `--tolerance`: r of the tolerance model before the backbone's enrichment
+    /// ([`basis`]), and the pairs whose attachment modes the enrichment added.
+    pub tolerance_model_size: Option<usize>,
+    pub attachment_pairs: Option<usize>,
     /// The preload factor S and its master load `[Fx, Fy, Fz (N), Mx, My, Mz (N·mm)]`.
     pub preload: f64,
     pub preload_load: [f64; 6],
@@ -425,6 +434,7 @@ pub fn compute(model: &Model, spec: &ModelSpec, opts: &BackboneOptions) -> Resul
     let count = opts.modes.iter().copied().max().unwrap_or(1);
     let friction = opts.transient.problem.friction;
     let scene = Scene::of(model);
+    let mut enrichment = None;
     let (size, eq, modes, rom) = match spec {
         ModelSpec::Full => {
             check_modes(count, model.dofs(), "full")?;
@@ -441,7 +451,19 @@ pub fn compute(model: &Model, spec: &ModelSpec, opts: &BackboneOptions) -> Resul
                 ..opts.transient.clone()
             };
             let built = build_rom(model, spec, &choose, "backbone")?;
-            let rom = built.rom;
+            let mut rom = built.rom;
+            if let ModelSpec::Tolerance { .. } = spec {
+                // The enrichment adds the modes asked for: any of the full model's will do.
+                check_modes(count, model.dofs(), "full")?;
+                let phi = rom.phi.as_ref().ok_or_else(|| RomError::Unsupported {
+                    command: "backbone".into(),
+                    model: "a tolerance model without its basis".into(),
+                    takes: "--tolerance TOL with the basis kept",
+                })?;
+                let b = backbone_model(model, phi, opts.preload, count, friction)?;
+                enrichment = Some((b.attachment_pairs, b.full_frequencies_hz, rom.dim()));
+                rom = b.rom;
+            }
             check_modes(count, rom.dim(), &spec.name())?;
             let eq = reduced_equilibrium(model, &rom, opts.preload)?;
             let modes = reduced_modes(model, &rom, &eq, count, friction)?;
@@ -452,6 +474,8 @@ pub fn compute(model: &Model, spec: &ModelSpec, opts: &BackboneOptions) -> Resul
     let mut out = Backbone {
         model: spec.name(),
         model_size: size,
+        tolerance_model_size: enrichment.as_ref().map(|e| e.2),
+        attachment_pairs: enrichment.as_ref().map(|e| e.0),
         preload: opts.preload,
         preload_load: eq.load,
         closed_pairs: eq.closed.iter().filter(|&&c| c).count(),
@@ -480,6 +504,7 @@ pub fn compute(model: &Model, spec: &ModelSpec, opts: &BackboneOptions) -> Resul
         out.modes.push(ModeBackbone {
             mode: k,
             linear_frequency_hz: mode.frequency_hz,
+            full_linear_frequency_hz: enrichment.as_ref().map(|e| e.1[k - 1]),
             shape_master: mode.master,
             modal_mass: mode.modal_mass,
             ring_downs,

@@ -20,6 +20,8 @@ pub struct BackboneArgs {
     /// Case file, matrix map (`jointrom-matrices` JSON) or built-in name.
     case: String,
     /// The model (default: tvd, or adaptive with --tolerance; `--model full` for the FE check).
+    /// With --tolerance the tolerance model is enriched for the backbone (the full model's
+    /// equilibrium, linearised modes and every pair's attachment modes).
     #[command(flatten)]
     model: ModelFlags,
     /// Mode numbers of the model linearised about the preloaded equilibrium with its closed
