@@ -179,6 +179,10 @@ pub struct JointFlexibility {
 /// modes of these beyond a basis's span are the ones whose dynamics it checks.
 pub const TRUNCATION_MODES: usize = 40;
 
+/// The lowest truncated modes that the truncation check's re-run adds to a basis
+/// ([`ErrorEstimator::truncation_check_basis`], module docs "Truncation").
+pub const TRUNCATION_CHECK_MODES: usize = 10;
+
 /// Refinement steps (double-double residuals) of the flexibility columns and the friction
 /// term: one, where the basis vectors take two (the pair-space statics still equal the full
 /// model's to 1e-9 of ‖f_c‖, tested); the columns are most of the estimate's cost on a
@@ -549,6 +553,9 @@ struct Truncation {
     psi_m: Mat<f64>,
     /// `Ψᵀ K Φ` (m × r).
     psi_k_phi: Mat<f64>,
+    /// The lowest [`TRUNCATION_CHECK_MODES`] columns of `Ψ` (n × ≤ that), for the truncation
+    /// check's re-run.
+    lowest: Mat<f64>,
 }
 
 impl Truncation {
@@ -577,7 +584,13 @@ impl Truncation {
         }
         let master = model.master_dofs();
         let k_phi = sym_mul_mat(&model.stiffness, phi);
+        let mut by_frequency: Vec<usize> = (0..omega2.len()).collect();
+        by_frequency.sort_by(|&a, &b| omega2[a].total_cmp(&omega2[b]));
+        by_frequency.truncate(TRUNCATION_CHECK_MODES);
         Ok(Truncation {
+            lowest: Mat::from_fn(psi.nrows(), by_frequency.len(), |i, j| {
+                psi[(i, by_frequency[j])]
+            }),
             b_psi: model.joint.reduce(psi.as_ref()),
             psi_m: Mat::from_fn(6, psi.ncols(), |d, j| psi[(master[d], j)]),
             psi_k_phi: psi.transpose() * &k_phi,
@@ -904,6 +917,26 @@ impl Dissipation {
 }
 
 impl ErrorEstimator<'_> {
+    /// The basis of the truncation check (module docs, "Truncation"): this estimator's Φ and
+    /// its lowest [`TRUNCATION_CHECK_MODES`] truncated modes — the fixed-interface modes the
+    /// next step of ν would add, M-orthogonal to Φ (n × (r + ≤ that); `None` when no mode is
+    /// beyond Φ). A re-run on it shows what those modes change of the run, the back-coupling
+    /// through the pair forces into the global motion included, which the quasi-static
+    /// correction does not see.
+    pub fn truncation_check_basis(&self) -> Option<Mat<f64>> {
+        let extra = &self.truncation.lowest;
+        let phi = self.rom.phi.as_ref()?;
+        (extra.ncols() > 0).then(|| {
+            Mat::from_fn(phi.nrows(), phi.ncols() + extra.ncols(), |i, j| {
+                if j < phi.ncols() {
+                    phi[(i, j)]
+                } else {
+                    extra[(i, j - phi.ncols())]
+                }
+            })
+        })
+    }
+
     /// The estimate of a run of this estimator's reduced model under the law `law` (its
     /// friction switch says whether `states.s` holds a slip memory).
     pub fn estimate(&self, law: &PairLaw, states: RunStates<'_>) -> Result<Estimate, Error> {
