@@ -61,7 +61,10 @@
 //! so while those are wrong the truncation part is inflated by orders of magnitude: growing ν in
 //! the same round as the pairs would make every model [`NU_STEP`] columns larger for nothing.
 //! The rounds' e_k come from the joint part alone, so truncation does not masquerade as pair
-//! error.
+//! error. A round whose correction meets TOL may be the result: it also gets the estimate's
+//! truncation check ([`super::estimate::add_truncation_check`], a re-run with the next
+//! [`NU_STEP`] fixed-interface modes, which sees their back-coupling into the global motion),
+//! and ν grows when that part exceeds θ·TOL and the total misses.
 //!
 //! The last round's run is the result; its estimate then gains the integration part
 //! ([`super::estimate::integration_errors`]: one more run at 2× looser tolerances, its difference scaled to this
