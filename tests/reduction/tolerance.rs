@@ -7,7 +7,7 @@ use serde_json::Value;
 
 use jointrom::integrate::{integrate, TransientOptions};
 use jointrom::joint::statics::ContactOptions;
-use jointrom::model::contact_static_full;
+use jointrom::model::{contact_static_full, Model};
 use jointrom::reduction::{
     build_basis, BasisKind, BasisOptions, JointFlexibility, Quantities, Quantity, RunStates,
 };
@@ -132,6 +132,39 @@ fn tolerance_model_meets_the_stored_full_reference() {
             "{name}: no truncation check"
         );
         assert!(t.offline_s > 0.0 && t.run.wall_s > 0.0 && t.estimate_s > 0.0);
+    }
+}
+
+/// The lap joint (`cases/lap_joint.json`: unequal sheets, off-node welds, its own load; not a
+/// scene the estimator was built on) at TOL 1e-2: met, every true error within it, the
+/// estimates of ‖f_c‖, ‖f_R‖, u_y and D (over the run) within 0.5–10× of their true errors.
+/// D at the end is not asserted: its true error there, 2.0e-4, is estimated at 0.49×
+/// (docs/validation/error-control.md).
+#[test]
+fn tolerance_model_meets_the_lap_joint_reference() {
+    let m =
+        Model::from_case_name(&crate::common::repo_path("cases/lap_joint.json").to_string_lossy())
+            .unwrap();
+    let (path, _) = reference_json("lap_joint_full_friction_on");
+    let reference = JointCurves::read(&path).unwrap();
+    let t = tolerance_model(&m, &ToleranceOptions::new(1e-2)).unwrap();
+    assert!(t.met, "not met ({:?})", t.estimate.total);
+    let truth = reference.errors(&t.run.curves);
+    let est = &t.estimate.total;
+    assert!(truth.dissipated_end.unwrap() <= 1e-2);
+    for (what, truth, est) in [
+        ("fc", truth.contact_force, est.contact_force),
+        ("fr", truth.friction_force, est.friction_force),
+        ("uy", truth.master_uy, est.master_uy),
+        ("D", truth.dissipated, est.dissipated),
+    ] {
+        let (truth, est) = (truth.unwrap(), est.unwrap());
+        assert!(truth <= 1e-2, "true {what} error {truth}");
+        let eff = est / truth;
+        assert!(
+            (0.5..=10.0).contains(&eff),
+            "{what} effectivity {eff} ({est} / {truth})"
+        );
     }
 }
 
