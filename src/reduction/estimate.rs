@@ -66,7 +66,11 @@
 //! (I + k_t F_SS) p_S* = k_t (û_S − F_{S,n} p_n* − F_{S,L} p_L* − s_S)
 //! ```
 //!
-//! a pair of S whose force leaves its cone slides on it and S is solved again without it. The
+//! a pair of S whose force leaves its cone slides on it and S is solved again without it. A pair
+//! the run holds open has no slip memory of its own there (it follows the pair's tangential
+//! motion): where the correction closes it, it slides on its cone in the direction of its
+//! tangential motion over the last output interval if that motion exceeds its stick radius
+//! `μ|p_n*|/k_t` (what the full model's pair does once closed), else it joins S. The
 //! tangential rows of the tangential flexibility columns are kept beside their normal rows.
 //! The dissipated energy `D = ∫ p_t · ṡ dt` of the run and of the correction is summed over the
 //! output states with the run's slip increments (only while the run's pair is closed), and its
@@ -178,6 +182,10 @@ pub struct JointFlexibility {
 /// Fixed-interface modes computed for the truncation part of the estimate (module docs): the
 /// modes of these beyond a basis's span are the ones whose dynamics it checks.
 pub const TRUNCATION_MODES: usize = 40;
+
+/// The lowest truncated modes that the truncation check's re-run adds to a basis
+/// ([`ErrorEstimator::truncation_check_basis`], module docs "Truncation").
+pub const TRUNCATION_CHECK_MODES: usize = 10;
 
 /// Refinement steps (double-double residuals) of the flexibility columns and the friction
 /// term: one, where the basis vectors take two (the pair-space statics still equal the full
@@ -549,6 +557,9 @@ struct Truncation {
     psi_m: Mat<f64>,
     /// `Ψᵀ K Φ` (m × r).
     psi_k_phi: Mat<f64>,
+    /// The lowest [`TRUNCATION_CHECK_MODES`] columns of `Ψ` (n × ≤ that), for the truncation
+    /// check's re-run.
+    lowest: Mat<f64>,
 }
 
 impl Truncation {
@@ -577,7 +588,13 @@ impl Truncation {
         }
         let master = model.master_dofs();
         let k_phi = sym_mul_mat(&model.stiffness, phi);
+        let mut by_frequency: Vec<usize> = (0..omega2.len()).collect();
+        by_frequency.sort_by(|&a, &b| omega2[a].total_cmp(&omega2[b]));
+        by_frequency.truncate(TRUNCATION_CHECK_MODES);
         Ok(Truncation {
+            lowest: Mat::from_fn(psi.nrows(), by_frequency.len(), |i, j| {
+                psi[(i, by_frequency[j])]
+            }),
             b_psi: model.joint.reduce(psi.as_ref()),
             psi_m: Mat::from_fn(6, psi.ncols(), |d, j| psi[(master[d], j)]),
             psi_k_phi: psi.transpose() * &k_phi,
@@ -904,6 +921,26 @@ impl Dissipation {
 }
 
 impl ErrorEstimator<'_> {
+    /// The basis of the truncation check (module docs, "Truncation"): this estimator's Φ and
+    /// its lowest [`TRUNCATION_CHECK_MODES`] truncated modes — the fixed-interface modes the
+    /// next step of ν would add, M-orthogonal to Φ (n × (r + ≤ that); `None` when no mode is
+    /// beyond Φ). A re-run on it shows what those modes change of the run, the back-coupling
+    /// through the pair forces into the global motion included, which the quasi-static
+    /// correction does not see.
+    pub fn truncation_check_basis(&self) -> Option<Mat<f64>> {
+        let extra = &self.truncation.lowest;
+        let phi = self.rom.phi.as_ref()?;
+        (extra.ncols() > 0).then(|| {
+            Mat::from_fn(phi.nrows(), phi.ncols() + extra.ncols(), |i, j| {
+                if j < phi.ncols() {
+                    phi[(i, j)]
+                } else {
+                    extra[(i, j - phi.ncols())]
+                }
+            })
+        })
+    }
+
     /// The estimate of a run of this estimator's reduced model under the law `law` (its
     /// friction switch says whether `states.s` holds a slip memory).
     pub fn estimate(&self, law: &PairLaw, states: RunStates<'_>) -> Result<Estimate, Error> {
@@ -1096,6 +1133,8 @@ struct Corrector<'a> {
     stick_factor: SubsetLlt,
     /// The flexibility columns of the pairs met so far (w entries, `None` before).
     cols: Vec<Option<Arc<[f64]>>>,
+    /// The run's slip memory at the previous output (2w, mm; empty before the first).
+    last_s: Vec<f64>,
 }
 
 /// Active-set iterations per output before the projected Gauss–Seidel fallback.
@@ -1135,6 +1174,7 @@ impl<'a> Corrector<'a> {
             factor: SubsetLlt::new(),
             stick_factor: SubsetLlt::new(),
             cols: vec![None; flex.pairs()],
+            last_s: Vec::new(),
         }
     }
 
@@ -1221,13 +1261,17 @@ impl<'a> Corrector<'a> {
         }
         if self.law.friction {
             self.tangential(u0, p, s, &mut pc)?;
+            self.last_s.clear();
+            self.last_s.extend_from_slice(s);
         }
         Ok(pc)
     }
 
     /// The corrected tangential forces (module docs, "Friction"), written into the tangential
     /// rows of `pc` whose normal rows hold the corrected normal forces: a pair the run slides
-    /// keeps its direction on the corrected cone `μ|p_n*|`; the other closed pairs S stick with
+    /// keeps its direction on the corrected cone `μ|p_n*|`, and so does a pair the run holds
+    /// open that moved tangentially by more than its stick radius over the last output
+    /// interval (in the direction of that motion); the other closed pairs S stick with
     /// the run's slip memory `s` (2w, mm), `p_t* = k_t (u_t* − s)` at the corrected tangential
     /// kinematics `u_t* = û_t − F_{t,n} p_n* − F_{t,t} p_t*` — one linear pair-space solve
     /// `(I + k_t F_SS) p_S = k_t (û_S − F_{S,n} p_n* − F_{S,L} p_L − s_S)`; a sticking pair whose
@@ -1253,7 +1297,23 @@ impl<'a> Corrector<'a> {
             } else {
                 cone / pt
             };
-            if cone > 0.0 && !sliding {
+            // A pair the run holds open has no slip memory of its own (it follows the pair's
+            // tangential motion), so sticking with it would give such a pair next to no friction
+            // force. The full model's pair, once closed, reaches its cone after a tangential
+            // motion of its stick radius μ|p_n*|/k_t: if the pair moved that far over the last
+            // output interval, it slides on its cone in that direction.
+            let moved = match (p[nrm(k)] == 0.0, self.last_s.is_empty()) {
+                (true, false) => [
+                    s[2 * k] - self.last_s[2 * k],
+                    s[2 * k + 1] - self.last_s[2 * k + 1],
+                ],
+                _ => [0.0; 2],
+            };
+            let travel = moved[0].hypot(moved[1]);
+            if cone > 0.0 && !sliding && travel > 0.0 && k_t * travel >= cone {
+                pc[3 * k + T1] = cone * moved[0] / travel;
+                pc[3 * k + T2] = cone * moved[1] / travel;
+            } else if cone > 0.0 && !sliding {
                 stick.push(k);
             } else {
                 pc[3 * k + T1] = scale * pt1;

@@ -9,9 +9,18 @@
 //! - the **reduction** part: the run against its quasi-static joint correction
 //!   ([`crate::reduction::estimate`]): the pair forces the full model would carry under the
 //!   reduced run's own motion, from the exact pair-space flexibility;
+//! - the **truncation** part ([`truncation_check_run`]): the run against a re-run of a richer
+//!   model, its basis and the next fixed-interface modes ([`TRUNCATION_CHECK_MODES`]) beyond
+//!   it. The correction above treats those modes quasi-statically plus a first-order dynamic
+//!   excess, driven by the run's own forces: it cannot see that they change the pair forces,
+//!   through them the friction's damping and through that the global motion and the dissipated
+//!   energy. The re-run sees it, as the next step of the tolerance model's ν would;
 //! - the **integration** part ([`integration_errors`]): the run against a re-run of the same
 //!   system at other tolerances ([`check_factor`]), scaled to the run's own error by the BDF2
 //!   error model.
+//!
+//! The total is `sqrt(e_reduction² + e_truncation² + e_integration²)`: the three re-runs differ
+//! from the run in independent ways (pair directions, fixed-interface modes, tolerances).
 //!
 //! Each part is a relative L2 error of a curve over the output times ([`super::compare`]):
 //! ‖f_c‖(t), ‖f_R‖(t) with friction, master u_y(t), and with friction the dissipated energy
@@ -29,7 +38,12 @@ use crate::error::{Error, RomError};
 use crate::integrate::{integrate, ProblemOptions, Run, TransientOptions};
 use crate::joint::law::PairLaw;
 use crate::model::Model;
-use crate::reduction::{CurveErrors, Estimate, JointFlexibility, RunStates};
+#[cfg(doc)]
+use crate::reduction::estimate::TRUNCATION_CHECK_MODES;
+use crate::reduction::{
+    final_basis, modal_rotation, CurveErrors, ErrorEstimator, Estimate, JointFlexibility,
+    RunStates, DEFAULT_DROP_TOL,
+};
 use crate::rom::compare::relative_l2;
 use crate::system::{ReducedSystem, Scene};
 
@@ -74,12 +88,72 @@ pub struct RunEstimate {
     pub total: CurveErrors,
     /// The reduction part: the run against its quasi-static joint correction.
     pub reduction: CurveErrors,
+    /// The truncation part: the run against a re-run with the next fixed-interface modes
+    /// beyond its basis ([`truncation_check_run`]; `None`: not checked).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub truncation: Option<CurveErrors>,
     /// The integration part: the run against a re-run at other rtol and atol ([`check_factor`]),
     /// scaled to this run's error ([`integration_errors`]; `None`: not checked).
     pub integration: Option<CurveErrors>,
     /// The reduction estimate's details (corrected curves, per-pair errors).
     #[serde(skip)]
     pub detail: Estimate,
+    /// The basis of the truncation check ([`ErrorEstimator::truncation_check_basis`]), for a
+    /// check made after the run ([`add_truncation_check`]).
+    #[serde(skip)]
+    pub truncation_basis: Option<faer::Mat<f64>>,
+}
+
+/// Which re-runs [`run_estimated_with`] makes beside the run.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Checks {
+    /// The integration check ([`integration_check_run`]).
+    pub integration: bool,
+    /// The truncation check ([`truncation_check_run`]).
+    pub truncation: bool,
+}
+
+impl RunEstimate {
+    /// The error of the reduced model alone: the reduction and truncation parts (root sum of
+    /// squares), without the integration part.
+    pub fn model_error(&self) -> CurveErrors {
+        match &self.truncation {
+            Some(t) => self.reduction.combine(t),
+            None => self.reduction,
+        }
+    }
+
+    /// Sets `total` from the parts.
+    fn update_total(&mut self) {
+        self.total = match &self.integration {
+            Some(i) => self.model_error().combine(i),
+            None => self.model_error(),
+        };
+    }
+}
+
+/// Adds the truncation part to the estimate of `run` made without it: the truncation check's
+/// re-run ([`truncation_check_run`]) after the run, at its options `opts` (the tolerance model
+/// makes it only for a round that may be its result). Nothing to add when no mode lies beyond
+/// the basis.
+///
+/// # Errors
+/// The richer basis fails, or its run does not finish.
+pub fn add_truncation_check(
+    model: &Model,
+    estimate: &mut RunEstimate,
+    run: &Run,
+    scene: &Scene,
+    opts: &TransientOptions,
+) -> Result<(), Error> {
+    let Some(basis) = &estimate.truncation_basis else {
+        return Ok(());
+    };
+    let rich = truncation_check_system_of(model, basis)?;
+    let check = truncation_check_run(rich, scene, opts)?;
+    estimate.truncation = Some(curve_differences(&check, run, opts.problem.friction, 1.0));
+    estimate.update_total();
+    Ok(())
 }
 
 /// The integration part of a run's error estimate: the relative L2 differences `D` of its curves
@@ -159,28 +233,74 @@ pub fn integration_check_run(
 /// [`integration_errors`] from its re-run `check` of `run` (made by [`integration_check_run`]
 /// with the same `opts`).
 pub fn integration_errors_from(check: &Run, run: &Run, opts: &TransientOptions) -> CurveErrors {
-    let (a, b) = (&check.curves, &run.curves);
     let scale = 1.0 / (check_factor(opts).powf(integration_order_exponent(opts)) - 1.0).abs();
+    curve_differences(check, run, opts.problem.friction, scale)
+}
+
+/// The relative L2 differences of `run`'s curves from `check`'s (and of D at the end), times
+/// `scale`; ‖f_R‖ and D only with `friction`.
+fn curve_differences(check: &Run, run: &Run, friction: bool, scale: f64) -> CurveErrors {
+    let (a, b) = (&check.curves, &run.curves);
     let diff = |x: &[f64], y: &[f64]| relative_l2(&a.t, x, &b.t, y).map(|d| d * scale);
     CurveErrors {
         contact_force: diff(&a.contact_force_norm, &b.contact_force_norm),
-        friction_force: if opts.problem.friction {
+        friction_force: if friction {
             diff(&a.friction_force_norm, &b.friction_force_norm)
         } else {
             None
         },
         master_uy: diff(&a.master_uy, &b.master_uy),
-        dissipated: if opts.problem.friction {
+        dissipated: if friction {
             diff(&a.dissipated, &b.dissipated)
         } else {
             None
         },
-        dissipated_end: if opts.problem.friction {
+        dissipated_end: if friction {
             end_difference(&a.dissipated, &b.dissipated).map(|d| d * scale)
         } else {
             None
         },
     }
+}
+
+/// The reduced system of the truncation check of `estimator`'s model: its basis Φ and the
+/// next [`TRUNCATION_CHECK_MODES`] fixed-interface modes beyond it
+/// ([`ErrorEstimator::truncation_check_basis`]), M-orthonormalized and rotated to the reduced
+/// eigenbasis like every basis; `None` when no mode is beyond Φ.
+pub fn truncation_check_system(
+    model: &Model,
+    estimator: &ErrorEstimator<'_>,
+) -> Result<Option<ReducedSystem>, Error> {
+    match estimator.truncation_check_basis() {
+        Some(basis) => truncation_check_system_of(model, &basis).map(Some),
+        None => Ok(None),
+    }
+}
+
+/// The reduced system on `basis` (M-orthonormalized, rotated to the reduced eigenbasis).
+fn truncation_check_system_of(
+    model: &Model,
+    basis: &faer::Mat<f64>,
+) -> Result<ReducedSystem, Error> {
+    let (phi, _) = final_basis(&[basis.as_ref()], &model.mass, DEFAULT_DROP_TOL)?;
+    let (phi, _) = modal_rotation(model, phi)?;
+    ReducedSystem::new(model, phi)
+}
+
+/// The truncation check's re-run ([`truncation_check_system`]) at the run's own tolerances.
+/// The relative L2 differences of the run's curves from it are the truncation part of the
+/// estimate, unscaled: the richer model holds the modes whose effect the part measures. Its
+/// run does not depend on the one it checks, so [`run_estimated`] makes it beside that run.
+pub fn truncation_check_run(
+    rich: ReducedSystem,
+    scene: &Scene,
+    opts: &TransientOptions,
+) -> Result<Run, Error> {
+    let check = TransientOptions {
+        record: false,
+        ..opts.clone()
+    };
+    integrate(rich, scene, &check, |_, _| {}).into_result()
 }
 
 /// `|a(T) − b(T)| / |b(T)|` at the last output of the shorter curve (`None` if `b` is zero
@@ -218,8 +338,9 @@ pub(crate) fn loosened(opts: &TransientOptions, factor: f64) -> TransientOptions
 }
 
 /// Runs a reduced model of `model` (its trajectory recorded) under `scene` (the model's own, or
-/// a variant's law) and estimates its error: the reduction part always, the integration part
-/// with `check_integration` (one more run of the same model at looser tolerances). The run's own
+/// a variant's law) and estimates its error: the reduction part always, the truncation and
+/// integration parts with `checks` (two more runs: the model with the next fixed-interface
+/// modes, and the same model at other tolerances). The run's own
 /// failure is in the [`Run`]; an estimate that cannot be made is the `Err` of the second value.
 ///
 /// # Errors
@@ -230,7 +351,27 @@ pub fn run_estimated(
     rom: ReducedSystem,
     scene: &Scene,
     opts: &TransientOptions,
-    check_integration: bool,
+    checks: bool,
+    observe: impl FnMut(f64, &[f64]),
+) -> Result<(Run, Result<RunEstimate, Error>), Error> {
+    let checks = Checks {
+        integration: checks,
+        truncation: checks,
+    };
+    run_estimated_with(model, flex, rom, scene, opts, checks, observe)
+}
+
+/// [`run_estimated`] with the re-runs chosen one by one.
+///
+/// # Errors
+/// As [`run_estimated`].
+pub fn run_estimated_with(
+    model: &Model,
+    flex: &JointFlexibility,
+    rom: ReducedSystem,
+    scene: &Scene,
+    opts: &TransientOptions,
+    checks: Checks,
     observe: impl FnMut(f64, &[f64]),
 ) -> Result<(Run, Result<RunEstimate, Error>), Error> {
     flex.basis_of(&rom)?;
@@ -253,7 +394,23 @@ pub fn run_estimated(
         },
         move || {
             let estimator = flex.estimator(model, &aside);
-            let check = check_integration.then(|| integration_check_run(aside, scene, opts));
+            // The two re-runs beside each other (a third job when a core is free).
+            let rich = match &estimator {
+                Ok(e) if checks.truncation => truncation_check_system(model, e),
+                _ => Ok(None),
+            };
+            let check = beside(
+                || {
+                    checks
+                        .integration
+                        .then(|| integration_check_run(aside, scene, opts))
+                },
+                || match rich {
+                    Ok(Some(rich)) => truncation_check_run(rich, scene, opts).map(Some),
+                    Ok(None) => Ok(None),
+                    Err(e) => Err(e),
+                },
+            );
             if estimator.is_ok() {
                 // A column that fails here fails again, named, in the estimate.
                 let _ = flex.prefetch_normal_columns(stop);
@@ -261,35 +418,41 @@ pub fn run_estimated(
             (estimator, check)
         },
     );
-    let estimate = match run.trajectory.take() {
-        Some(tr) if run.status.finished() => estimator?.estimate(
-            &pair_law(scene, &opts.problem),
-            RunStates {
-                t: &run.curves.t,
-                q: &tr.q,
-                p: &tr.p,
-                s: &tr.s,
-            },
-        ),
-        _ => Err(RomError::EstimateEarlyEnd {
-            status: run.status.to_string(),
-        }
-        .into()),
-    };
-    let estimate = estimate.and_then(|detail| {
-        let integration = match check {
+    let trajectory = run.trajectory.take();
+    let estimate = estimator.and_then(|estimator| {
+        let detail = match trajectory {
+            Some(tr) if run.status.finished() => estimator.estimate(
+                &pair_law(scene, &opts.problem),
+                RunStates {
+                    t: &run.curves.t,
+                    q: &tr.q,
+                    p: &tr.p,
+                    s: &tr.s,
+                },
+            ),
+            _ => Err(RomError::EstimateEarlyEnd {
+                status: run.status.to_string(),
+            }
+            .into()),
+        }?;
+        let truncation_basis = estimator.truncation_check_basis();
+        let (c, rich) = check;
+        let integration = match c {
             Some(c) => Some(integration_errors_from(&c?, &run, opts)),
             None => None,
         };
-        Ok(RunEstimate {
-            total: match &integration {
-                Some(i) => detail.errors.combine(i),
-                None => detail.errors,
-            },
+        let truncation =
+            rich?.map(|rich| curve_differences(&rich, &run, opts.problem.friction, 1.0));
+        let mut estimate = RunEstimate {
+            total: detail.errors,
             reduction: detail.errors,
+            truncation,
             integration,
             detail,
-        })
+            truncation_basis,
+        };
+        estimate.update_total();
+        Ok(estimate)
     });
     Ok((run, estimate))
 }

@@ -61,7 +61,10 @@
 //! so while those are wrong the truncation part is inflated by orders of magnitude: growing ν in
 //! the same round as the pairs would make every model [`NU_STEP`] columns larger for nothing.
 //! The rounds' e_k come from the joint part alone, so truncation does not masquerade as pair
-//! error.
+//! error. A round whose correction meets TOL may be the result: it also gets the estimate's
+//! truncation check ([`super::estimate::add_truncation_check`], a re-run with the next
+//! [`NU_STEP`] fixed-interface modes, which sees their back-coupling into the global motion),
+//! and ν grows when that part exceeds θ·TOL and the total misses.
 //!
 //! The last round's run is the result; its estimate then gains the integration part
 //! ([`super::estimate::integration_errors`]: one more run at 2× looser tolerances, its difference scaled to this
@@ -80,14 +83,16 @@ use crate::error::{Error, RomError};
 use crate::integrate::{Run, TransientOptions};
 use crate::joint::statics::ContactOptions;
 use crate::model::Model;
-use crate::reduction::estimate::TRUNCATION_MODES;
+use crate::reduction::estimate::{TRUNCATION_CHECK_MODES, TRUNCATION_MODES};
 #[cfg(doc)]
 use crate::reduction::Estimate;
 use crate::reduction::{
     craig_bampton, final_basis, modal_rotation, CurveErrors, JointFlexibility, Quantities,
     Quantity, DEFAULT_DROP_TOL,
 };
-use crate::rom::estimate::{beside, loosened, run_estimated, RunEstimate};
+use crate::rom::estimate::{
+    add_truncation_check, beside, loosened, run_estimated_with, Checks, RunEstimate,
+};
 use crate::rom::statics::{reduced_contact_static_restarting, scaled_load, ReducedStatic};
 use crate::system::{ReducedSystem, Scene};
 
@@ -187,6 +192,11 @@ pub struct Round {
     pub joint_friction: Option<f64>,
     /// Its truncation part (what more fixed-interface modes remove).
     pub truncation: Option<f64>,
+    /// The truncation check's part of the estimate (the re-run with the next fixed-interface
+    /// modes, [`super::estimate::truncation_check_run`]): the largest over the controlled
+    /// quantities (`None` in the ranking round, which makes no re-runs).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub truncation_check: Option<f64>,
     /// Wall time of the round's run, s.
     pub wall_s: f64,
     /// Wall time of the round's basis and reduced system, s.
@@ -294,18 +304,28 @@ pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<Toleran
         );
         // Any round at the user's tolerances may be the result: its integration check runs
         // beside it (on a second core; unused when the round is not the last).
-        let (run, estimate) = run_estimated(
+        let scene = Scene::of(model);
+        let checks = Checks {
+            integration: !ranking,
+            truncation: false,
+        };
+        let (run, estimate) = run_estimated_with(
             model,
             &flex,
             rom.clone(),
-            &Scene::of(model),
+            &scene,
             &transient,
-            !ranking,
+            checks,
             |_, _| {},
         )?;
         let run = run.into_result()?;
-        let estimate = estimate?;
-        let eta = worst(&estimate.reduction, on);
+        let mut estimate = estimate?;
+        // A round whose correction meets the tolerance may be the result: the truncation
+        // check's re-run (the next fixed-interface modes) decides (module docs).
+        if !ranking && worst(&estimate.reduction, on) <= tol {
+            add_truncation_check(model, &mut estimate, &run, &scene, &transient)?;
+        }
+        let eta = worst(&estimate.model_error(), on);
         let d = &estimate.detail;
         rounds.push(Round {
             pairs: chosen.pairs.len(),
@@ -317,6 +337,7 @@ pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<Toleran
             joint: d.joint,
             joint_friction: d.joint_friction,
             truncation: d.truncation,
+            truncation_check: estimate.truncation.map(|t| worst(&t, on)),
             wall_s: run.wall_s,
             basis_s,
             estimate_s: round_start.elapsed().as_secs_f64() - basis_s - run.wall_s,
@@ -328,7 +349,11 @@ pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<Toleran
             // The truncated modes are driven by the run's contact forces: while those are wrong
             // the truncation part is too, so ν grows only once the joint part is within its share.
             let part = SELECTION_MARGIN * tol;
-            if !changed && d.truncation.unwrap_or(0.0) > part && nu + NU_STEP <= max_nu(model) {
+            let truncated = d
+                .truncation
+                .unwrap_or(0.0)
+                .max(estimate.truncation.map_or(0.0, |t| worst(&t, on)));
+            if !changed && truncated > part && nu + NU_STEP <= max_nu(model) {
                 nu += NU_STEP;
                 cb = craig_bampton(model, nu)?;
                 changed = true;
@@ -488,8 +513,10 @@ fn main_direction(m: [f64; 3]) -> [f64; 2] {
 /// estimate only ranks the pairs (module docs, "Choosing S").
 pub const RANKING_LOOSENING: f64 = 10.0;
 
-/// Fixed-interface modes added to ν when the truncation part of the estimate exceeds its share.
-pub const NU_STEP: usize = 10;
+/// Fixed-interface modes added to ν when the truncation part of the estimate exceeds its share:
+/// the modes the estimate's truncation check adds ([`TRUNCATION_CHECK_MODES`]), so the check
+/// measures what this step removes.
+pub const NU_STEP: usize = TRUNCATION_CHECK_MODES;
 
 /// The largest ν the enrichment uses: [`TRUNCATION_MODES`] − [`NU_STEP`], so that the estimate
 /// still checks [`NU_STEP`] modes beyond the basis.

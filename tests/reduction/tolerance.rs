@@ -7,12 +7,12 @@ use serde_json::Value;
 
 use jointrom::integrate::{integrate, TransientOptions};
 use jointrom::joint::statics::ContactOptions;
-use jointrom::model::contact_static_full;
+use jointrom::model::{contact_static_full, Model};
 use jointrom::reduction::{
     build_basis, BasisKind, BasisOptions, JointFlexibility, Quantities, Quantity, RunStates,
 };
 use jointrom::rom::compare::JointCurves;
-use jointrom::rom::estimate::{integration_errors, pair_law, run_estimated};
+use jointrom::rom::estimate::{add_truncation_check, integration_errors, pair_law, run_estimated};
 use jointrom::rom::tolerance::{static_tolerance_model, tolerance_model, ToleranceOptions};
 use jointrom::system::{ReducedSystem, Scene};
 
@@ -113,16 +113,8 @@ fn tolerance_model_meets_the_stored_full_reference() {
             assert!(truth <= 1e-2, "{name}: true {what} error {truth}");
             assert!(est <= 1e-2, "{name}: estimated {what} error {est}");
             let eff = est / truth;
-            // The multilayer's u_y error (4.6e-4) is the back-coupling of the truncated
-            // modes' force error into the global motion, which the first-order correction
-            // does not see (docs/theory/error-estimate.md): measured effectivity 0.1.
-            if name == "multilayer_sheet" && what == "uy" {
-                assert!(
-                    eff < 0.5,
-                    "{name}: the u_y estimate improved ({eff}): tighten this"
-                );
-                continue;
-            }
+            // The multilayer's u_y error at ν = 10 is the back-coupling of the truncated
+            // modes into the global motion: only the truncation check's re-run sees it.
             assert!(
                 (0.5..=10.0).contains(&eff),
                 "{name}: {what} effectivity {eff} ({est} / {truth})"
@@ -135,7 +127,44 @@ fn tolerance_model_meets_the_stored_full_reference() {
             t.rom.dim()
         );
         assert!(t.pairs.len() < m.pair_count());
+        assert!(
+            t.estimate.truncation.is_some(),
+            "{name}: no truncation check"
+        );
         assert!(t.offline_s > 0.0 && t.run.wall_s > 0.0 && t.estimate_s > 0.0);
+    }
+}
+
+/// The lap joint (`cases/lap_joint.json`: unequal sheets, off-node welds, its own load; not a
+/// scene the estimator was built on) at TOL 1e-2: met, every true error within it, the
+/// estimates of ‖f_c‖, ‖f_R‖, u_y and D (over the run) within 0.5–10× of their true errors.
+/// D at the end is not asserted: its true error there, 2.0e-4, is estimated at 0.49×
+/// (docs/validation/error-control.md).
+#[test]
+fn tolerance_model_meets_the_lap_joint_reference() {
+    let m =
+        Model::from_case_name(&crate::common::repo_path("cases/lap_joint.json").to_string_lossy())
+            .unwrap();
+    let (path, _) = reference_json("lap_joint_full_friction_on");
+    let reference = JointCurves::read(&path).unwrap();
+    let t = tolerance_model(&m, &ToleranceOptions::new(1e-2)).unwrap();
+    assert!(t.met, "not met ({:?})", t.estimate.total);
+    let truth = reference.errors(&t.run.curves);
+    let est = &t.estimate.total;
+    assert!(truth.dissipated_end.unwrap() <= 1e-2);
+    for (what, truth, est) in [
+        ("fc", truth.contact_force, est.contact_force),
+        ("fr", truth.friction_force, est.friction_force),
+        ("uy", truth.master_uy, est.master_uy),
+        ("D", truth.dissipated, est.dissipated),
+    ] {
+        let (truth, est) = (truth.unwrap(), est.unwrap());
+        assert!(truth <= 1e-2, "true {what} error {truth}");
+        let eff = est / truth;
+        assert!(
+            (0.5..=10.0).contains(&eff),
+            "{what} effectivity {eff} ({est} / {truth})"
+        );
     }
 }
 
@@ -292,12 +321,21 @@ fn concurrent_integration_check_equals_the_sequential_one() {
     let scene = Scene::of(&m);
     let (run, est) = run_estimated(&m, &flex, rom.clone(), &scene, &opts, true, |_, _| {}).unwrap();
     let run = run.into_result().unwrap();
-    let beside = est.unwrap().integration.unwrap();
+    let est = est.unwrap();
+    let beside = est.integration.unwrap();
     let after = integration_errors(rom, &scene, &opts, &run).unwrap();
     assert_eq!(beside.contact_force, after.contact_force);
     assert_eq!(beside.friction_force, after.friction_force);
     assert_eq!(beside.master_uy, after.master_uy);
     assert!(beside.contact_force.unwrap() > 0.0);
+    // The truncation check made beside the run equals the one made after it.
+    let truncation = est.truncation.unwrap();
+    let mut later = est.clone();
+    later.truncation = None;
+    add_truncation_check(&m, &mut later, &run, &scene, &opts).unwrap();
+    assert_eq!(later.truncation, Some(truncation));
+    assert_eq!(later.total, est.total);
+    assert!(truncation.master_uy.unwrap() > 0.0);
 }
 
 /// The estimate of a fixed model (the paper's a-priori TVD, Craig–Bampton alone, g = 0, and the

@@ -477,6 +477,9 @@ fn print_summary(a: &TransientArgs, name: &str, model: &Model, o: &ModelRun, tot
                 "  reduction (vs quasi-static joint correction)",
                 &e.reduction,
             );
+            if let Some(t) = &e.truncation {
+                line("  truncation (vs the next fixed-interface modes)", t);
+            }
             if let Some(i) = &e.integration {
                 line("  integration (vs 2x looser tolerances, scaled)", i);
             }
