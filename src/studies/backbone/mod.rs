@@ -177,6 +177,42 @@ impl RingDown {
     pub fn first(&self) -> Option<&Cycle> {
         self.cycles.first()
     }
+
+    /// What a reader must know about one ring-down of mode `k` (module docs, *Where a backbone
+    /// stops meaning something*).
+    pub fn warnings(&self, k: usize, cycles: usize) -> Vec<String> {
+        let r = self;
+        let a = r.amplitude;
+        let mut w = Vec::new();
+        if !r.status.finished() {
+            w.push(format!(
+                "mode {k}, --amplitudes {a}: the ring-down stopped at t = {:.4e} s ({})",
+                r.end_time, r.status
+            ));
+        }
+        if !r.energy_ok {
+            w.push(format!(
+                "mode {k}, --amplitudes {a}: the energy balance misses by {:.2} % of the run's \
+                 energy (> {} %): its frequency and damping cannot be trusted; use a smaller amplitude",
+                100.0 * r.energy_residual_ratio,
+                100.0 * crate::integrate::driver::ENERGY_BALANCE_TOLERANCE
+            ));
+        }
+        if r.joint_opened {
+            w.push(format!(
+                "mode {k}, --amplitudes {a}: the joint opened fully during the decay: beyond the \
+                 amplitudes where mode {k} of the preloaded joint describes the motion"
+            ));
+        }
+        if r.cycles.is_empty() {
+            w.push(format!(
+                "mode {k}, --amplitudes {a}: the decay is too short to extract a frequency (no full \
+                 cycle in {:.4e} s; --cycles {cycles})",
+                r.end_time
+            ));
+        }
+        w
+    }
 }
 
 /// The backbone of one mode.
@@ -498,7 +534,7 @@ pub fn compute(model: &Model, spec: &ModelSpec, opts: &BackboneOptions) -> Resul
             };
             out.ring_down_cpu_s += r.cpu_s;
             out.ring_down_wall_s += r.wall_s;
-            out.warnings.extend(warnings_of(k, &r, opts.cycles));
+            out.warnings.extend(r.warnings(k, opts.cycles));
             ring_downs.push(r);
         }
         out.modes.push(ModeBackbone {
@@ -524,39 +560,4 @@ fn check_modes(count: usize, available: usize, model: &str) -> Result<(), Error>
         .into());
     }
     Ok(())
-}
-
-/// What a reader must know about one ring-down of mode `k` (module docs, *Where a backbone
-/// stops meaning something*).
-fn warnings_of(k: usize, r: &RingDown, cycles: usize) -> Vec<String> {
-    let a = r.amplitude;
-    let mut w = Vec::new();
-    if !r.status.finished() {
-        w.push(format!(
-            "mode {k}, --amplitudes {a}: the ring-down stopped at t = {:.4e} s ({})",
-            r.end_time, r.status
-        ));
-    }
-    if !r.energy_ok {
-        w.push(format!(
-            "mode {k}, --amplitudes {a}: the energy balance misses by {:.2} % of the run's \
-             energy (> {} %): its frequency and damping cannot be trusted; use a smaller amplitude",
-            100.0 * r.energy_residual_ratio,
-            100.0 * crate::integrate::driver::ENERGY_BALANCE_TOLERANCE
-        ));
-    }
-    if r.joint_opened {
-        w.push(format!(
-            "mode {k}, --amplitudes {a}: the joint opened fully during the decay: beyond the \
-             amplitudes where mode {k} of the preloaded joint describes the motion"
-        ));
-    }
-    if r.cycles.is_empty() {
-        w.push(format!(
-            "mode {k}, --amplitudes {a}: the decay is too short to extract a frequency (no full \
-             cycle in {:.4e} s; --cycles {cycles})",
-            r.end_time
-        ));
-    }
-    w
 }
