@@ -838,6 +838,8 @@ fn welds(
             return Err(e("the two sheets are at the same height".into()));
         }
         let inside = |p: [f64; 2]| lower.locate(p).is_some() && upper.locate(p).is_some();
+        // One sampling rule for both sheets (the finer one's): the same points on each.
+        let h = lower.h.min(upper.h);
         let layers = [&*lower, &*upper]
             .map(|l| {
                 let interpolation = |p: [f64; 2]| {
@@ -847,7 +849,7 @@ fn welds(
                 let view = nugget::SheetView {
                     sheet: l.sheet,
                     y: l.y,
-                    h: l.h,
+                    h,
                     interpolation: &interpolation,
                 };
                 nugget::sample(centre, d, &inside, &view)

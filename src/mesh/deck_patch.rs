@@ -9,7 +9,7 @@
 use std::collections::HashMap;
 
 use super::build::{check_deck_patches, regular_weld_patch, RegularSheet};
-use super::{RigidTie, ShellElem, WeldElem};
+use super::{OwnShellNugget, RigidTie, ShellElem, WeldElem};
 use crate::case::{LocalMesh, NODE_TOLERANCE};
 use crate::error::Error;
 
@@ -197,6 +197,18 @@ pub(super) fn weld_patches(
             warnings,
         )?;
         weld.own_shells = own_shells;
+        if own_shells == OwnShellNugget::BondedSlab && !sampled_alike(weld) {
+            // CWELDs merged through a stack of sheets meshed unequally carry different points
+            // per pair of sheets; the slab pairs points across the sheets, the RBE3 weld does
+            // not need to.
+            weld.own_shells = OwnShellNugget::Rbe3;
+            warnings.push(format!(
+                "{file}: the area weld at (x, z) = ({}, {}) mm: its sheets are sampled unequally \
+                 through the stack, so the nugget acts on them through the RBE3 weld instead \
+                 of the bonded slab",
+                weld.centre[0], weld.centre[1]
+            ));
+        }
         let Some(mut patch) = patch else {
             continue;
         };
@@ -226,4 +238,19 @@ pub(super) fn weld_patches(
     }
     let tied: Vec<usize> = tie.slaves.iter().copied().chain([tie.master]).collect();
     check_deck_patches(file, welds, (nodes.len(), clamped, &tied), warnings)
+}
+
+/// Whether consecutive layers of `weld` carry the same sampling points (positions and weights):
+/// what the bonded slab needs.
+fn sampled_alike(weld: &WeldElem) -> bool {
+    let mut layers: Vec<&super::NuggetLayer> = weld.layers.iter().collect();
+    layers.sort_by(|a, b| a.y.total_cmp(&b.y));
+    layers.windows(2).all(|p| {
+        p[0].points.len() == p[1].points.len()
+            && p[0]
+                .points
+                .iter()
+                .zip(&p[1].points)
+                .all(|(a, b)| a.xz == b.xz && a.weight == b.weight)
+    })
 }

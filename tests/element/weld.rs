@@ -506,8 +506,20 @@ fn bonded_slab_on_resolved_shells_tends_to_the_bonded_neighbourhood() {
 
 #[test]
 fn bonded_slab_is_symmetric_and_free_of_rigid_work() {
-    let case = plates_with(24, [31.25, 28.75], "area", json!("auto"));
-    let mesh = Mesh::from_case(&case).unwrap();
+    // Equal sheets, and sheets meshed unequally (1.25 mm and 1 mm shells, whose own sampling
+    // rules would differ: the stack shares the finer one's).
+    let mut unequal = plates_with(48, [31.25, 28.75], "area", json!("auto"));
+    unequal.sheets[1].elements = [60, 60];
+    for case in [
+        plates_with(24, [31.25, 28.75], "area", json!("auto")),
+        unequal,
+    ] {
+        bonded_slab_checks(&case);
+    }
+}
+
+fn bonded_slab_checks(case: &Case) {
+    let mesh = Mesh::from_case(case).unwrap();
     assert_eq!(mesh.welds[0].own_shells, OwnShellNugget::BondedSlab);
     let weld = Weld::new(&mesh.welds[0], &mesh.nodes, Material::STEEL).unwrap();
     assert!(weld.reference_map(0).is_none());

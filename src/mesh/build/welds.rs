@@ -240,11 +240,14 @@ impl Sheets<'_> {
                 ));
             }
         }
-        for &s in stack {
-            let g = &grids[s];
-            nugget::check_points(weld.diameter, g.step[0].min(g.step[1]))
-                .map_err(|reason| ctx.err(format!("welds[{w}].diameter"), reason))?;
-        }
+        // One sampling rule for the whole stack (the finest sheet's), so that every layer
+        // carries the same points: the bonded slab pairs them across the sheets.
+        let h = stack
+            .iter()
+            .map(|&s| grids[s].step[0].min(grids[s].step[1]))
+            .fold(f64::INFINITY, f64::min);
+        nugget::check_points(weld.diameter, h)
+            .map_err(|reason| ctx.err(format!("welds[{w}].diameter"), reason))?;
         let clip = Rect::common(stack.iter().map(|&s| &grids[s]));
         let inside = |p: [f64; 2]| clip.contains(p);
         let layers = stack
@@ -255,7 +258,7 @@ impl Sheets<'_> {
                 let view = nugget::SheetView {
                     sheet: s,
                     y: g.y,
-                    h: g.step[0].min(g.step[1]),
+                    h,
                     interpolation: &interpolation,
                 };
                 nugget::sample(centre, weld.diameter, &inside, &view)
