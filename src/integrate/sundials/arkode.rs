@@ -42,7 +42,10 @@ use std::ffi::{c_int, c_long, c_void, CString};
 use sundials_sys::{SUNDenseMatrix, SUNLinSol_Dense};
 
 use super::callbacks::{self, Failure, Shared};
-use super::cvode::{callback_error, check_state, SharedBox};
+use super::cvode::{
+    callback_error, check_flag, check_state, check_stop_time, poisoned_failure, read_counter,
+    root_directions, SharedBox,
+};
 use super::ffi::{
     ARKStepCreate, ARKStepEvolve, ARKStepGetCurrentTime, ARKStepGetDky, ARKStepGetLastStep,
     ARKStepGetLinReturnFlagName, ARKStepGetNumErrTestFails, ARKStepGetNumGEvals,
@@ -473,14 +476,7 @@ impl<P: OdeProblem> Arkode<P> {
     /// [`Error::Integration`] for a non-finite `tstop`; [`Error::Sundials`] naming
     /// `ARKStepSetStopTime`.
     pub fn set_stop_time(&mut self, tstop: f64) -> Result<(), Error> {
-        if !tstop.is_finite() {
-            return Err(IntegrationError::TimeNotFinite {
-                function: "set_stop_time",
-                name: "tstop",
-                value: tstop,
-            }
-            .into());
-        }
+        check_stop_time(tstop)?;
         // SAFETY: memory live and owned by `self`.
         let flag = unsafe { ARKStepSetStopTime(self.mem.as_raw(), tstop) };
         self.check("ARKStepSetStopTime", flag)
@@ -491,18 +487,9 @@ impl<P: OdeProblem> Arkode<P> {
     /// # Errors
     /// As [`super::Cvode::set_root_direction`].
     pub fn set_root_direction(&mut self, directions: &[i32]) -> Result<(), Error> {
-        let nroots = self.shared.get().nroots;
-        if directions.len() != nroots || directions.iter().any(|d| d.abs() > 1) {
-            return Err(IntegrationError::RootDirections {
-                roots: nroots,
-                directions: directions.to_vec(),
-            }
-            .into());
-        }
-        if nroots == 0 {
+        let Some(mut dirs) = root_directions(self.shared.get().nroots, directions)? else {
             return Ok(());
-        }
-        let mut dirs: Vec<c_int> = directions.to_vec();
+        };
         // SAFETY: memory live; `dirs` holds `nroots` ints, copied by ARKODE.
         let flag = unsafe { ARKStepSetRootDirection(self.mem.as_raw(), dirs.as_mut_ptr()) };
         self.check("ARKStepSetRootDirection", flag)
@@ -559,27 +546,12 @@ impl<P: OdeProblem> Arkode<P> {
     }
 
     fn poisoned_failure(&self) -> Option<Failure> {
-        let shared = self.shared.get();
-        shared.poisoned.then(|| {
-            shared.failure.clone().unwrap_or(Failure {
-                callback: "unknown",
-                message: "panicked".into(),
-                time: self.t,
-                fatal: true,
-            })
-        })
+        poisoned_failure(self.shared.get(), self.t)
     }
 
     /// An ARKODE counter (0 if ARKODE refuses).
     fn raw_counter(&self, get: unsafe extern "C" fn(*mut c_void, *mut c_long) -> c_int) -> u64 {
-        let mut value: c_long = 0;
-        // SAFETY: memory live; `value` is a valid out-pointer.
-        let flag = unsafe { get(self.mem.as_raw(), &mut value) };
-        if flag == 0 {
-            u64::try_from(value).unwrap_or(0)
-        } else {
-            0
-        }
+        read_counter(self.mem.as_raw(), get)
     }
 
     fn current_stats(&self) -> OdeStats {
@@ -652,15 +624,7 @@ impl<P: OdeProblem> Arkode<P> {
         flag: c_int,
         name: fn(i32) -> String,
     ) -> Result<(), Error> {
-        let message = self.shared.get_mut().cvode_message.take();
-        if flag >= 0 {
-            return Ok(());
-        }
-        Err(Error::Sundials {
-            function,
-            flag: cvode_flag(flag, name, message),
-            time: self.t,
-        })
+        check_flag(self.shared.get_mut(), function, flag, name, self.t)
     }
 }
 

@@ -562,14 +562,7 @@ impl<P: OdeProblem> Cvode<P> {
     /// [`Error::Integration`] for a non-finite `tstop`; [`Error::Sundials`] naming
     /// `CVodeSetStopTime` (e.g. `tstop` behind the current time).
     pub fn set_stop_time(&mut self, tstop: f64) -> Result<(), Error> {
-        if !tstop.is_finite() {
-            return Err(IntegrationError::TimeNotFinite {
-                function: "set_stop_time",
-                name: "tstop",
-                value: tstop,
-            }
-            .into());
-        }
+        check_stop_time(tstop)?;
         // SAFETY: memory live and owned by `self`.
         let flag = unsafe { CVodeSetStopTime(self.mem.as_raw(), tstop) };
         self.check_cv("CVodeSetStopTime", flag)
@@ -586,18 +579,9 @@ impl<P: OdeProblem> Cvode<P> {
     /// [`Error::Integration`] if `directions` does not have `num_roots()` entries of −1, 0, +1;
     /// [`Error::Sundials`] naming `CVodeSetRootDirection`.
     pub fn set_root_direction(&mut self, directions: &[i32]) -> Result<(), Error> {
-        let nroots = self.shared.get().nroots;
-        if directions.len() != nroots || directions.iter().any(|d| d.abs() > 1) {
-            return Err(IntegrationError::RootDirections {
-                roots: nroots,
-                directions: directions.to_vec(),
-            }
-            .into());
-        }
-        if nroots == 0 {
+        let Some(mut dirs) = root_directions(self.shared.get().nroots, directions)? else {
             return Ok(());
-        }
-        let mut dirs: Vec<c_int> = directions.to_vec();
+        };
         // SAFETY: memory live; `dirs` holds `nroots` ints, read (copied) by CVODE.
         let flag = unsafe { CVodeSetRootDirection(self.mem.as_raw(), dirs.as_mut_ptr()) };
         self.check_cv("CVodeSetRootDirection", flag)
@@ -658,28 +642,13 @@ impl<P: OdeProblem> Cvode<P> {
 
     /// The failure that poisoned the integrator, if a callback panicked.
     fn poisoned_failure(&self) -> Option<Failure> {
-        let shared = self.shared.get();
-        shared.poisoned.then(|| {
-            shared.failure.clone().unwrap_or(Failure {
-                callback: "unknown",
-                message: "panicked".into(),
-                time: self.t,
-                fatal: true,
-            })
-        })
+        poisoned_failure(self.shared.get(), self.t)
     }
 
     /// A CVODE counter (0 if CVODE refuses, which it does only without the module the counter
     /// belongs to — never for the counters read here).
     fn raw_counter(&self, get: unsafe extern "C" fn(*mut c_void, *mut c_long) -> c_int) -> u64 {
-        let mut value: c_long = 0;
-        // SAFETY: memory live; `value` is a valid out-pointer.
-        let flag = unsafe { get(self.mem.as_raw(), &mut value) };
-        if flag == 0 {
-            u64::try_from(value).unwrap_or(0)
-        } else {
-            0
-        }
+        read_counter(self.mem.as_raw(), get)
     }
 
     /// `base` plus CVODE's current counters.
@@ -763,15 +732,7 @@ impl<P: OdeProblem> Cvode<P> {
         flag: c_int,
         name: fn(i32) -> String,
     ) -> Result<(), Error> {
-        let message = self.shared.get_mut().cvode_message.take();
-        if flag >= 0 {
-            return Ok(());
-        }
-        Err(Error::Sundials {
-            function,
-            flag: cvode_flag(flag, name, message),
-            time: self.t,
-        })
+        check_flag(self.shared.get_mut(), function, flag, name, self.t)
     }
 }
 
@@ -783,6 +744,83 @@ pub(super) fn callback_error(f: Failure, outcome: CallbackOutcome) -> Error {
         time: f.time,
         outcome,
     }
+}
+
+/// The failure of a poisoned integrator (a callback panicked): the recorded one, or an unknown
+/// panic at `t`.
+pub(super) fn poisoned_failure<P>(shared: &Shared<P>, t: f64) -> Option<Failure> {
+    shared.poisoned.then(|| {
+        shared.failure.clone().unwrap_or(Failure {
+            callback: "unknown",
+            message: "panicked".into(),
+            time: t,
+            fatal: true,
+        })
+    })
+}
+
+/// A SUNDIALS counter read by `get` from the integrator memory `mem` (0 if it refuses).
+pub(super) fn read_counter(
+    mem: *mut c_void,
+    get: unsafe extern "C" fn(*mut c_void, *mut c_long) -> c_int,
+) -> u64 {
+    let mut value: c_long = 0;
+    // SAFETY: the callers pass their live integrator memory; `value` is a valid out-pointer.
+    let flag = unsafe { get(mem, &mut value) };
+    if flag == 0 {
+        u64::try_from(value).unwrap_or(0)
+    } else {
+        0
+    }
+}
+
+/// Checks a SUNDIALS return code of `function` at time `t`: the error names the flag (`name`)
+/// with the message the error handler left in `shared` (taken in any case).
+pub(super) fn check_flag<P>(
+    shared: &mut Shared<P>,
+    function: &'static str,
+    flag: c_int,
+    name: fn(i32) -> String,
+    t: f64,
+) -> Result<(), Error> {
+    let message = shared.cvode_message.take();
+    if flag >= 0 {
+        return Ok(());
+    }
+    Err(Error::Sundials {
+        function,
+        flag: cvode_flag(flag, name, message),
+        time: t,
+    })
+}
+
+/// Checks a stop time before it goes to SUNDIALS: finite.
+pub(super) fn check_stop_time(tstop: f64) -> Result<(), Error> {
+    if tstop.is_finite() {
+        return Ok(());
+    }
+    Err(IntegrationError::TimeNotFinite {
+        function: "set_stop_time",
+        name: "tstop",
+        value: tstop,
+    }
+    .into())
+}
+
+/// The event directions for SUNDIALS' `SetRootDirection`: one of −1, 0, +1 per event function
+/// (`nroots`); `None` without event functions (nothing to set).
+pub(super) fn root_directions(
+    nroots: usize,
+    directions: &[i32],
+) -> Result<Option<Vec<c_int>>, Error> {
+    if directions.len() != nroots || directions.iter().any(|d| d.abs() > 1) {
+        return Err(IntegrationError::RootDirections {
+            roots: nroots,
+            directions: directions.to_vec(),
+        }
+        .into());
+    }
+    Ok((nroots > 0).then(|| directions.to_vec()))
 }
 
 /// Checks a state: finite `t`, `y` of length `n` with finite entries.
