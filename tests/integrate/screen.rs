@@ -1,15 +1,19 @@
-//! Pair screening of reduced models (`ProblemOptions::screen`): the screened run evaluates a
-//! tracked subset of the pairs and proves the others open, so its curves must be those of the
-//! run that evaluates every pair, to the integration tolerance — on a mesh fine enough that
-//! most pairs are far from contact at any time.
+//! Pair screening of reduced models (`ProblemOptions::screen`) and the slip memory as elastic
+//! stretch (`ProblemOptions::stretch`): the screened run evaluates a tracked subset of the pairs
+//! and proves the others open, and the stretch states are a change of variables of the same
+//! law, so their curves must be those of the run that evaluates every pair with the slip
+//! states, to the integration tolerance — on a mesh fine enough that most pairs are far from
+//! contact at any time.
 
-use jointrom::integrate::{run, Run, TransientOptions};
+use jointrom::integrate::{run, ProblemOptions, Run, TransientOptions};
 use jointrom::reduction::{build_basis, BasisKind, BasisOptions};
 use jointrom::system::{ReducedSystem, Scene, SecondOrderSystem};
 
 use crate::common::{self, rel_l2};
 
-fn runs(case: &str, end: f64) -> (Run, Run, usize) {
+/// The TVD model of `case` over `[0, end]` run with `change` applied to the default problem
+/// options, and with the defaults; and its number of pairs.
+fn runs(case: &str, end: f64, change: impl Fn(&mut ProblemOptions)) -> (Run, Run, usize) {
     let path = common::repo_path(case);
     let model = common::model(path.to_str().expect("path"));
     let basis = build_basis(&model, BasisKind::Tvd, &BasisOptions::default()).expect("basis");
@@ -18,18 +22,43 @@ fn runs(case: &str, end: f64) -> (Run, Run, usize) {
     let scene = Scene::of(&model);
     let off = common::until(end);
     assert!(!off.problem.screen, "screening is off by default");
+    assert!(
+        !off.problem.stretch,
+        "the stretch states are off by default"
+    );
     let mut on: TransientOptions = off.clone();
-    on.problem.screen = true;
-    let a = run(rom.clone(), &scene, &on).expect("screened run");
-    let b = run(rom, &scene, &off).expect("run over every pair");
+    change(&mut on.problem);
+    let a = run(rom.clone(), &scene, &on).expect("changed run");
+    let b = run(rom, &scene, &off).expect("default run");
     (a, b, pairs)
+}
+
+/// Relative L2 differences of ‖f_c‖, ‖f_R‖, u_y and D between two runs with the same outputs.
+fn differences(a: &Run, b: &Run) -> [(&'static str, f64); 4] {
+    assert_eq!(a.curves.t.len(), b.curves.t.len(), "output count");
+    let n = a.curves.t.len();
+    let (x, y) = (&a.curves, &b.curves);
+    [
+        (
+            "|f_c|",
+            rel_l2(&x.contact_force_norm, &y.contact_force_norm, n),
+        ),
+        (
+            "|f_R|",
+            rel_l2(&x.friction_force_norm, &y.friction_force_norm, n),
+        ),
+        ("u_y", rel_l2(&x.master_uy, &y.master_uy, n)),
+        ("D", rel_l2(&x.dissipated, &y.dissipated, n)),
+    ]
 }
 
 #[test]
 fn screened_reduced_run_keeps_the_curves_and_evaluates_fewer_pairs() {
     // The friction bar refined 2× (173 pairs) over its first 20 ms: contact builds up under
     // the ramped load while most of the interface stays open.
-    let (on, off, pairs) = runs("cases/scale/friction_bar_x2.json", 0.02);
+    let (on, off, pairs) = runs("cases/scale/friction_bar_x2.json", 0.02, |p| {
+        p.screen = true
+    });
     assert_eq!(on.curves.t.len(), off.curves.t.len(), "output count");
     let n = on.curves.t.len();
     let fc = rel_l2(
@@ -68,5 +97,34 @@ fn screened_reduced_run_keeps_the_curves_and_evaluates_fewer_pairs() {
     );
     for (what, e) in [("|f_c|", fc), ("|f_R|", fr), ("u_y", uy), ("D", d)] {
         assert!(e < 2e-3, "{what}(t) moved by {e:.2e} with screening");
+    }
+}
+
+#[test]
+fn stretch_states_keep_the_curves() {
+    // The same law in other variables: the built-in friction bar over its first 50 ms (the
+    // load ramp: closing, sticking and the onset of sliding) with every pair, and the ×2 bar
+    // over 20 ms with screening.
+    for (case, end, screen) in [
+        ("cases/friction_bar.json", 0.05, false),
+        ("cases/scale/friction_bar_x2.json", 0.02, true),
+    ] {
+        let (on, off, _) = runs(case, end, |p| {
+            p.stretch = true;
+            p.screen = screen;
+        });
+        let diff = differences(&on, &off);
+        println!(
+            "{case}: stretch{} vs slip states: {diff:?}; steps {} vs {}",
+            if screen { " + screening" } else { "" },
+            on.stats.steps,
+            off.stats.steps
+        );
+        for (what, e) in diff {
+            assert!(
+                e < 2e-3,
+                "{case}: {what}(t) moved by {e:.2e} with the stretch states"
+            );
+        }
     }
 }

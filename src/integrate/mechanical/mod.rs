@@ -4,7 +4,7 @@
 //! ## State
 //!
 //! ```text
-//! y = [q (n), v (n), s (2w, friction on only), W, D]
+//! y = [q (n), v (n), s (2w, friction on only; or e = u_t − s, *The slip memory as elastic stretch*), W, D]
 //! q' = v
 //! M v' = f(t) − K q − Bᵀ p(B q, s)                 (paper eq. 6 / eq. 7)
 //! s' = ṡ(B q, s)                                   (viscoplastic slip memory, crate::joint::law)
@@ -121,6 +121,44 @@
 //! The full model does not screen (its sparse `B q` costs a few entries per pair); screening
 //! is off with events on (the root functions need every pair). Curves with and without
 //! screening agree to the integration tolerance (`tests/integrate/screen.rs`).
+//!
+//! ## The slip memory as elastic stretch
+//!
+//! With [`ProblemOptions::stretch`] (opt-in, reduced models, events off) the memory states hold
+//! the elastic stretch `e = u_t − s` (mm, in units of `slip_scale`) instead of the slip `s`.
+//! It is a change of variables, not of the law ([`crate::joint::law`] sees `s = u_t − e`):
+//!
+//! ```text
+//! ė = B_t v − ṡ(g, e)          (open pairs: ṡ = e/τ, so e relaxes to τ u̇_t)
+//! ```
+//!
+//! The Newton solve eliminates the same way. With `c` the correction of `e`, `∂p_t/∂e = T`,
+//! `∂ė/∂v = B_t` and `γ b = a − r_q`:
+//!
+//! ```text
+//! (I + γ D_s) c = r_e + B_t a − B_t r_q − γ φ_g B_n a
+//! (M + γ² (K + Bᵀ K_c B)) a = M r_q + γ M r_v − γ² B_tᵀ T (I + γ D_s)⁻¹ (r_e − B_t r_q)
+//! z_D = r_D + γ (∂d/∂e · c + ∂d/∂g B_n a)
+//! ```
+//!
+//! with the same `K_c` as above (the `φ_g` term drops out again), so the factorization is
+//! shared; a solve needs one more joint product, `B_t r_q`, and a right-hand side `B_t v`.
+//!
+//! **Why it exists.** An open pair's `s` follows its tangential displacement `u_t` — the
+//! structure's motion — and the error test holds it to the slip memory's tolerance
+//! (1e-9 mm at atol 1e-6); its `e` stays near `τ u̇_t` and varies little. With screening, a
+//! pair that leaves the tracked set keeps the rate of its state, and one that joins gets the
+//! offset that makes the law's rate equal to it, as with `s`: `e = τ (u̇_t − ė_frozen)`. The
+//! frozen rate of `e` is `τ ü_t`, small, where that of `s` was `u̇_t`: set changes disturb
+//! the integrated state far less, and the screened run takes fewer steps than with `s`.
+//!
+//! **Why it is not the default.** The same fact cuts the other way: the `s` states of the open
+//! pairs are a tight, implicit control on the tangential motion of the whole interface, and
+//! without it the error test at the same rtol is looser — the steps saved are bought with
+//! accuracy (docs/performance/speed.md, *Pair screening*), and the tolerance model's
+//! integration check then tightens rtol and takes more steps than with `s`.
+//! Curves with and without it agree to the integration tolerance
+//! (`tests/integrate/screen.rs`).
 //!
 //! ## What sets the step size
 //!
@@ -253,6 +291,12 @@ pub struct ProblemOptions {
     /// on the refined friction bars the set changes cost more steps than the pairs it skips
     /// save (docs/performance/speed.md, *Pair screening*).
     pub screen: bool,
+    /// The slip memory as elastic stretch (module docs, *The slip memory as elastic
+    /// stretch*): the memory states of a system that offers screening (the reduced model) hold
+    /// `e = u_t − s` (mm, in units of `slip_scale`) instead of `s`; the same law. Ignored with
+    /// friction off, with events on and by the full model. Off by default: at equal
+    /// tolerances it is less accurate than the slip form.
+    pub stretch: bool,
 }
 
 impl Default for ProblemOptions {
@@ -266,6 +310,7 @@ impl Default for ProblemOptions {
             velocity_scale: DEFAULT_VELOCITY_SCALE,
             refresh: Some(DEFAULT_REFRESH_MARGIN),
             screen: false,
+            stretch: false,
         }
     }
 }
@@ -327,8 +372,17 @@ pub struct MechanicalOde<S: SecondOrderSystem> {
     rhs_q: Vec<f64>,
     rhs_s: Vec<f64>,
     rhs_u: Vec<f64>,
-    /// Slip memory in mm (the states times `s_scale`).
+    /// Slip memory in mm (the states times `s_scale` plus `offset`; with `stretch`,
+    /// `u_t − e` on the live pairs).
     s_phys: Vec<f64>,
+    /// The memory states as elastic stretch `e = u_t − s` (module docs, *The slip memory as
+    /// elastic stretch*); off: the states are the slip `s`.
+    stretch: bool,
+    /// With `stretch`: the elastic stretch in mm (the states times `s_scale` plus `offset`).
+    e_phys: Vec<f64>,
+    /// Joint kinematics of a second vector (`B v` in a right-hand side, `B r_q` in a Newton
+    /// solve) on the live pairs (3w, scratch of `stretch`).
+    ub: Vec<f64>,
     s_scale: f64,
     e_scale: f64,
     v_scale: f64,
@@ -339,8 +393,8 @@ pub struct MechanicalOde<S: SecondOrderSystem> {
     live: Vec<usize>,
     /// Pair screening, if on.
     screen: Option<screen::PairScreen>,
-    /// Slip-memory offsets (2w with friction, mm): the memory is `slip_scale · state + offset`,
-    /// zero unless a pair joined the screened set ([`screen`]).
+    /// Slip-memory offsets (2w with friction, mm): the memory (`s`, or `e` with `stretch`) is
+    /// `slip_scale · state + offset`, zero unless a pair joined the screened set ([`screen`]).
     offset: Vec<f64>,
 }
 
@@ -391,6 +445,8 @@ impl<S: SecondOrderSystem> MechanicalOde<S> {
         };
         let n = sys.dim();
         let w = sys.pairs();
+        let screening = sys.joint_normal_row_norms().is_some() && !opts.events;
+        let stretch = opts.stretch && opts.friction && screening;
         let screen = if opts.screen && !opts.events {
             sys.joint_normal_row_norms()
                 .map(|norms| screen::PairScreen::new(norms, n))
@@ -423,6 +479,9 @@ impl<S: SecondOrderSystem> MechanicalOde<S> {
             rhs_s: vec![f64::NAN; if opts.friction { 2 * w } else { 0 }],
             rhs_u: vec![0.0; 3 * w],
             s_phys: vec![0.0; if opts.friction { 2 * w } else { 0 }],
+            stretch,
+            e_phys: vec![0.0; if stretch { 2 * w } else { 0 }],
+            ub: vec![0.0; if stretch { 3 * w } else { 0 }],
             s_scale: opts.slip_scale,
             e_scale: opts.energy_scale,
             v_scale: opts.velocity_scale,
@@ -528,11 +587,25 @@ impl<S: SecondOrderSystem> MechanicalOde<S> {
         self.e_scale
     }
 
-    /// Copies the slip memory of `y` into `s_phys` (mm).
+    /// Copies the slip memory of `y` into `s_phys` (mm). With `stretch` the states are the
+    /// elastic stretch: it goes to `e_phys`, and the live pairs' slip `s = u_t − e` to `s_phys`
+    /// from the kinematics in `u` (the caller's `B q` at the same `y`).
     fn load_slip(&mut self, y: &[f64]) {
         let i0 = 2 * self.n;
-        for ((o, &x), &d) in self.s_phys.iter_mut().zip(&y[i0..]).zip(&self.offset) {
+        let out = if self.stretch {
+            &mut self.e_phys
+        } else {
+            &mut self.s_phys
+        };
+        for ((o, &x), &d) in out.iter_mut().zip(&y[i0..]).zip(&self.offset) {
             *o = self.s_scale * x + d;
+        }
+        if self.stretch {
+            for &k in &self.live {
+                for i in 0..2 {
+                    self.s_phys[2 * k + i] = self.u[3 * k + 1 + i] - self.e_phys[2 * k + i];
+                }
+            }
         }
     }
 
@@ -608,6 +681,14 @@ impl<S: SecondOrderSystem> MechanicalOde<S> {
             y.extend_from_slice(x);
         }
         let s0 = 2 * self.n;
+        if self.stretch {
+            // The states hold e = u_t − s.
+            for k in 0..self.w {
+                let u = self.sys.joint_pair(&start.q, k);
+                y[s0 + 2 * k] = u[1] - y[s0 + 2 * k];
+                y[s0 + 2 * k + 1] = u[2] - y[s0 + 2 * k + 1];
+            }
+        }
         y[s0..].iter_mut().for_each(|s| *s /= self.s_scale);
         y.extend_from_slice(&[0.0, 0.0]);
         Ok(y)
@@ -616,11 +697,11 @@ impl<S: SecondOrderSystem> MechanicalOde<S> {
     /// Outputs at `(t, y)`: force norms, master displacement, energies.
     pub fn sample(&mut self, t: f64, y: &[f64]) -> EnergySample {
         let n = self.n;
-        self.load_slip(y);
         let (q, rest) = y.split_at(n);
         let (v, rest) = rest.split_at(n);
         let rest = &rest[self.ns()..];
         self.sys.joint_apply_into(q, &mut self.u);
+        self.load_slip(y);
         if self.screen.is_some() && self.law.friction {
             // An untracked pair is open, its memory its tangential displacement.
             let mut live = self.live.iter().peekable();
@@ -733,10 +814,10 @@ impl<S: SecondOrderSystem> OdeProblem for MechanicalOde<S> {
         let n = self.n;
         let ns = self.ns();
         self.check_untracked(t, y);
-        self.load_slip(y);
         let (q, rest) = y.split_at(n);
         let v = &rest[..n];
         self.apply_live(q);
+        self.load_slip(y);
         self.rhs_q.copy_from_slice(q);
         self.rhs_s.copy_from_slice(&y[2 * n..2 * n + ns]);
         self.rhs_u.copy_from_slice(&self.u);
@@ -771,7 +852,23 @@ impl<S: SecondOrderSystem> OdeProblem for MechanicalOde<S> {
         }
         self.sys.solve_m_in_place(dv);
         let inv_s = 1.0 / self.s_scale;
-        if let Some(sc) = &self.screen {
+        if self.stretch {
+            // ė = u̇_t − ṡ on the live pairs; the others keep the rate they left the set with.
+            if self.screen.is_some() {
+                self.sys.joint_apply_pairs_into(v, &self.live, &mut self.ub);
+            } else {
+                self.sys.joint_apply_into(v, &mut self.ub);
+            }
+            match &self.screen {
+                Some(sc) => sc.frozen_rates_into(&mut drest[..ns]),
+                None => drest[..ns].fill(0.0),
+            }
+            for &k in &self.live {
+                for i in 0..2 {
+                    drest[2 * k + i] = inv_s * (self.ub[3 * k + 1 + i] - self.srate[2 * k + i]);
+                }
+            }
+        } else if let Some(sc) = &self.screen {
             // Untracked pairs' memory keeps the rate it left the set with.
             sc.frozen_rates_into(&mut drest[..ns]);
             for &k in &self.live {

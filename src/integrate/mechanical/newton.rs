@@ -147,13 +147,30 @@ impl<S: SecondOrderSystem> MechanicalOde<S> {
         }
         self.sys.mul_m_into(&self.tmp2, &mut self.tmp);
         if fr {
+            // With the stretch states `(I + γD_s) c = r_e + B_t a − B_t r_q − γ φ_g B_n a`
+            // (module docs, *The slip memory as elastic stretch*): the known part is
+            // `r_e − B_t r_q`, and it enters with the opposite sign (∂p_t/∂e = +T).
+            let sign = if self.stretch {
+                self.live_apply_ub(rq);
+                -1.0
+            } else {
+                1.0
+            };
             for &k in &self.live {
                 let l = &self.lin[k];
-                let x = mul2(&l.inv, [ss * rs[2 * k], ss * rs[2 * k + 1]]);
+                let known = if self.stretch {
+                    [
+                        ss * rs[2 * k] - self.ub[3 * k + 1],
+                        ss * rs[2 * k + 1] - self.ub[3 * k + 2],
+                    ]
+                } else {
+                    [ss * rs[2 * k], ss * rs[2 * k + 1]]
+                };
+                let x = mul2(&l.inv, known);
                 let h = mul2(&l.pt_u, x);
                 self.p[3 * k] = 0.0;
-                self.p[3 * k + 1] = g * g * h[0];
-                self.p[3 * k + 2] = g * g * h[1];
+                self.p[3 * k + 1] = sign * g * g * h[0];
+                self.p[3 * k + 2] = sign * g * g * h[1];
             }
             let mut tmp = std::mem::take(&mut self.tmp);
             self.transpose_add_live(&mut tmp);
@@ -172,21 +189,10 @@ impl<S: SecondOrderSystem> MechanicalOde<S> {
             // Untracked pairs: frozen memory, zero Jacobian rows (`c = r_s`).
             zs.copy_from_slice(rs);
             self.apply_live(za);
-            for &k in &self.live {
-                let l = &self.lin[k];
-                let ba = [self.u[3 * k], self.u[3 * k + 1], self.u[3 * k + 2]];
-                let du = mul2(&l.sdot_u, [ba[1], ba[2]]);
-                let rhs = [
-                    ss * rs[2 * k] + g * (du[0] + l.sdot_g[0] * ba[0]),
-                    ss * rs[2 * k + 1] + g * (du[1] + l.sdot_g[1] * ba[0]),
-                ];
-                let c = mul2(&l.inv, rhs);
-                zs[2 * k] = c[0] / ss;
-                zs[2 * k + 1] = c[1] / ss;
-                zd += g
-                    * (l.diss_u[0] * (ba[1] - c[0])
-                        + l.diss_u[1] * (ba[2] - c[1])
-                        + l.diss_g * ba[0]);
+            if self.stretch {
+                self.stretch_corrections(rs, zs, g, &mut zd);
+            } else {
+                self.slip_corrections(rs, zs, g, &mut zd);
             }
         }
         self.total_load_into_f(t);
@@ -194,6 +200,58 @@ impl<S: SecondOrderSystem> MechanicalOde<S> {
         ze[1] = zd / self.e_scale;
         // Checked by the CVODE trampoline, as the right-hand side.
         Ok(())
+    }
+
+    /// The slip states' corrections of a Newton solve, given `u = B a` on the live pairs:
+    /// `c = (I + γD_s)⁻¹ (r_s + γ D_s B_t a + γ φ_g B_n a)` (mm, written to `zs` in state
+    /// units) and the dissipation's `γ ∇D'·[a; c]` added to `zd` (N·mm).
+    fn slip_corrections(&self, rs: &[f64], zs: &mut [f64], g: f64, zd: &mut f64) {
+        let ss = self.s_scale;
+        for &k in &self.live {
+            let l = &self.lin[k];
+            let ba = [self.u[3 * k], self.u[3 * k + 1], self.u[3 * k + 2]];
+            let du = mul2(&l.sdot_u, [ba[1], ba[2]]);
+            let rhs = [
+                ss * rs[2 * k] + g * (du[0] + l.sdot_g[0] * ba[0]),
+                ss * rs[2 * k + 1] + g * (du[1] + l.sdot_g[1] * ba[0]),
+            ];
+            let c = mul2(&l.inv, rhs);
+            zs[2 * k] = c[0] / ss;
+            zs[2 * k + 1] = c[1] / ss;
+            *zd += g
+                * (l.diss_u[0] * (ba[1] - c[0]) + l.diss_u[1] * (ba[2] - c[1]) + l.diss_g * ba[0]);
+        }
+    }
+}
+
+impl<S: SecondOrderSystem> MechanicalOde<S> {
+    /// `ub = B x` on the live pairs.
+    fn live_apply_ub(&mut self, x: &[f64]) {
+        if self.screen.is_some() {
+            self.sys.joint_apply_pairs_into(x, &self.live, &mut self.ub);
+        } else {
+            self.sys.joint_apply_into(x, &mut self.ub);
+        }
+    }
+
+    /// The stretch states' corrections of a Newton solve, given `u = B a` and
+    /// `ub = B r_q` on the live pairs: `c = (I + γD_s)⁻¹ (r_e + B_t a − B_t r_q − γ φ_g B_n a)`
+    /// (mm, written to `zs` in state units) and the dissipation's `γ (∂d/∂e · c + ∂d/∂g B_n a)`
+    /// added to `zd` (N·mm).
+    fn stretch_corrections(&self, rs: &[f64], zs: &mut [f64], g: f64, zd: &mut f64) {
+        let ss = self.s_scale;
+        for &k in &self.live {
+            let l = &self.lin[k];
+            let ba = [self.u[3 * k], self.u[3 * k + 1], self.u[3 * k + 2]];
+            let rhs = [
+                ss * rs[2 * k] + ba[1] - self.ub[3 * k + 1] - g * l.sdot_g[0] * ba[0],
+                ss * rs[2 * k + 1] + ba[2] - self.ub[3 * k + 2] - g * l.sdot_g[1] * ba[0],
+            ];
+            let c = mul2(&l.inv, rhs);
+            zs[2 * k] = c[0] / ss;
+            zs[2 * k + 1] = c[1] / ss;
+            *zd += g * (l.diss_u[0] * c[0] + l.diss_u[1] * c[1] + l.diss_g * ba[0]);
+        }
     }
 }
 

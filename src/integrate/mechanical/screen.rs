@@ -257,7 +257,15 @@ impl<S: SecondOrderSystem> MechanicalOde<S> {
             self.lin[z] = super::PairLin::default();
             self.branch[z] = PairState::Open;
             self.p[3 * z..3 * z + 3].fill(0.0);
-            if self.law.friction && sc.is_tracked[z] {
+            if self.stretch && sc.is_tracked[z] {
+                // e = τ (u̇_t − ė_frozen): the open pair's law `ė = u̇_t − e/τ` then gives the
+                // frozen rate.
+                let ud = self.sys.joint_pair(&y[n..2 * n], z);
+                for (i, vt) in [(2 * z, ud[1]), (2 * z + 1, ud[2])] {
+                    let rate = self.s_scale * sc.frozen_rate[i];
+                    self.offset[i] = self.law.tau * (vt - rate) - self.s_scale * y[2 * n + i];
+                }
+            } else if self.law.friction && sc.is_tracked[z] {
                 // s = u_t − τ ṡ_frozen: the open pair's law `ṡ = (u_t − s)/τ` then gives the
                 // frozen rate.
                 let u = self.sys.joint_pair(&y[..n], z);

@@ -80,11 +80,15 @@ pub struct TransientArgs {
     /// more than this re-linearizes and refactors the Newton matrix), or `off`. Default 1e-8.
     #[arg(long)]
     refresh: Option<String>,
-    /// Pair screening of reduced models (experimental): evaluate only the joint pairs that may
-    /// be in contact within a step, the others proved open by a bound (on), or every pair at
-    /// every right-hand side (off, the default). The full model evaluates every pair.
-    #[arg(long, value_enum, default_value_t = OnOff::Off)]
-    screen: OnOff,
+    /// Pair screening of reduced models: evaluate only the joint pairs that may be in contact
+    /// within a step, the others proved open by a bound (on), or every pair at every
+    /// right-hand side (off). The full model evaluates every pair. Default off
+    #[arg(long, value_enum)]
+    screen: Option<OnOff>,
+    /// Slip memory of reduced models as elastic stretch `e = u_t − s` (on) or as the slip `s`
+    /// (off); the same law and curves. The full model keeps `s`. Default off
+    #[arg(long, value_enum)]
+    stretch: Option<OnOff>,
     /// `--model full`: capacity of the exact low-rank update of the Newton factor at active-set
     /// refreshes, columns (one per changed pair row; a refresh that would exceed it refactors);
     /// 0 refactors at every refresh. Default 96.
@@ -280,7 +284,12 @@ fn transient_options(a: &TransientArgs) -> Result<TransientOptions, Error> {
     }
     o.ode.method = method(a)?;
     o.profile = a.profile;
-    o.problem.screen = a.screen == OnOff::On;
+    if let Some(s) = a.screen {
+        o.problem.screen = s.is_on();
+    }
+    if let Some(s) = a.stretch {
+        o.problem.stretch = s.is_on();
+    }
     if let Some(r) = &a.refresh {
         o.problem.refresh = if r == "off" {
             None
