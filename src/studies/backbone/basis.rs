@@ -34,7 +34,7 @@
 //! 5. **Dynamic attachment modes** `K⁻¹ M K⁻¹ b_zᵀ` of the same rows. A ring-down at ω sees the
 //!    dynamic compliance `(K − ω²M)⁻¹ b_zᵀ = K⁻¹ b_zᵀ + ω² K⁻¹ M K⁻¹ b_zᵀ + O(ω⁴)`, not the static
 //!    one: the pair forces of a slipping joint accelerate the structure around the pair, and
-//!    with the static columns alone the reduced model dissipated up to 7 % more per cycle than
+//!    with the static columns alone the reduced model dissipated up to 9 % more per cycle than
 //!    the full one (docs/validation/backbone.md). These columns are the first dynamic term;
 //!    most of them lie in the span already (to the drop tolerance), so they add few columns (34 on the friction bar, 90 on the
 //!    multilayer sheet). Further Krylov blocks `(K⁻¹M)ʲ K⁻¹ b_zᵀ` add none.
