@@ -29,7 +29,7 @@
 //!   transient's energy unit scaled like the displacements (a tolerance ∝ A²) W was held to
 //!   1e-10 of itself, and it alone set the step of a ring-down where the joint sticks (a
 //!   linear oscillation: 1 100 steps per period). A ring-down's energy unit is therefore
-//!   `|f·ψ_master| + ½ m_k ω_k² A` per mm of amplitude ([`ring_down_energy_unit`]): both
+//!   `|f·ψ_master| + ½ m_k ω_k² A` per mm of amplitude (`ring_down_energy_unit`): both
 //!   energies resolved to `atol` relative to the work and energy of the vibration itself.
 //! - **The velocities.** A transient's velocities are held to `atol · 1e3 1/s`, so every mode
 //!   above 160 Hz is resolved in velocity, i.e. in displacement to `atol · 1e3/ω`. A slipping
