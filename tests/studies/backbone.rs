@@ -154,6 +154,9 @@ fn setup(press: f64, shape: [f64; 2], f_lin: f64) -> (Equilibrium, LinearMode) {
 fn options(amplitudes: &[f64], friction: bool) -> BackboneOptions {
     let mut transient = TransientOptions::default();
     transient.problem.friction = friction;
+    // The extraction is checked against closed forms to 1e-4 in frequency: at a tolerance where
+    // BDF2's phase error (1.4e-4 on this oscillator at the default atol 1e-6) is below that.
+    transient.ode.atol = 1e-7;
     BackboneOptions {
         modes: vec![1],
         amplitudes: amplitudes.to_vec(),
@@ -447,7 +450,7 @@ fn a_ring_down_whose_energy_balance_misses_is_named_with_its_amplitude() {
         w.contains("--amplitudes 1") && w.contains("energy balance"),
         "{w}"
     );
-    // The same run at the default tolerances balances and warns of nothing.
+    // The same run at the tests' tolerance (`options`) balances and warns of nothing.
     let ok = decay(PRESS, [1.0, 0.0], f_lin, 1.0, false);
     assert!(ok.warnings(1, 3).is_empty(), "{:?}", ok.warnings(1, 3));
 }
