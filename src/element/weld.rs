@@ -79,8 +79,7 @@
 use std::sync::{Arc, Mutex};
 
 use faer::linalg::solvers::Solve;
-use faer::{Mat, Par, Side};
-use rayon::prelude::*;
+use faer::{Mat, Side};
 
 use super::{Beam2, Material};
 use crate::error::{ElementError, Error, WeldLayerProblem};
@@ -169,9 +168,8 @@ impl Weld {
     /// geometry relative to the weld centre, to 1e-9 mm, and the same material) reuses that
     /// weld's condensed matrices — within the scene (the friction bar's two welds are one
     /// condensation), across scenes built by this process (a cache bounded at 512 MB) and across
-    /// commands (the disk cache of `element::weld_cache`). The distinct neighbourhoods left to
-    /// condense are condensed in parallel (rayon), one alone with faer's threads; the result
-    /// does not depend on the thread count.
+    /// commands (the disk cache of `element::weld_cache`). The neighbourhoods left to condense
+    /// are condensed one at a time (with faer's global parallelism).
     pub fn build_all(
         welds: &[WeldElem],
         nodes: &[[f64; 3]],
@@ -210,24 +208,16 @@ impl Weld {
                 None => todo.push(i),
             }
         }
-        // Several neighbourhoods are condensed side by side, one alone with faer's threads.
-        let par = if todo.len() > 1 {
-            Par::Seq
-        } else {
-            Par::rayon(0)
-        };
-        let condensed: Vec<Result<CondensedMatrices, Error>> = todo
-            .par_iter()
-            .map(|&i| {
-                let w = &welds[i];
-                let patch = w
-                    .patch
-                    .as_ref()
-                    .expect("a weld with a key has a neighbourhood");
-                super::weld_patch::condense(w, patch, material, par)
-                    .map(|c| Arc::new((c.stiffness, c.mass)))
-            })
-            .collect();
+        // One at a time: the peak memory is one neighbourhood's.
+        let condensed = todo.iter().map(|&i| {
+            let w = &welds[i];
+            let patch = w
+                .patch
+                .as_ref()
+                .expect("a weld with a key has a neighbourhood");
+            super::weld_patch::condense(w, patch, material, faer::get_global_parallelism())
+                .map(|c| Arc::new((c.stiffness, c.mass)))
+        });
         for (&i, c) in todo.iter().zip(condensed) {
             let c = c?;
             let key = key_of(i).expect("a condensed weld has a key");

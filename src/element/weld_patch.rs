@@ -606,17 +606,26 @@ fn guyan_inner(
     for j0 in (0..nr).step_by(BLOCK) {
         let w = BLOCK.min(nr - j0);
         let mut zj = z.as_mut().subcols_mut(0, w);
-        zj.fill(0.0);
         for j in 0..w {
-            let (xj, mut out) = (x.col(j0 + j), zj.rb_mut().col_mut(j));
-            for col in 0..ni {
-                let xv = xj[col];
-                if xv == 0.0 {
-                    continue;
-                }
-                for p in mii.col_ptr[col]..mii.col_ptr[col + 1] {
-                    out[mii.row_idx[p]] += mii.values[p] * xv;
-                }
+            let xj = x
+                .col(j0 + j)
+                .try_as_col_major()
+                .expect("a matrix's columns are contiguous")
+                .as_slice();
+            let mut zc = zj.rb_mut().col_mut(j);
+            let out = zc
+                .rb_mut()
+                .try_as_col_major_mut()
+                .expect("a matrix's columns are contiguous")
+                .as_slice_mut();
+            // Row i of the symmetric M̂_ii is its column i: a gather, one store per row.
+            for (i, o) in out.iter_mut().enumerate() {
+                let (a, b) = (mii.col_ptr[i], mii.col_ptr[i + 1]);
+                *o = mii.row_idx[a..b]
+                    .iter()
+                    .zip(&mii.values[a..b])
+                    .map(|(&r, &v)| v * xj[r])
+                    .sum::<f64>();
             }
             for (s, &row) in slot_dofs.iter().enumerate() {
                 out[row] += mri[(j0 + j, s)];

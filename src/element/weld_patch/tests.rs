@@ -66,7 +66,7 @@ fn relative(a: &Mat<f64>, b: &Mat<f64>) -> f64 {
 
 #[test]
 fn condensation_equals_the_dense_formula() {
-    let mesh = mesh(1.25);
+    let mesh = mesh(2.0);
     let weld = &mesh.welds[0];
     let patch = weld.patch.as_ref().expect("a re-meshed neighbourhood");
     let material = Material::STEEL;
