@@ -109,7 +109,8 @@ impl Weld {
     /// is invalid, or a shell under the slab is degenerate.
     pub fn new(weld: &WeldElem, coords: &[[f64; 3]], material: Material) -> Result<Weld, Error> {
         if let Some(patch) = &weld.patch {
-            let c = super::weld_patch::condense(weld, patch, material)?;
+            let c =
+                super::weld_patch::condense(weld, patch, material, faer::get_global_parallelism())?;
             return Ok(Weld {
                 nodes: c.nodes,
                 maps: Vec::new(),
@@ -167,45 +168,79 @@ impl Weld {
     /// geometry relative to the weld centre, to 1e-9 mm, and the same material) reuses that
     /// weld's condensed matrices — within the scene (the friction bar's two welds are one
     /// condensation), across scenes built by this process (a cache bounded at 512 MB) and across
-    /// commands (the disk cache of `element::weld_cache`).
+    /// commands (the disk cache of `element::weld_cache`). The neighbourhoods left to condense
+    /// are condensed one at a time (with faer's global parallelism).
     pub fn build_all(
         welds: &[WeldElem],
         nodes: &[[f64; 3]],
         material: Material,
     ) -> Result<Vec<Weld>, Error> {
-        let mut out: Vec<Weld> = Vec::with_capacity(welds.len());
-        for w in welds {
-            let Some(patch) = &w.patch else {
-                out.push(Weld::new(w, nodes, material)?);
+        // Each neighbourhood's retained nodes and key.
+        let keys: Vec<Option<(Vec<usize>, Vec<i64>)>> = welds
+            .iter()
+            .map(|w| {
+                w.patch.as_ref().map(|p| {
+                    let retained = super::weld_patch::retained_nodes(p);
+                    let key = condensation_key(w, p, &retained, nodes, material);
+                    (retained, key)
+                })
+            })
+            .collect();
+        let key_of = |i: usize| keys[i].as_ref().map(|(_, k)| k.as_slice());
+        // The distinct keys: found in this process or on disk, or to be condensed (the first
+        // weld of each).
+        let mut found: Vec<(&[i64], CondensedMatrices)> = Vec::new();
+        let mut todo: Vec<usize> = Vec::new();
+        for i in 0..welds.len() {
+            let Some(key) = key_of(i) else { continue };
+            if found.iter().any(|(k, _)| *k == key) || todo.iter().any(|&j| key_of(j) == Some(key))
+            {
                 continue;
-            };
-            let retained = super::weld_patch::retained_nodes(patch);
-            let key = condensation_key(w, patch, &retained, nodes, material);
-            let condensed = match CONDENSED.get(&key) {
-                Some(c) => c,
-                None => {
-                    let c = match super::weld_cache::load(&key) {
-                        Some(km) => Arc::new(km),
-                        None => {
-                            let c = Weld::new(w, nodes, material)?
-                                .condensed
-                                .expect("a weld with a neighbourhood is condensed");
-                            super::weld_cache::store(&key, &c.0, &c.1);
-                            c
-                        }
-                    };
-                    CONDENSED.insert(key, c.clone());
-                    c
+            }
+            match CONDENSED
+                .get(key)
+                .or_else(|| super::weld_cache::load(key).map(Arc::new))
+            {
+                Some(c) => {
+                    CONDENSED.insert(key.to_vec(), c.clone());
+                    found.push((key, c));
                 }
-            };
-            out.push(Weld {
-                nodes: retained,
-                maps: Vec::new(),
-                beams: Vec::new(),
-                condensed: Some(condensed),
-            });
+                None => todo.push(i),
+            }
         }
-        Ok(out)
+        // One at a time: the peak memory is one neighbourhood's.
+        let condensed = todo.iter().map(|&i| {
+            let w = &welds[i];
+            let patch = w
+                .patch
+                .as_ref()
+                .expect("a weld with a key has a neighbourhood");
+            super::weld_patch::condense(w, patch, material, faer::get_global_parallelism())
+                .map(|c| Arc::new((c.stiffness, c.mass)))
+        });
+        for (&i, c) in todo.iter().zip(condensed) {
+            let c = c?;
+            let key = key_of(i).expect("a condensed weld has a key");
+            super::weld_cache::store(key, &c.0, &c.1);
+            CONDENSED.insert(key.to_vec(), c.clone());
+            found.push((key, c));
+        }
+        welds
+            .iter()
+            .zip(&keys)
+            .map(|(w, entry)| match entry {
+                None => Weld::new(w, nodes, material),
+                Some((retained, key)) => Ok(Weld {
+                    nodes: retained.clone(),
+                    maps: Vec::new(),
+                    beams: Vec::new(),
+                    condensed: found
+                        .iter()
+                        .find(|(k, _)| *k == key.as_slice())
+                        .map(|(_, c)| c.clone()),
+                }),
+            })
+            .collect()
     }
 
     /// The shell nodes the weld couples, in the order of its matrices' DOF.

@@ -53,13 +53,15 @@
 //! Guyan's mass is accurate while the patch's own (fixed-boundary) frequencies lie far above the
 //! structure's (a 20 × 25 mm patch of 0.5 mm steel: above 10 kHz).
 
-use faer::Mat;
+use faer::linalg::matmul::matmul;
+use faer::reborrow::{Reborrow, ReborrowMut};
+use faer::{Accum, Mat, Par};
 
 use super::shell4::dkmq_phi;
 use super::{Material, Shell4};
 use crate::error::{ElementError, Error};
 use crate::linalg::{SparseCholesky, SymCsc};
-use crate::mesh::{line_cell, NuggetLayer, PatchLayer, WeldElem, WeldPatch};
+use crate::mesh::{line_cell, PatchLayer, WeldElem, WeldPatch};
 
 /// What a small shell node is ([`condense`]'s module docs).
 #[derive(Clone, Copy, Debug)]
@@ -196,95 +198,261 @@ fn layer_roles(
     roles
 }
 
-/// Accumulates the blocks `rr` (dense), `ri` (dense, nr × ni) and `ii` (triplets) of
-/// `Aᵀ K A` from element matrices.
+/// The `Aᵀ K A` terms of a small-shell node's fine DOF `c` on the retained DOF: `(index,
+/// coefficient)` pairs, of which the first `.1` are used. Internal nodes have none.
+fn retained_terms(role: Role, c: usize) -> ([(usize, f64); 4], usize) {
+    const Z: (usize, f64) = (0, 0.0);
+    match role {
+        Role::Retained(r) => ([(6 * r + c, 1.0), Z, Z, Z], 1),
+        Role::Edge(a, b, t, side) => match side.bending_terms(t, c) {
+            Some([ta, tb, wa, wb]) => (
+                [
+                    (6 * a + ta.0, ta.1),
+                    (6 * b + tb.0, tb.1),
+                    (6 * a + wa.0, wa.1),
+                    (6 * b + wb.0, wb.1),
+                ],
+                4,
+            ),
+            None => ([(6 * a + c, 1.0 - t), (6 * b + c, t), Z, Z], 2),
+        },
+        Role::Internal(_) => ([Z; 4], 0),
+    }
+}
+
+/// Calls `add(nodes, k, m)` for every element of the neighbourhood: each small shell (4 nodes,
+/// stiffness and consistent mass) and each sampling point of the bonded slab between two
+/// consecutive sheets (8 nodes, stiffness only); `nodes` in the small shells' node numbering
+/// (layer by layer, z fastest). With `matrices` false, `k` and `m` are empty (the pattern pass).
+fn for_each_element(
+    patch: &WeldPatch,
+    material: Material,
+    index: usize,
+    matrices: bool,
+    mut add: impl FnMut(&[usize], &Mat<f64>, Option<&Mat<f64>>),
+) -> Result<(), Error> {
+    let empty = Mat::<f64>::zeros(0, 0);
+    let mut offset = 0usize;
+    for layer in &patch.layers {
+        let nz = layer.fine_zs.len();
+        let node = |i: usize, kk: usize| offset + i * nz + kk;
+        for i in 0..layer.fine_xs.len() - 1 {
+            for kk in 0..nz - 1 {
+                let ids = [
+                    node(i, kk),
+                    node(i + 1, kk),
+                    node(i + 1, kk + 1),
+                    node(i, kk + 1),
+                ];
+                if !matrices {
+                    add(&ids, &empty, Some(&empty));
+                    continue;
+                }
+                let xyz = |n: usize| {
+                    let (a, b) = ((n - offset) / nz, (n - offset) % nz);
+                    [layer.fine_xs[a], layer.y, layer.fine_zs[b]]
+                };
+                let shell = Shell4::new(ids.map(xyz), layer.thickness, material)?;
+                add(&ids, &shell.stiffness(), Some(&shell.mass()));
+            }
+        }
+        offset += layer.fine_xs.len() * nz;
+    }
+    for (l, pair) in patch.nugget.windows(2).enumerate() {
+        let (layers, (lower, upper)) = (&patch.layers[l..l + 2], (&pair[0], &pair[1]));
+        super::weld_slab::check_layers(index, lower, upper)?;
+        let gap = upper.y - lower.y;
+        let mut ke = Mat::<f64>::zeros(48, 48);
+        for (pa, pb) in lower.points.iter().zip(&upper.points) {
+            let mut ids = [0usize; 8];
+            ids[..4].copy_from_slice(&pa.nodes);
+            ids[4..].copy_from_slice(&pb.nodes);
+            if !matrices {
+                add(&ids, &empty, None);
+                continue;
+            }
+            ke.fill(0.0);
+            super::weld_slab::add_point(
+                &mut ke,
+                (pa, shape_derivatives(&layers[0], pa.xz)),
+                (pb, shape_derivatives(&layers[1], pb.xz)),
+                gap,
+                material,
+            );
+            add(&ids, &ke, None);
+        }
+    }
+    Ok(())
+}
+
+/// Where `Aᵀ K A`'s entries go: the small-shell nodes' roles, the sparsity pattern of the
+/// internal block (node by node: every internal node's 6 columns hold the same rows, the 6 DOF
+/// of each internal node it shares an element with) and the internal nodes that share an element
+/// with a retained or side node (the only rows of the `ir` block, "slots").
+struct Layout {
+    roles: Vec<Role>,
+    /// Per internal node, the internal nodes it couples with (itself included), ascending.
+    couples: Vec<Vec<usize>>,
+    /// Per internal node, the offset of its first column's values; the last entry is the count.
+    base: Vec<usize>,
+    /// Per internal node, its slot (position in `slots`), or `usize::MAX`.
+    slot: Vec<usize>,
+    /// The internal nodes with a slot, ascending.
+    slots: Vec<usize>,
+}
+
+impl Layout {
+    fn new(
+        patch: &WeldPatch,
+        roles: Vec<Role>,
+        internal: usize,
+        material: Material,
+        index: usize,
+    ) -> Result<Layout, Error> {
+        let mut couples: Vec<Vec<usize>> = vec![Vec::new(); internal];
+        let mut slot = vec![usize::MAX; internal];
+        for_each_element(patch, material, index, false, |nodes, _, _| {
+            let mut inner = [0usize; 8];
+            let mut n = 0;
+            let mut outer = false;
+            for &v in nodes {
+                match roles[v] {
+                    Role::Internal(i) => {
+                        inner[n] = i;
+                        n += 1;
+                    }
+                    _ => outer = true,
+                }
+            }
+            for &i in &inner[..n] {
+                couples[i].extend_from_slice(&inner[..n]);
+                if outer {
+                    slot[i] = 0;
+                }
+            }
+        })?;
+        let mut base = Vec::with_capacity(internal + 1);
+        let mut at = 0usize;
+        for c in &mut couples {
+            c.sort_unstable();
+            c.dedup();
+            base.push(at);
+            at += 36 * c.len();
+        }
+        base.push(at);
+        let slots: Vec<usize> = (0..internal).filter(|&i| slot[i] == 0).collect();
+        for (s, &i) in slots.iter().enumerate() {
+            slot[i] = s;
+        }
+        Ok(Layout {
+            roles,
+            couples,
+            base,
+            slot,
+            slots,
+        })
+    }
+
+    /// The position in the internal block's values of row DOF `6 i + c`, column DOF `6 j + d`.
+    fn at(&self, i: usize, c: usize, j: usize, d: usize) -> usize {
+        let pos = self.couples[j]
+            .binary_search(&i)
+            .expect("coupled nodes share an element");
+        self.base[j] + d * 6 * self.couples[j].len() + 6 * pos + c
+    }
+
+    /// The internal block with `values` (both triangles, rows ascending).
+    fn matrix(&self, values: Vec<f64>) -> SymCsc {
+        let ni = 6 * self.couples.len();
+        let mut col_ptr = Vec::with_capacity(ni + 1);
+        let mut row_idx = Vec::with_capacity(values.len());
+        col_ptr.push(0);
+        for c in &self.couples {
+            for _ in 0..6 {
+                row_idx.extend(c.iter().flat_map(|&i| (0..6).map(move |d| 6 * i + d)));
+                col_ptr.push(row_idx.len());
+            }
+        }
+        SymCsc {
+            n: ni,
+            col_ptr,
+            row_idx,
+            values,
+        }
+    }
+}
+
+/// The blocks of `Aᵀ K A`: `rr` (dense, nr × nr), `ri` on the slots' DOF (dense,
+/// nr × 6·slots) and `ii`'s values on the [`Layout`]'s pattern.
 struct Blocks {
     rr: Mat<f64>,
-    ri: sprs::TriMat<f64>,
-    ii: sprs::TriMat<f64>,
+    ri: Mat<f64>,
+    ii: Vec<f64>,
 }
 
 impl Blocks {
-    fn new(nr: usize, ni: usize) -> Blocks {
+    fn new(nr: usize, layout: &Layout) -> Blocks {
         Blocks {
             rr: Mat::zeros(nr, nr),
-            ri: sprs::TriMat::new((nr, ni)),
-            ii: sprs::TriMat::new((ni, ni)),
+            ri: Mat::zeros(nr, 6 * layout.slots.len()),
+            ii: vec![0.0; layout.base[layout.couples.len()]],
         }
     }
 
-    /// `K̂_ri X` (nr × nr) for `x` (ni × nr), `K̂_ri` sparse.
-    fn ri_times(&self, x: &Mat<f64>) -> Mat<f64> {
-        let ri: sprs::CsMat<f64> = self.ri.to_csr();
-        let nr = x.ncols();
-        let mut out = Mat::<f64>::zeros(ri.rows(), nr);
-        // Column by column: X's columns are contiguous.
-        for j in 0..nr {
-            let xj = x.col(j);
-            for (r, row) in ri.outer_iterator().enumerate() {
-                out[(r, j)] = row.iter().map(|(i, &v)| v * xj[i]).sum::<f64>();
-            }
-        }
-        out
-    }
-
-    /// The terms of fine DOF `c` of a node with `role`: (is retained, index, coefficient).
-    fn terms(role: Role, c: usize) -> ([(bool, usize, f64); 4], usize) {
-        const Z: (bool, usize, f64) = (true, 0, 0.0);
-        match role {
-            Role::Retained(r) => ([(true, 6 * r + c, 1.0), Z, Z, Z], 1),
-            Role::Edge(a, b, t, side) => match side.bending_terms(t, c) {
-                Some([ta, tb, wa, wb]) => (
-                    [
-                        (true, 6 * a + ta.0, ta.1),
-                        (true, 6 * b + tb.0, tb.1),
-                        (true, 6 * a + wa.0, wa.1),
-                        (true, 6 * b + wb.0, wb.1),
-                    ],
-                    4,
-                ),
-                None => ([(true, 6 * a + c, 1.0 - t), (true, 6 * b + c, t), Z, Z], 2),
-            },
-            Role::Internal(i) => ([(false, 6 * i + c, 1.0), Z, Z, Z], 1),
-        }
-    }
-
-    /// Adds element matrix `k` over nodes with `roles`.
-    fn add(&mut self, roles: &[Role], k: &Mat<f64>) {
-        let dofs = 6 * roles.len();
+    /// Adds element matrix `k` over the small-shell nodes `nodes`.
+    fn add(&mut self, layout: &Layout, nodes: &[usize], k: &Mat<f64>) {
+        let roles: Vec<Role> = nodes.iter().map(|&v| layout.roles[v]).collect();
         // Each DOF's terms once (a side's are polynomials in t), not once per matrix entry.
-        let terms: Vec<_> = (0..dofs)
-            .map(|a| Blocks::terms(roles[a / 6], a % 6))
+        let terms: Vec<_> = (0..6 * nodes.len())
+            .map(|a| retained_terms(roles[a / 6], a % 6))
             .collect();
-        for (a, &(ta, na)) in terms.iter().enumerate() {
-            for (b, &(tb, nb)) in terms.iter().enumerate() {
-                let v = k[(a, b)];
-                if v == 0.0 {
-                    continue;
-                }
-                for &(ra, ia, ca) in &ta[..na] {
-                    for &(rb, ib, cb) in &tb[..nb] {
-                        let w = v * ca * cb;
-                        match (ra, rb) {
-                            (true, true) => self.rr[(ia, ib)] += w,
-                            (true, false) => self.ri.add_triplet(ia, ib, w),
-                            (false, false) => self.ii.add_triplet(ia, ib, w),
-                            (false, true) => {}
+        for (q, &rq) in roles.iter().enumerate() {
+            for (p, &rp) in roles.iter().enumerate() {
+                match (rp, rq) {
+                    (Role::Internal(i), Role::Internal(j)) => {
+                        for d in 0..6 {
+                            let at = self::Layout::at(layout, i, 0, j, d);
+                            for c in 0..6 {
+                                self.ii[at + c] += k[(6 * p + c, 6 * q + d)];
+                            }
+                        }
+                    }
+                    // The transpose of `ri`.
+                    (Role::Internal(_), _) => {}
+                    (_, Role::Internal(j)) => {
+                        let col = 6 * layout.slot[j];
+                        for d in 0..6 {
+                            for c in 0..6 {
+                                let v = k[(6 * p + c, 6 * q + d)];
+                                if v == 0.0 {
+                                    continue;
+                                }
+                                let (t, n) = terms[6 * p + c];
+                                for &(r, coef) in &t[..n] {
+                                    self.ri[(r, col + d)] += coef * v;
+                                }
+                            }
+                        }
+                    }
+                    _ => {
+                        for d in 0..6 {
+                            let (tb, nb) = terms[6 * q + d];
+                            for c in 0..6 {
+                                let v = k[(6 * p + c, 6 * q + d)];
+                                if v == 0.0 {
+                                    continue;
+                                }
+                                let (ta, na) = terms[6 * p + c];
+                                for &(ra, ca) in &ta[..na] {
+                                    for &(rb, cb) in &tb[..nb] {
+                                        self.rr[(ra, rb)] += v * ca * cb;
+                                    }
+                                }
+                            }
                         }
                     }
                 }
             }
-        }
-    }
-
-    /// The `ii` block as a [`SymCsc`] (duplicates summed).
-    fn ii_matrix(&self) -> SymCsc {
-        let csc: sprs::CsMat<f64> = self.ii.to_csc();
-        SymCsc {
-            n: csc.rows(),
-            col_ptr: csc.indptr().raw_storage().to_vec(),
-            row_idx: csc.indices().to_vec(),
-            values: csc.data().to_vec(),
         }
     }
 }
@@ -301,40 +469,6 @@ fn shape_derivatives(layer: &PatchLayer, p: [f64; 2]) -> ([f64; 4], [f64; 4]) {
         [-(1.0 - eta) / hx, (1.0 - eta) / hx, eta / hx, -eta / hx],
         [-(1.0 - xi) / hz, -xi / hz, xi / hz, (1.0 - xi) / hz],
     )
-}
-
-/// The nugget between two consecutive sheets as a bonded slab ([`super::weld_slab`]),
-/// integrated by the nugget's sampling points on the small shells, added to `k`.
-fn add_slab(
-    k: &mut Blocks,
-    roles: &[Role],
-    layers: &[PatchLayer],
-    nugget: &[NuggetLayer],
-    material: Material,
-    index: usize,
-) -> Result<(), Error> {
-    let (lower, upper) = (&nugget[0], &nugget[1]);
-    super::weld_slab::check_layers(index, lower, upper)?;
-    let gap = upper.y - lower.y;
-    let mut ke = Mat::<f64>::zeros(48, 48);
-    for (pa, pb) in lower.points.iter().zip(&upper.points) {
-        ke.fill(0.0);
-        super::weld_slab::add_point(
-            &mut ke,
-            (pa, shape_derivatives(&layers[0], pa.xz)),
-            (pb, shape_derivatives(&layers[1], pb.xz)),
-            gap,
-            material,
-        );
-        let r: Vec<Role> = pa
-            .nodes
-            .iter()
-            .chain(&pb.nodes)
-            .map(|&n| roles[n])
-            .collect();
-        k.add(&r, &ke);
-    }
-    Ok(())
 }
 
 /// A condensed patch: its retained sheet nodes (sorted) and the stiffness and mass on their DOF.
@@ -358,10 +492,17 @@ pub(super) fn retained_nodes(patch: &WeldPatch) -> Vec<usize> {
 }
 
 /// The condensed patch of `weld` (module docs).
+///
+/// Nothing of the internal size is dense but `X` (ni × nr, which the Guyan mass needs whole):
+/// `K̂_ii`, `M̂_ii` are assembled straight into their pattern, `K̂_ri`, `M̂_ri` are kept only on the
+/// internal DOF that share an element with a retained or side node, `X` comes from one sparse
+/// Cholesky with nr right-hand sides, and the mass's `Xᵀ (M̂_ir + M̂_ii X)` is formed a block of
+/// columns at a time, lower block triangle only (the product is symmetric).
 pub(super) fn condense(
     weld: &WeldElem,
     patch: &WeldPatch,
     material: Material,
+    par: Par,
 ) -> Result<Condensed, Error> {
     let retained = retained_nodes(patch);
     let mut internal = 0usize;
@@ -370,80 +511,53 @@ pub(super) fn condense(
         .iter()
         .flat_map(|l| layer_roles(l, &retained, &mut internal, material))
         .collect();
+    let layout = Layout::new(patch, roles, internal, material, weld.index)?;
     let (nr, ni) = (6 * retained.len(), 6 * internal);
-    let mut k = Blocks::new(nr, ni);
-    let mut m = Blocks::new(nr, ni);
-    let mut offset = 0usize;
-    for layer in &patch.layers {
-        let nz = layer.fine_zs.len();
-        let node = |i: usize, kk: usize| offset + i * nz + kk;
-        for i in 0..layer.fine_xs.len() - 1 {
-            for kk in 0..nz - 1 {
-                let ids = [
-                    node(i, kk),
-                    node(i + 1, kk),
-                    node(i + 1, kk + 1),
-                    node(i, kk + 1),
-                ];
-                let xyz = |n: usize| {
-                    let (a, b) = ((n - offset) / nz, (n - offset) % nz);
-                    [layer.fine_xs[a], layer.y, layer.fine_zs[b]]
-                };
-                let shell = Shell4::new(ids.map(xyz), layer.thickness, material)?;
-                let r = ids.map(|n| roles[n]);
-                k.add(&r, &shell.stiffness());
-                m.add(&r, &shell.mass());
-            }
+    let mut k = Blocks::new(nr, &layout);
+    let mut m = Blocks::new(nr, &layout);
+    for_each_element(patch, material, weld.index, true, |nodes, ke, me| {
+        k.add(&layout, nodes, ke);
+        if let Some(me) = me {
+            m.add(&layout, nodes, me);
         }
-        offset += layer.fine_xs.len() * nz;
-    }
-    for (l, pair) in patch.nugget.windows(2).enumerate() {
-        add_slab(
-            &mut k,
-            &roles,
-            &patch.layers[l..l + 2],
-            pair,
-            material,
-            weld.index,
-        )?;
-    }
+    })?;
     let what = |source| ElementError::InWeld {
         index: weld.index,
         source: Box::new(ElementError::NeighbourhoodStiffness { source }),
     };
-    let kii = k.ii_matrix();
-    let chol = SparseCholesky::new(&kii).map_err(what)?;
-    // X = −K_ii⁻¹ K_ir.
+    // The pattern without the element matrices' structural zeros (less fill in the factor).
+    let kii = without_zeros(layout.matrix(std::mem::take(&mut k.ii)));
+    let chol = SparseCholesky::new_with(&kii, par).map_err(what)?;
+    drop(kii);
+    // X = −K̂_ii⁻¹ K̂_ir; K̂_ir is nonzero on the slots' rows only.
+    let slot_dofs: Vec<usize> = layout
+        .slots
+        .iter()
+        .flat_map(|&i| (0..6).map(move |d| 6 * i + d))
+        .collect();
     let mut x = Mat::<f64>::zeros(ni, nr);
-    for (&v, (r, i)) in k.ri.triplet_iter() {
-        x[(i, r)] -= v;
-    }
-    chol.solve_in_place(&mut x);
-    let mut kc = k.rr.clone() + k.ri_times(&x);
-    let mii = m.ii_matrix();
-    // M̂_ii X column by column (X and the product are column-major: contiguous columns).
-    let mut mx = Mat::<f64>::zeros(ni, nr);
-    for j in 0..nr {
-        let (xj, mut out) = (x.col(j), mx.col_mut(j));
-        for col in 0..ni {
-            let xv = xj[col];
-            if xv == 0.0 {
-                continue;
-            }
-            for p in mii.col_ptr[col]..mii.col_ptr[col + 1] {
-                out[mii.row_idx[p]] += mii.values[p] * xv;
-            }
+    for (s, &row) in slot_dofs.iter().enumerate() {
+        for r in 0..nr {
+            x[(row, r)] = -k.ri[(r, s)];
         }
     }
-    let mri_x = m.ri_times(&x);
-    let mut mc = m.rr.clone() + &mri_x + mri_x.transpose() + x.transpose() * &mx;
-    for a in [&mut kc, &mut mc] {
-        for i in 0..nr {
-            for j in 0..i {
-                let v = 0.5 * (a[(i, j)] + a[(j, i)]);
-                a[(i, j)] = v;
-                a[(j, i)] = v;
-            }
+    chol.solve_in_place(&mut x);
+    drop(chol);
+    let xs = Mat::from_fn(slot_dofs.len(), nr, |s, j| x[(slot_dofs[s], j)]);
+    let mut kc = k.rr;
+    matmul(&mut kc, Accum::Add, &k.ri, &xs, 1.0, par);
+    let mut mc = m.rr;
+    matmul(&mut mc, Accum::Add, &m.ri, &xs, 1.0, par);
+    // The consistent mass couples only like DOF: most of its pattern's entries are zero.
+    let mii = without_zeros(layout.matrix(m.ii));
+    guyan_inner(&mut mc, &mii, &m.ri, &slot_dofs, &x, par);
+    for i in 0..nr {
+        for j in 0..i {
+            let v = 0.5 * (kc[(i, j)] + kc[(j, i)]);
+            kc[(i, j)] = v;
+            kc[(j, i)] = v;
+            // `guyan_inner` completed the lower triangle.
+            mc[(j, i)] = mc[(i, j)];
         }
     }
     Ok(Condensed {
@@ -452,3 +566,81 @@ pub(super) fn condense(
         mass: mc,
     })
 }
+
+/// `a` without its stored zeros.
+fn without_zeros(a: SymCsc) -> SymCsc {
+    let mut col_ptr = Vec::with_capacity(a.n + 1);
+    let (mut row_idx, mut values) = (Vec::new(), Vec::new());
+    col_ptr.push(0);
+    for j in 0..a.n {
+        for p in a.col_ptr[j]..a.col_ptr[j + 1] {
+            if a.values[p] != 0.0 {
+                row_idx.push(a.row_idx[p]);
+                values.push(a.values[p]);
+            }
+        }
+        col_ptr.push(row_idx.len());
+    }
+    SymCsc {
+        n: a.n,
+        col_ptr,
+        row_idx,
+        values,
+    }
+}
+
+/// Adds `Xᵀ (M̂_ir + M̂_ii X)` to the lower triangle of `mc` (and to some entries above it), a
+/// block of columns J at a time: `Z_J = M̂_iJ + M̂_ii X_J` (ni × |J|), then rows from J's first
+/// on, `X[:, J₀..]ᵀ Z_J`. `mri` holds `M̂_ri` on the DOF `slot_dofs`.
+fn guyan_inner(
+    mc: &mut Mat<f64>,
+    mii: &SymCsc,
+    mri: &Mat<f64>,
+    slot_dofs: &[usize],
+    x: &Mat<f64>,
+    par: Par,
+) {
+    const BLOCK: usize = 64;
+    let (ni, nr) = (x.nrows(), x.ncols());
+    let mut z = Mat::<f64>::zeros(ni, BLOCK.min(nr));
+    for j0 in (0..nr).step_by(BLOCK) {
+        let w = BLOCK.min(nr - j0);
+        let mut zj = z.as_mut().subcols_mut(0, w);
+        for j in 0..w {
+            let xj = x
+                .col(j0 + j)
+                .try_as_col_major()
+                .expect("a matrix's columns are contiguous")
+                .as_slice();
+            let mut zc = zj.rb_mut().col_mut(j);
+            let out = zc
+                .rb_mut()
+                .try_as_col_major_mut()
+                .expect("a matrix's columns are contiguous")
+                .as_slice_mut();
+            // Row i of the symmetric M̂_ii is its column i: a gather, one store per row.
+            for (i, o) in out.iter_mut().enumerate() {
+                let (a, b) = (mii.col_ptr[i], mii.col_ptr[i + 1]);
+                *o = mii.row_idx[a..b]
+                    .iter()
+                    .zip(&mii.values[a..b])
+                    .map(|(&r, &v)| v * xj[r])
+                    .sum::<f64>();
+            }
+            for (s, &row) in slot_dofs.iter().enumerate() {
+                out[row] += mri[(j0 + j, s)];
+            }
+        }
+        matmul(
+            mc.as_mut().submatrix_mut(j0, j0, nr - j0, w),
+            Accum::Add,
+            x.as_ref().subcols(j0, nr - j0).transpose(),
+            zj.rb(),
+            1.0,
+            par,
+        );
+    }
+}
+
+#[cfg(test)]
+mod tests;

@@ -46,16 +46,17 @@ impl SparseCholesky {
     /// parallelism). Errors if `a` is not positive definite (e.g. an unsupported, singular
     /// structure).
     pub fn new(a: &SymCsc) -> Result<SparseCholesky, LinalgError> {
-        let mut chol = SparseCholesky::analyze_with(
-            a.n,
-            a.col_ptr.clone(),
-            a.row_idx.clone(),
-            get_global_parallelism(),
-        )
-        .map_err(|e| LinalgError::Symbolic {
-            what: format!("Cholesky of a {0}×{0} matrix", a.n),
-            source: Box::new(e),
-        })?;
+        SparseCholesky::new_with(a, get_global_parallelism())
+    }
+
+    /// [`SparseCholesky::new`] with the parallelism `par` of the numeric factorization and of
+    /// many-column solves.
+    pub fn new_with(a: &SymCsc, par: Par) -> Result<SparseCholesky, LinalgError> {
+        let mut chol = SparseCholesky::analyze_with(a.n, a.col_ptr.clone(), a.row_idx.clone(), par)
+            .map_err(|e| LinalgError::Symbolic {
+                what: format!("Cholesky of a {0}×{0} matrix", a.n),
+                source: Box::new(e),
+            })?;
         chol.factor_with(&a.values, |e| {
             let e = SparseLltError::Numeric(e);
             LinalgError::NotPositiveDefinite {
