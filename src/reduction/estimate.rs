@@ -148,7 +148,9 @@ use crate::joint::law::PairLaw;
 use crate::joint::JointOperator;
 use crate::joint::{NORMAL, T1, T2};
 use crate::linalg::cholesky::SparseCholesky;
-use crate::linalg::compensated::{compensated_gram, solve_refined, solve_refined_steps};
+use crate::linalg::compensated::{
+    compensated_gram, solve_refined, solve_refined_owned, solve_refined_steps_owned,
+};
 use crate::linalg::sparse::sym_mul_mat;
 use crate::linalg::symmetric_eigen;
 use crate::linalg::LinalgError;
@@ -308,7 +310,8 @@ impl JointFlexibility {
                     rhs[(i, j)] += v;
                 }
             }
-            let x = solve_refined_steps(&self.stiffness, &self.chol, &rhs, COLUMN_REFINEMENT);
+            // The solution overwrites the right-hand sides: one n × chunk matrix, not two.
+            let x = solve_refined_steps_owned(&self.stiffness, &self.chol, rhs, COLUMN_REFINEMENT);
             let solved: Vec<Arc<[f64]>> = (0..chunk.len())
                 .map(|j| {
                     (0..w)
@@ -424,7 +427,7 @@ impl JointFlexibility {
                 rhs[(i, j)] += v;
             }
         }
-        solve_refined(&self.stiffness, &self.chol, &rhs)
+        solve_refined_owned(&self.stiffness, &self.chol, rhs)
     }
 
     /// The tangential attachment modes `K⁻¹ B_{t,k}ᵀ d` of `pairs`, each with its direction `d`
@@ -439,7 +442,7 @@ impl JointFlexibility {
                 }
             }
         }
-        solve_refined(&self.stiffness, &self.chol, &rhs)
+        solve_refined_owned(&self.stiffness, &self.chol, rhs)
     }
 
     /// The frictionless contact statics (the model's `k_n`) under the master load `load` (`[Fx, Fy, Fz (N), Mx, My,
@@ -471,7 +474,7 @@ impl JointFlexibility {
     ) -> Result<ErrorEstimator<'a>, Error> {
         let phi = self.basis_of(rom)?;
         let m_phi = sym_mul_mat(&model.mass, phi.as_ref());
-        let y = solve_refined(&self.stiffness, &self.chol, &m_phi);
+        let y = solve_refined_owned(&self.stiffness, &self.chol, m_phi);
         Ok(ErrorEstimator {
             flex: self,
             g: self.joint.reduce(y.as_ref()),
