@@ -173,6 +173,12 @@ pub(crate) fn solve_refined(a: &SymCsc, chol: &SparseCholesky, b: &Mat<f64>) -> 
     solve_refined_steps(a, chol, b, REFINEMENT_STEPS)
 }
 
+/// [`solve_refined`] on right-hand sides the caller gives up ([`solve_refined_steps_owned`]):
+/// the same bits, without a second n × columns matrix.
+pub(crate) fn solve_refined_owned(a: &SymCsc, chol: &SparseCholesky, b: Mat<f64>) -> Mat<f64> {
+    solve_refined_steps_owned(a, chol, b, REFINEMENT_STEPS)
+}
+
 /// Columns of one block of [`solve_refined_steps`].
 const SOLVE_BLOCK: usize = 32;
 
