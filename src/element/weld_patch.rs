@@ -471,6 +471,19 @@ fn shape_derivatives(layer: &PatchLayer, p: [f64; 2]) -> ([f64; 4], [f64; 4]) {
     )
 }
 
+/// The patch's retained sheet nodes (sorted), every small-shell node's role (layer by layer)
+/// and the number of internal nodes.
+fn patch_roles(patch: &WeldPatch, material: Material) -> (Vec<usize>, Vec<Role>, usize) {
+    let retained = retained_nodes(patch);
+    let mut internal = 0usize;
+    let roles: Vec<Role> = patch
+        .layers
+        .iter()
+        .flat_map(|l| layer_roles(l, &retained, &mut internal, material))
+        .collect();
+    (retained, roles, internal)
+}
+
 /// A condensed patch: its retained sheet nodes (sorted) and the stiffness and mass on their DOF.
 pub(super) struct Condensed {
     pub(super) nodes: Vec<usize>,
@@ -504,13 +517,7 @@ pub(super) fn condense(
     material: Material,
     par: Par,
 ) -> Result<Condensed, Error> {
-    let retained = retained_nodes(patch);
-    let mut internal = 0usize;
-    let roles: Vec<Role> = patch
-        .layers
-        .iter()
-        .flat_map(|l| layer_roles(l, &retained, &mut internal, material))
-        .collect();
+    let (retained, roles, internal) = patch_roles(patch, material);
     let layout = Layout::new(patch, roles, internal, material, weld.index)?;
     let (nr, ni) = (6 * retained.len(), 6 * internal);
     let mut k = Blocks::new(nr, &layout);

@@ -73,13 +73,7 @@ fn condensation_equals_the_dense_formula() {
     let got = condense(weld, patch, material, Par::Seq).unwrap();
 
     // The dense reference: K_f, M_f on every small-shell DOF, A from the roles.
-    let retained = retained_nodes(patch);
-    let mut internal = 0usize;
-    let roles: Vec<Role> = patch
-        .layers
-        .iter()
-        .flat_map(|l| layer_roles(l, &retained, &mut internal, material))
-        .collect();
+    let (retained, roles, internal) = patch_roles(patch, material);
     let (nr, ni, nf) = (6 * retained.len(), 6 * internal, 6 * roles.len());
     let (mut kf, mut mf) = (Mat::<f64>::zeros(nf, nf), Mat::<f64>::zeros(nf, nf));
     for_each_element(patch, material, 0, true, |nodes, ke, me| {
