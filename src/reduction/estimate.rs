@@ -887,6 +887,15 @@ impl Estimate {
     }
 }
 
+/// One output's run forces `p` (3w), corrected forces `pc` (3w), the run's slip memory `s` (2w)
+/// and the corrected state's slip (2w), mm and N.
+struct OutputState {
+    p: Vec<f64>,
+    pc: Vec<f64>,
+    s: Vec<f64>,
+    slip: Vec<f64>,
+}
+
 /// The joint's dissipated energy `D(t) = ∫ p_t · ṡ dt` of the run and of the correction, by the
 /// trapezoidal rule over the output states, each with its own forces and slip (the run's memory,
 /// the corrected state's `s*`; module docs, "Friction").
@@ -896,10 +905,8 @@ struct Dissipation {
     run: Vec<f64>,
     /// The correction's D*, N·mm.
     corrected: Vec<f64>,
-    /// The last output's run forces (3w), corrected forces (3w), the run's slip memory (2w)
-    /// and the corrected state's (2w).
-    #[allow(clippy::type_complexity)]
-    last: Option<(Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>)>,
+    /// The last output's forces and slips.
+    last: Option<OutputState>,
 }
 
 impl Dissipation {
@@ -908,7 +915,13 @@ impl Dissipation {
             self.run.last().copied().unwrap_or(0.0),
             self.corrected.last().copied().unwrap_or(0.0),
         );
-        if let Some((p0, pc0, s0, slip0)) = &self.last {
+        if let Some(OutputState {
+            p: p0,
+            pc: pc0,
+            s: s0,
+            slip: slip0,
+        }) = &self.last
+        {
             for i in 0..s.len() {
                 let r = 3 * (i / 2) + 1 + i % 2;
                 let n = 3 * (i / 2) + NORMAL;
@@ -927,7 +940,12 @@ impl Dissipation {
         }
         self.run.push(d);
         self.corrected.push(dc);
-        self.last = Some((p.to_vec(), pc.to_vec(), s.to_vec(), slip.to_vec()));
+        self.last = Some(OutputState {
+            p: p.to_vec(),
+            pc: pc.to_vec(),
+            s: s.to_vec(),
+            slip: slip.to_vec(),
+        });
     }
 
     /// `|D(T) − D*(T)| / |D*(T)|` (`None` when nothing is dissipated).
