@@ -137,9 +137,9 @@ pub trait SecondOrderSystem {
     /// blocks in `kc` (every other pair's block must be the one factored), at the γ of the last
     /// [`SecondOrderSystem::newton_factor`] `γ_f`:
     /// `A ← A + γ_f² Σ_{i ∈ changed} B_iᵀ (K_c,i − K_c,i^factored) B_i`, exactly, without
-    /// refactoring. `false` if the system does not do this (the default; the reduced model's
-    /// dense refactorization is cheap) or cannot now (its correction is full): the caller then
-    /// refactors with [`SecondOrderSystem::newton_factor`].
+    /// refactoring. `false` if the system does not do this (the default) or cannot now (its
+    /// correction is full, or would cost more than a factorization): the caller then refactors
+    /// with [`SecondOrderSystem::newton_factor`].
     fn newton_update(&mut self, kc: &[f64], changed: &[usize]) -> bool {
         let _ = (kc, changed);
         false

@@ -1,13 +1,28 @@
 //! A reduced model (eq. 7) as a second-order system: `M̃ q̈ + K̃ q = Φᵀ f(t) − (BΦ)ᵀ p`, dense
 //! r × r, the Newton matrix `M̃ + γ²(K̃ + (BΦ)ᵀ K_c BΦ)` factored in place per setup.
+//!
+//! ## Active-set refreshes by a rank update
+//!
+//! A refresh of the mechanical problem ([`crate::integrate::mechanical`]) changes the `K_c`
+//! blocks of the pairs that switched branch. The Newton matrix changes by
+//! `γ_f² Σ_i (BΦ)_iᵀ ΔK_c,i (BΦ)_i`; each `ΔK_c,i` has no normal–tangential coupling (the
+//! problem's blocks have none), so it is the normal entry and the tangential 2 × 2 block's two
+//! eigenpairs `λ v vᵀ` — at most three columns `w = γ_f (BΦ)_iᵀ v` with weights `λ` per pair.
+//! [`ReducedSystem::newton_update`](SecondOrderSystem::newton_update) applies them to the
+//! Cholesky factor as a rank-k up/downdate (faer's `rank_r_update_clobber`, ~2kr² flops) when
+//! that is cheaper than a factorization (r³/3 flops: k ≤ r/6), and declines otherwise, or when a
+//! downdate loses definiteness (the factor is then refactored). A refactorization re-linearizes
+//! every pair at the current γ, a better Newton matrix than the update at the factored γ, so
+//! the update is taken only where it saves the factorization's cost.
 
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::llt::factor::{
     cholesky_in_place, cholesky_in_place_scratch, LltRegularization,
 };
 use faer::linalg::cholesky::llt::solve::solve_in_place_with_conj;
+use faer::linalg::cholesky::llt::update::rank_r_update_clobber;
 use faer::linalg::matmul::matmul;
-use faer::{Accum, Conj, Mat, MatMut, Par};
+use faer::{Accum, Col, Conj, Mat, MatMut, Par};
 
 use super::SecondOrderSystem;
 use crate::case::LoadSpec;
@@ -62,6 +77,14 @@ pub struct ReducedSystem {
     m_llt: Mat<f64>,
     newton: Mat<f64>,
     newton_ok: bool,
+    /// γ and the pairs' `K_c` blocks (9 per pair, N/mm) of the factored Newton matrix, as
+    /// [`SecondOrderSystem::newton_update`] changed them since the factorization.
+    gamma_factored: f64,
+    kc_factored: Vec<f64>,
+    /// Scratch of [`SecondOrderSystem::newton_update`]: the update's columns `W` (r × 3w) and
+    /// weights `α`, `A ← A + W diag(α) Wᵀ`.
+    update_w: Mat<f64>,
+    update_alpha: Col<f64>,
     /// Scratch of the Newton setup: the rows of `BΦ` of the pairs with a non-zero `K_c` block
     /// (`active`) and `K_c (BΦ)` on them (`kcb`), up to 3w × r.
     active: Mat<f64>,
@@ -85,6 +108,30 @@ fn col_major(a: &Mat<f64>) -> Vec<f64> {
         out.extend(a.col(j).iter().copied());
     }
     out
+}
+
+/// The eigenpairs `(λ, v)` (v unit, in the pair's rows normal, t1, t2) of a change of a pair's
+/// `K_c` block (row-major 3 × 3, symmetric) that couples the normal and tangential rows nowhere:
+/// the normal entry, and the 2 × 2 tangential block's two eigenpairs (closed form).
+fn block_eigen(d: [f64; 9]) -> [(f64, [f64; 3]); 3] {
+    let normal = (d[0], [1.0, 0.0, 0.0]);
+    let (a, b, c) = (d[4], 0.5 * (d[5] + d[7]), d[8]);
+    if b == 0.0 {
+        return [normal, (a, [0.0, 1.0, 0.0]), (c, [0.0, 0.0, 1.0])];
+    }
+    let mean = 0.5 * (a + c);
+    let rad = (0.5 * (a - c)).hypot(b);
+    let (l1, l2) = (mean + rad, mean - rad);
+    // Eigenvector of l1: (b, l1 − a) or (l1 − c, b), whichever is longer (no cancellation);
+    // that of l2 is its perpendicular.
+    let (x, y) = if (l1 - a).abs() >= (l1 - c).abs() {
+        (b, l1 - a)
+    } else {
+        (l1 - c, b)
+    };
+    let n = x.hypot(y);
+    let (x, y) = (x / n, y / n);
+    [normal, (l1, [0.0, x, y]), (l2, [0.0, -y, x])]
 }
 
 impl ReducedSystem {
@@ -251,6 +298,10 @@ impl ReducedSystem {
             load,
             newton: Mat::zeros(r, r),
             newton_ok: false,
+            gamma_factored: 0.0,
+            kc_factored: vec![0.0; 3 * w3],
+            update_w: Mat::zeros(r, w3),
+            update_alpha: Col::zeros(w3),
             active: Mat::zeros(w3, r),
             kcb: Mat::zeros(w3, r),
             mem,
@@ -308,6 +359,10 @@ impl Clone for ReducedSystem {
             m_llt: self.m_llt.clone(),
             newton: Mat::zeros(self.r, self.r),
             newton_ok: false,
+            gamma_factored: 0.0,
+            kc_factored: vec![0.0; 3 * self.b_phi.nrows()],
+            update_w: Mat::zeros(self.r, self.b_phi.nrows()),
+            update_alpha: Col::zeros(self.b_phi.nrows()),
             active: Mat::zeros(self.b_phi.nrows(), self.r),
             kcb: Mat::zeros(self.b_phi.nrows(), self.r),
             mem: MemBuffer::new(cholesky_in_place_scratch::<f64>(
@@ -455,7 +510,61 @@ impl SecondOrderSystem for ReducedSystem {
             })
         })?;
         self.newton_ok = true;
+        self.gamma_factored = gamma;
+        self.kc_factored.copy_from_slice(kc);
         Ok(())
+    }
+    fn newton_update(&mut self, kc: &[f64], changed: &[usize]) -> bool {
+        if !self.newton_ok {
+            return false;
+        }
+        let r = self.r;
+        let gf = self.gamma_factored;
+        let mut cols = 0;
+        for &i in changed {
+            let (new, old) = (&kc[9 * i..9 * i + 9], &self.kc_factored[9 * i..9 * i + 9]);
+            let d: [f64; 9] = std::array::from_fn(|ab| new[ab] - old[ab]);
+            // The blocks couple the normal and tangential rows nowhere (module docs of
+            // `crate::integrate::mechanical`); a block that did is left to a refactorization.
+            if [1, 2, 3, 6].iter().any(|&ab| d[ab] != 0.0) {
+                return false;
+            }
+            for (lambda, v) in block_eigen(d) {
+                if lambda == 0.0 {
+                    continue;
+                }
+                // k columns cost ~2kr² flops against a factorization's r³/3 (module docs).
+                if cols == self.update_alpha.nrows() || 6 * (cols + 1) > r {
+                    return false;
+                }
+                let row = |a: usize| &self.b_rows[(3 * i + a) * r..(3 * i + a + 1) * r];
+                let (b0, b1, b2) = (row(0), row(1), row(2));
+                for (c, o) in self.update_w.col_mut(cols).iter_mut().enumerate() {
+                    *o = gf * (v[0] * b0[c] + v[1] * b1[c] + v[2] * b2[c]);
+                }
+                self.update_alpha[cols] = lambda;
+                cols += 1;
+            }
+        }
+        if cols > 0 {
+            let updated = rank_r_update_clobber(
+                self.newton.as_mut(),
+                self.update_w.as_mut().subcols_mut(0, cols),
+                self.update_alpha
+                    .as_mut()
+                    .subrows_mut(0, cols)
+                    .as_diagonal_mut(),
+            );
+            if updated.is_err() {
+                // The factor is clobbered: the caller refactors.
+                self.newton_ok = false;
+                return false;
+            }
+        }
+        for &i in changed {
+            self.kc_factored[9 * i..9 * i + 9].copy_from_slice(&kc[9 * i..9 * i + 9]);
+        }
+        true
     }
     fn newton_solve_in_place(&mut self, x: &mut [f64]) {
         if !self.newton_ok {

@@ -705,3 +705,61 @@ fn bad_transient_options_are_errors() {
         assert!(err.to_string().contains(field), "{field}: {err}");
     }
 }
+
+/// A pair block of `K_c` as the mechanical problem builds it (normal entry, symmetric
+/// tangential 2 × 2, no coupling), N/mm.
+fn pair_block(kn: f64, t: [f64; 3]) -> [f64; 9] {
+    [kn, 0.0, 0.0, 0.0, t[0], t[1], 0.0, t[1], t[2]]
+}
+
+#[test]
+fn reduced_newton_update_equals_a_refactorization() {
+    let model = common::model("friction_bar");
+    let mut rom = reduced_model(&model, 60);
+    let (r, w) = (rom.dim(), rom.pairs());
+    let gamma = 2e-5;
+    let mut kc = vec![0.0; 9 * w];
+    for z in (0..w).step_by(3) {
+        let block = pair_block(1e4, [1e4, 0.0, 1e4]);
+        kc[9 * z..9 * z + 9].copy_from_slice(&block);
+    }
+    rom.newton_factor(gamma, &kc).unwrap();
+    // Close a pair, open one, let one slide (a sliding pair's symmetric tangent) and one
+    // whose tangent is diagonal change: up- and downdates of rank 1 and 2.
+    let changed = [1, 3, 6, 9];
+    kc[9..18].copy_from_slice(&pair_block(1e4, [1e4, 0.0, 1e4]));
+    kc[27..36].fill(0.0);
+    kc[54..63].copy_from_slice(&pair_block(1e4, [2.5e3, -1.2e3, 0.8e3]));
+    kc[81..90].copy_from_slice(&pair_block(1e4, [0.0, 0.0, 1e4]));
+    assert!(rom.newton_update(&kc, &changed), "the update was declined");
+    let x0: Vec<f64> = (0..r).map(|i| ((i * 7 + 3) % 11) as f64 - 5.0).collect();
+    let mut updated = x0.clone();
+    rom.newton_solve_in_place(&mut updated);
+    let mut fresh = reduced_model(&model, 60);
+    fresh.newton_factor(gamma, &kc).unwrap();
+    let mut refactored = x0;
+    fresh.newton_solve_in_place(&mut refactored);
+    let diff = updated
+        .iter()
+        .zip(&refactored)
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0, f64::max);
+    let scale = refactored.iter().map(|v| v.abs()).fold(0.0, f64::max);
+    assert!(
+        diff <= 1e-10 * scale,
+        "updated and refactored solves differ by {diff:.2e} (scale {scale:.2e})"
+    );
+    // A block that couples the normal and tangential rows is left to a refactorization.
+    let mut coupled = kc.clone();
+    coupled[9 * 12 + 1] = 1.0;
+    coupled[9 * 12 + 3] = 1.0;
+    assert!(!rom.newton_update(&coupled, &[12]));
+    // A change of higher rank than a factorization is worth (> r/6 columns) is declined.
+    let mut many = kc.clone();
+    // Each of these blocks changes by rank 3.
+    let closing: Vec<usize> = (0..w).filter(|z| z % 3 == 1).take(r / 18 + 1).collect();
+    for &z in &closing {
+        many[9 * z..9 * z + 9].copy_from_slice(&pair_block(2e4, [2e4, 5e3, 3e4]));
+    }
+    assert!(!rom.newton_update(&many, &closing));
+}

@@ -70,11 +70,12 @@
 //! iterate; pairs on the same branch are left as linearized) and first asks the system to
 //! update its factor by their blocks alone at the factored γ
 //! ([`SecondOrderSystem::newton_update`]): the full model does that exactly by a low-rank
-//! (capacitance) correction, without refactoring ([`crate::system::FullSystem`]). If the system
-//! declines (the reduced model, whose dense refactorization is cheap and re-linearizes every
-//! pair at the current γ, a better Newton matrix than an update at the factored γ, or a full
-//! correction), every pair is re-linearized and the matrix refactored at the current γ, as
-//! before. The pairs on a branch with a constant tangent (open, stick) are then exactly as a
+//! (capacitance) correction, without refactoring ([`crate::system::FullSystem`]), the reduced
+//! model by a rank update of its dense Cholesky factor when that costs less than a
+//! factorization ([`crate::system::ReducedSystem`]). If the system declines (a change of too
+//! high a rank, a full correction, a downdate that would lose definiteness), every pair is
+//! re-linearized and the matrix refactored at the current γ — a better Newton matrix than the
+//! update at the factored γ, which is why an update is only taken where it is cheaper. The pairs on a branch with a constant tangent (open, stick) are then exactly as a
 //! full re-linearization would leave them; the sliding ones keep the tangent of their last
 //! linearization.
 //!
