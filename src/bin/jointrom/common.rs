@@ -1,25 +1,35 @@
 //! Helpers the commands share: printing, flag checks, files.
 
 use std::path::Path;
-use std::sync::Mutex;
+use std::sync::{LazyLock, Mutex};
+use std::time::Instant;
 
 use jointrom::model::LoadOptions;
 use jointrom::{Error, Model};
 use serde_json::Value;
 
 /// Prints one pretty JSON document on stdout. A document of a command that loaded a model gains
-/// `"model_s"`: the wall time of reading and building the model (s), so that the end-to-end time
-/// of a command is visible beside its `offline_s` and `wall_s`.
+/// `"model_s"`: the wall time of reading and building the model (s), and every document
+/// `"total_s"` (where the command did not set its own): the wall time of the command up to this
+/// print (s), so that the end-to-end time of a command is visible beside its `offline_s` and
+/// `wall_s`.
 pub fn print_json(v: &Value) {
     let mut v = v.clone();
-    if let (Value::Object(map), Some(s)) = (&mut v, model_seconds()) {
-        map.entry("model_s").or_insert(Value::from(s));
+    if let Value::Object(map) = &mut v {
+        if let Some(s) = model_seconds() {
+            map.entry("model_s").or_insert(Value::from(s));
+        }
+        map.entry("total_s")
+            .or_insert(Value::from(COMMAND_START.elapsed().as_secs_f64()));
     }
     println!(
         "{}",
         serde_json::to_string_pretty(&v).expect("JSON values serialise")
     );
 }
+
+/// When the command started (the first use: `main` touches it before parsing the command line).
+pub static COMMAND_START: LazyLock<Instant> = LazyLock::new(Instant::now);
 
 /// Wall time of the model loads of this command, s (`None` before one).
 static MODEL_S: Mutex<Option<f64>> = Mutex::new(None);

@@ -8,12 +8,14 @@ mod common;
 mod summary;
 
 use std::process::ExitCode;
+use std::sync::LazyLock;
 
 use clap::Parser;
 
 use cli::Cli;
 
 fn main() -> ExitCode {
+    LazyLock::force(&common::COMMAND_START);
     quiet_broken_pipe();
     // Bit-identical results for any number of threads: faer's parallel kernels split their
     // sums by the thread count, so the dense linear algebra runs sequentially (the offline
