@@ -13,7 +13,9 @@
 //! with a coarser output step at its own outputs.
 //!
 //! Two file formats: CSV with a header naming the columns `t`, `contact_force_norm`,
-//! `friction_force_norm`, `master_uy` (others ignored, so a run's own `curves.csv` is a
+//! `friction_force_norm`, `master_uy` and optionally `dissipated`, each also with the unit a
+//! run's own `curves.csv` appends (`t_s`, `contact_force_norm_N`, `friction_force_norm_N`,
+//! `master_uy_mm`, `dissipated_Nmm`; other columns ignored, so a run's `curves.csv` is a
 //! reference), and the compact JSON of `cases/reference/compact.py` (arrays of those names).
 
 use std::path::Path;
@@ -66,6 +68,20 @@ const COLUMNS: [&str; 4] = [
     "friction_force_norm",
     "master_uy",
 ];
+
+/// The units a run's own `curves.csv` appends to [`COLUMNS`] (`t_s`, `contact_force_norm_N`, …:
+/// [`crate::report::curves::CURVE_COLUMNS`]).
+const COLUMN_UNITS: [&str; 4] = ["s", "N", "N", "mm"];
+
+/// The position of the CSV column `name`, or of `name_unit` as a run's `curves.csv` names it.
+fn column_position(header: &csv::StringRecord, name: &str, unit: &str) -> Option<usize> {
+    header.iter().position(|h| {
+        h == name
+            || h.strip_prefix(name)
+                .and_then(|rest| rest.strip_prefix('_'))
+                .is_some_and(|u| u == unit)
+    })
+}
 
 impl From<Curves> for JointCurves {
     /// The four compared curves of a run, taken from it.
@@ -130,10 +146,8 @@ impl JointCurves {
             .map_err(|e| bad(ReferenceProblem::Csv(e)))?
             .clone();
         let mut index = [0usize; 4];
-        for (slot, name) in index.iter_mut().zip(COLUMNS) {
-            *slot = header
-                .iter()
-                .position(|h| h == name)
+        for ((slot, name), unit) in index.iter_mut().zip(COLUMNS).zip(COLUMN_UNITS) {
+            *slot = column_position(&header, name, unit)
                 .ok_or_else(|| bad(ReferenceProblem::NoColumn { name }))?;
         }
         let mut cols: [Vec<f64>; 4] = Default::default();
@@ -156,7 +170,7 @@ impl JointCurves {
         }
         let [t, fc, fr, uy] = cols;
         JointCurves::checked(t, fc, fr, uy, what)
-            .map(|c| c.with_dissipated(optional_csv_column(text, "dissipated")))
+            .map(|c| c.with_dissipated(optional_csv_column(text, "dissipated", "Nmm")))
     }
 
     /// Parses the compact JSON form (`cases/reference/compact.py`): the curves at the top level,
@@ -329,15 +343,16 @@ fn relative_at(t_a: &[f64], a: &[f64], t_ref: &[f64], reference: &[f64], t: f64)
         .then(|| (a[i] - reference[j]).abs() / reference[j].abs())
 }
 
-/// An optional CSV column of `text` by name (empty if absent or not all finite numbers).
-fn optional_csv_column(text: &str, name: &str) -> Vec<f64> {
+/// An optional CSV column of `text` by name, or `name_unit` (empty if absent or not all finite
+/// numbers).
+fn optional_csv_column(text: &str, name: &str, unit: &str) -> Vec<f64> {
     let mut r = csv::ReaderBuilder::new()
         .trim(csv::Trim::All)
         .from_reader(text.as_bytes());
     let Some(i) = r
         .headers()
         .ok()
-        .and_then(|h| h.iter().position(|h| h == name))
+        .and_then(|h| column_position(h, name, unit))
     else {
         return Vec::new();
     };

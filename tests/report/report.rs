@@ -205,3 +205,33 @@ fn check_outputs(dir: &std::path::Path) {
         "g = 0 not drawn off scale"
     );
 }
+
+/// A run's own `curves.csv` (units in its column names) is a reference for `--reference`: read
+/// back, it compares with the run at zero error, the dissipated energy included.
+#[test]
+fn a_runs_curves_csv_is_a_reference() {
+    let t: Vec<f64> = (0..5).map(|k| 1e-4 * k as f64).collect();
+    let ramp = |s: f64| t.iter().map(|&x| s * x).collect::<Vec<f64>>();
+    let run = jointrom::integrate::Curves {
+        contact_force_norm: ramp(1e3),
+        friction_force_norm: ramp(2.5e2),
+        master_uy: ramp(-1.0),
+        kinetic: ramp(0.0),
+        strain: ramp(0.0),
+        pair: ramp(0.0),
+        external_work: ramp(0.0),
+        dissipated: ramp(10.0),
+        t: t.clone(),
+    };
+    let csv = jointrom::report::curves::curves_csv(&run).unwrap();
+    assert!(csv.starts_with("t_s,contact_force_norm_N"), "{csv}");
+    let reference = jointrom::rom::JointCurves::parse_csv(&csv, "curves.csv").unwrap();
+    assert_eq!(reference.t.len(), t.len());
+    let e = reference.errors(&run);
+    assert!(e.contact_force.unwrap() < 1e-9, "{e:?}");
+    assert!(
+        e.friction_force.unwrap() < 1e-9 && e.master_uy.unwrap() < 1e-9,
+        "{e:?}"
+    );
+    assert!(e.dissipated.unwrap() < 1e-9, "{e:?}");
+}
