@@ -1,5 +1,7 @@
 //! A reduced model (eq. 7) as a second-order system: `M̃ q̈ + K̃ q = Φᵀ f(t) − (BΦ)ᵀ p`, dense
-//! r × r, the Newton matrix `M̃ + γ²(K̃ + (BΦ)ᵀ K_c BΦ)` factored in place per setup.
+//! r × r, the Newton matrix `M̃ + γ²(K̃ + (BΦ)ᵀ K_c BΦ)` factored in place per setup — as a
+//! diagonal plus the joint's low-rank term when the basis is the reduced eigenbasis
+//! ([`super::modal_newton`]).
 
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::llt::factor::{
@@ -9,6 +11,7 @@ use faer::linalg::cholesky::llt::solve::solve_in_place_with_conj;
 use faer::linalg::matmul::matmul;
 use faer::{Accum, Conj, Mat, MatMut, Par};
 
+use super::modal_newton::{modal_diagonal, ModalNewton};
 use super::SecondOrderSystem;
 use crate::case::LoadSpec;
 use crate::error::{Error, SystemError};
@@ -62,6 +65,10 @@ pub struct ReducedSystem {
     m_llt: Mat<f64>,
     newton: Mat<f64>,
     newton_ok: bool,
+    /// The Newton factor as diagonal plus low rank when the basis is the reduced eigenbasis
+    /// ([`super::modal_newton`]), and whether the last setup used it.
+    modal: Option<ModalNewton>,
+    modal_used: bool,
     /// Scratch of the Newton setup: the rows of `BΦ` of the pairs with a non-zero `K_c` block
     /// (`active`) and `K_c (BΦ)` on them (`kcb`), up to 3w × r.
     active: Mat<f64>,
@@ -234,6 +241,7 @@ impl ReducedSystem {
             })?;
         }
         let w3 = b_phi.nrows();
+        let modal = modal_diagonal(&k, m_identity).map(|d| ModalNewton::new(d, w3));
         Ok(ReducedSystem {
             r,
             phi,
@@ -251,6 +259,8 @@ impl ReducedSystem {
             load,
             newton: Mat::zeros(r, r),
             newton_ok: false,
+            modal,
+            modal_used: false,
             active: Mat::zeros(w3, r),
             kcb: Mat::zeros(w3, r),
             mem,
@@ -276,6 +286,13 @@ impl ReducedSystem {
     /// unit coordinate.
     pub fn b_phi(&self) -> &Mat<f64> {
         &self.b_phi
+    }
+
+    /// Whether the Newton matrix is factored as a diagonal plus the joint's low-rank term when
+    /// it can be: a basis in the reduced eigenbasis (`M̃ = I`, `K̃` diagonal to rounding,
+    /// [`super::modal_newton`]). A setup with too many joint rows still factors densely.
+    pub fn modal_newton(&self) -> bool {
+        self.modal.is_some()
     }
 
     /// `Φᵀ f_master` (r): the generalized forces of the final master load (N, N·mm per unit
@@ -308,6 +325,8 @@ impl Clone for ReducedSystem {
             m_llt: self.m_llt.clone(),
             newton: Mat::zeros(self.r, self.r),
             newton_ok: false,
+            modal: self.modal.clone(),
+            modal_used: false,
             active: Mat::zeros(self.b_phi.nrows(), self.r),
             kcb: Mat::zeros(self.b_phi.nrows(), self.r),
             mem: MemBuffer::new(cholesky_in_place_scratch::<f64>(
@@ -403,6 +422,14 @@ impl SecondOrderSystem for ReducedSystem {
         let r = self.r;
         let g2 = gamma * gamma;
         self.newton_ok = false;
+        self.modal_used = false;
+        if let Some(modal) = &mut self.modal {
+            if modal.factor(gamma, kc, &self.b_rows) {
+                self.modal_used = true;
+                self.newton_ok = true;
+                return Ok(());
+            }
+        }
         for j in 0..r {
             for i in 0..r {
                 self.newton[(i, j)] = self.m[(i, j)] + g2 * self.k[(i, j)];
@@ -461,6 +488,12 @@ impl SecondOrderSystem for ReducedSystem {
         if !self.newton_ok {
             x.fill(f64::NAN);
             return;
+        }
+        if self.modal_used {
+            if let Some(modal) = &mut self.modal {
+                modal.solve_in_place(x);
+                return;
+            }
         }
         let rhs = MatMut::from_column_major_slice_mut(x, self.r, 1);
         solve_in_place_with_conj(
