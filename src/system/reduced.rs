@@ -289,8 +289,9 @@ impl ReducedSystem {
     }
 
     /// Whether the Newton matrix is factored as a diagonal plus the joint's low-rank term when
-    /// it can be: a basis in the reduced eigenbasis (`M̃ = I`, `K̃` diagonal to rounding,
-    /// [`super::modal_newton`]). A setup with too many joint rows still factors densely.
+    /// it can be: a basis in the reduced eigenbasis (`M̃ = I`, `K̃` diagonal to rounding; by
+    /// Woodbury through the joint's rows, see the module `system::modal_newton`). A setup with
+    /// too many joint rows still factors densely.
     pub fn modal_newton(&self) -> bool {
         self.modal.is_some()
     }
