@@ -31,6 +31,7 @@
 //! integrator drives both.
 
 mod full;
+mod modal_newton;
 mod reduced;
 
 pub use full::FullSystem;

@@ -1,5 +1,7 @@
 //! A reduced model (eq. 7) as a second-order system: `M̃ q̈ + K̃ q = Φᵀ f(t) − (BΦ)ᵀ p`, dense
-//! r × r, the Newton matrix `M̃ + γ²(K̃ + (BΦ)ᵀ K_c BΦ)` factored in place per setup.
+//! r × r, the Newton matrix `M̃ + γ²(K̃ + (BΦ)ᵀ K_c BΦ)` factored in place per setup — as a
+//! diagonal plus the joint's low-rank term when the basis is the reduced eigenbasis
+//! ([`super::modal_newton`]).
 //!
 //! ## Active-set refreshes by a rank update
 //!
@@ -9,9 +11,10 @@
 //! problem's blocks have none), so it is the normal entry and the tangential 2 × 2 block's two
 //! eigenpairs `λ v vᵀ` — at most three columns `w = γ_f (BΦ)_iᵀ v` with weights `λ` per pair.
 //! [`ReducedSystem::newton_update`](SecondOrderSystem::newton_update) applies them to the
-//! Cholesky factor as a rank-k up/downdate (faer's `rank_r_update_clobber`, ~2kr² flops) when
-//! that is cheaper than a factorization (r³/3 flops: k ≤ r/6), and declines otherwise, or when a
-//! downdate loses definiteness (the factor is then refactored). A refactorization re-linearizes
+//! dense Cholesky factor as a rank-k up/downdate (faer's `rank_r_update_clobber`, ~2kr² flops)
+//! when that is cheaper than a factorization (r³/3 flops: k ≤ r/6), and declines otherwise, when
+//! a downdate loses definiteness (the factor is then refactored) or when the setup used the
+//! eigenbasis factor (whose setup already costs the joint's rank, not r³). A refactorization re-linearizes
 //! every pair at the current γ, a better Newton matrix than the update at the factored γ, so
 //! the update is taken only where it saves the factorization's cost.
 
@@ -24,6 +27,7 @@ use faer::linalg::cholesky::llt::update::rank_r_update_clobber;
 use faer::linalg::matmul::matmul;
 use faer::{Accum, Col, Conj, Mat, MatMut, Par};
 
+use super::modal_newton::{modal_diagonal, ModalNewton};
 use super::SecondOrderSystem;
 use crate::case::LoadSpec;
 use crate::error::{Error, SystemError};
@@ -85,6 +89,10 @@ pub struct ReducedSystem {
     /// weights `α`, `A ← A + W diag(α) Wᵀ`.
     update_w: Mat<f64>,
     update_alpha: Col<f64>,
+    /// The Newton factor as diagonal plus low rank when the basis is the reduced eigenbasis
+    /// ([`super::modal_newton`]), and whether the last setup used it.
+    modal: Option<ModalNewton>,
+    modal_used: bool,
     /// Scratch of the Newton setup: the rows of `BΦ` of the pairs with a non-zero `K_c` block
     /// (`active`) and `K_c (BΦ)` on them (`kcb`), up to 3w × r.
     active: Mat<f64>,
@@ -281,6 +289,7 @@ impl ReducedSystem {
             })?;
         }
         let w3 = b_phi.nrows();
+        let modal = modal_diagonal(&k, m_identity).map(|d| ModalNewton::new(d, w3));
         Ok(ReducedSystem {
             r,
             phi,
@@ -302,6 +311,8 @@ impl ReducedSystem {
             kc_factored: vec![0.0; 3 * w3],
             update_w: Mat::zeros(r, w3),
             update_alpha: Col::zeros(w3),
+            modal,
+            modal_used: false,
             active: Mat::zeros(w3, r),
             kcb: Mat::zeros(w3, r),
             mem,
@@ -327,6 +338,14 @@ impl ReducedSystem {
     /// unit coordinate.
     pub fn b_phi(&self) -> &Mat<f64> {
         &self.b_phi
+    }
+
+    /// Whether the Newton matrix is factored as a diagonal plus the joint's low-rank term when
+    /// it can be: a basis in the reduced eigenbasis (`M̃ = I`, `K̃` diagonal to rounding; by
+    /// Woodbury through the joint's rows, see the module `system::modal_newton`). A setup with
+    /// too many joint rows still factors densely.
+    pub fn modal_newton(&self) -> bool {
+        self.modal.is_some()
     }
 
     /// `Φᵀ f_master` (r): the generalized forces of the final master load (N, N·mm per unit
@@ -363,6 +382,8 @@ impl Clone for ReducedSystem {
             kc_factored: vec![0.0; 3 * self.b_phi.nrows()],
             update_w: Mat::zeros(self.r, self.b_phi.nrows()),
             update_alpha: Col::zeros(self.b_phi.nrows()),
+            modal: self.modal.clone(),
+            modal_used: false,
             active: Mat::zeros(self.b_phi.nrows(), self.r),
             kcb: Mat::zeros(self.b_phi.nrows(), self.r),
             mem: MemBuffer::new(cholesky_in_place_scratch::<f64>(
@@ -458,6 +479,14 @@ impl SecondOrderSystem for ReducedSystem {
         let r = self.r;
         let g2 = gamma * gamma;
         self.newton_ok = false;
+        self.modal_used = false;
+        if let Some(modal) = &mut self.modal {
+            if modal.factor(gamma, kc, &self.b_rows) {
+                self.modal_used = true;
+                self.newton_ok = true;
+                return Ok(());
+            }
+        }
         for j in 0..r {
             for i in 0..r {
                 self.newton[(i, j)] = self.m[(i, j)] + g2 * self.k[(i, j)];
@@ -515,7 +544,8 @@ impl SecondOrderSystem for ReducedSystem {
         Ok(())
     }
     fn newton_update(&mut self, kc: &[f64], changed: &[usize]) -> bool {
-        if !self.newton_ok {
+        // The eigenbasis factor's setup is already of the joint's rank: it refactors.
+        if !self.newton_ok || self.modal_used {
             return false;
         }
         let r = self.r;
@@ -570,6 +600,12 @@ impl SecondOrderSystem for ReducedSystem {
         if !self.newton_ok {
             x.fill(f64::NAN);
             return;
+        }
+        if self.modal_used {
+            if let Some(modal) = &mut self.modal {
+                modal.solve_in_place(x);
+                return;
+            }
         }
         let rhs = MatMut::from_column_major_slice_mut(x, self.r, 1);
         solve_in_place_with_conj(

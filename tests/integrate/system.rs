@@ -763,3 +763,73 @@ fn reduced_newton_update_equals_a_refactorization() {
     }
     assert!(!rom.newton_update(&many, &closing));
 }
+
+/// The Newton factor of a reduced model in its eigenbasis (diagonal plus the joint's low-rank
+/// term, by Woodbury) solves the same system as the dense factor of the same basis rotated
+/// out of its eigenbasis (same span, `K̃` full): for a stuck pair, a sliding pair (a rank-two
+/// symmetric tangent) and no pair at all.
+#[test]
+fn modal_newton_factor_solves_like_the_dense_one() {
+    let model = common::model("friction_bar");
+    let phi = jointrom::reduction::build_basis(
+        &model,
+        jointrom::reduction::BasisKind::Tvd,
+        &jointrom::reduction::BasisOptions::default(),
+    )
+    .unwrap()
+    .phi;
+    let (phi, _) = jointrom::reduction::modal_rotation(&model, phi).unwrap();
+    let r = phi.ncols();
+    // An orthogonal Q (Householder reflection I − 2 v vᵀ / vᵀv): Φ Q is M-orthonormal with the
+    // same span, and Φ Q z' = Φ z for z = Q z'.
+    let mut rng = common::rng(0x9e37_79b9_7f4a_7c15);
+    let v: Vec<f64> = (0..r).map(|_| common::uniform(&mut rng)).collect();
+    let vv: f64 = v.iter().map(|x| x * x).sum();
+    let q = Mat::from_fn(r, r, |i, j| {
+        f64::from(u8::from(i == j)) - 2.0 * v[i] * v[j] / vv
+    });
+    let mut modal = ReducedSystem::new(&model, phi.clone()).unwrap();
+    let mut dense = ReducedSystem::new(&model, &phi * &q).unwrap();
+    assert!(modal.modal_newton(), "an eigenbasis takes the modal factor");
+    assert!(!dense.modal_newton(), "a rotated basis is factored densely");
+    let w = modal.pairs();
+    let (k_n, k_t) = (
+        model.contact.normal_stiffness,
+        model.contact.stick_stiffness,
+    );
+    let mut kc = vec![0.0; 9 * w];
+    kc[..9].copy_from_slice(&[k_n, 0.0, 0.0, 0.0, k_t, 0.0, 0.0, 0.0, k_t]);
+    let (u, s) = ([0.2, 0.9, -0.4], [0.0, 0.3, 0.95]);
+    for i in 0..3 {
+        for j in 0..3 {
+            kc[9 * (w / 2) + 3 * i + j] = k_n * u[i] * u[j] + 0.3 * k_t * s[i] * s[j];
+        }
+    }
+    for (blocks, what) in [
+        (kc, "a stuck and a sliding pair"),
+        (vec![0.0; 9 * w], "none"),
+    ] {
+        for gamma in [1e-6, 1e-4] {
+            let b: Vec<f64> = (0..r).map(|_| common::uniform(&mut rng)).collect();
+            modal.newton_factor(gamma, &blocks).unwrap();
+            let mut z = b.clone();
+            modal.newton_solve_in_place(&mut z);
+            // Qᵀ b = Q b (Q symmetric); z = Q z'.
+            let qb: Vec<f64> = (0..r)
+                .map(|i| (0..r).map(|j| q[(i, j)] * b[j]).sum())
+                .collect();
+            dense.newton_factor(gamma, &blocks).unwrap();
+            let mut zq = qb;
+            dense.newton_solve_in_place(&mut zq);
+            let back: Vec<f64> = (0..r)
+                .map(|i| (0..r).map(|j| q[(i, j)] * zq[j]).sum())
+                .collect();
+            let diff: Vec<f64> = z.iter().zip(&back).map(|(a, b)| a - b).collect();
+            let rel = inf_norm(&diff) / inf_norm(&z);
+            assert!(
+                rel < 1e-9,
+                "{what}, γ = {gamma:e}: relative difference {rel:.2e}"
+            );
+        }
+    }
+}

@@ -45,8 +45,10 @@
 //!
 //! The damping ratio of a slipping joint converges slowly with the tolerance: the stick–slip
 //! switches excite the joint's high-frequency dynamics, whose resolution adds dissipation
-//! (about +1 % per decade of atol between 1e-6 and 1e-8 on the friction bar; the validation
-//! docs compare models at one tolerance).
+//! (about +1 % per decade of atol between 1e-6 and 1e-8 on the friction bar, up to +5 % per
+//! decade in a gross slip of the multilayer sheet, where a model with the full model's stiff
+//! local modes converges more slowly than a reduced one; the validation docs compare models at
+//! one tolerance, and at a tighter one where the reference has not converged).
 //!
 //! ## Where a backbone stops meaning something
 //!
