@@ -635,9 +635,16 @@ impl Truncation {
             let mut d = -rho[(i, 0)] / w2;
             let mut slope_prev = 0.0;
             let mut rate = 0.0;
+            // The outputs are mostly equally spaced: the rotation of the last step again.
+            let mut step = (f64::NAN, 0.0, 1.0);
             out[(i, 0)] = d;
             for j in 0..outputs.saturating_sub(1) {
                 let h = t[j + 1] - t[j];
+                if h.to_bits() != step.0.to_bits() {
+                    let (sn, cs) = (w * h).sin_cos();
+                    step = (h, sn, cs);
+                }
+                let (sn, cs) = (step.1, step.2);
                 let slope = if h > 0.0 {
                     (rho[(i, j + 1)] - rho[(i, j)]) / h
                 } else {
@@ -645,7 +652,6 @@ impl Truncation {
                 };
                 rate -= (slope - slope_prev) / w2;
                 slope_prev = slope;
-                let (sn, cs) = (w * h).sin_cos();
                 let d_next = d * cs + rate / w * sn;
                 rate = -d * w * sn + rate * cs;
                 d = d_next;

@@ -155,6 +155,60 @@ pub fn add_truncation_check(
     Ok(())
 }
 
+/// Adds to the estimate of `run` (of the reduced system `rom`, at its options `opts`) the
+/// parts it lacks of those asked for: the truncation check ([`add_truncation_check`]) when
+/// `truncation`, the integration check ([`integration_errors`]) when `integration`. The two
+/// re-runs do not depend on each other and go beside each other (on a second core); each part
+/// is the one a check made beside the run would give, bit for bit.
+///
+/// # Errors
+/// A re-run's basis fails, or a re-run does not finish.
+pub fn add_checks(
+    model: &Model,
+    estimate: &mut RunEstimate,
+    run: &Run,
+    rom: ReducedSystem,
+    scene: &Scene,
+    opts: &TransientOptions,
+    checks: Checks,
+) -> Result<(), Error> {
+    let want_integration = checks.integration && estimate.integration.is_none();
+    let basis = match &estimate.truncation_basis {
+        Some(b) if checks.truncation && estimate.truncation.is_none() => Some(b),
+        _ => None,
+    };
+    let (integration, truncation) = beside(
+        || {
+            want_integration
+                .then(|| integration_check_run(rom, scene, opts))
+                .transpose()
+        },
+        || {
+            basis
+                .map(|b| {
+                    let rich = truncation_check_system_of(model, b)?;
+                    truncation_check_run(rich, scene, opts)
+                })
+                .transpose()
+        },
+    );
+    if let Some(check) = integration? {
+        estimate.integration = Some(integration_errors_from(&check, run, opts));
+    }
+    if let Some(check) = truncation? {
+        estimate.truncation = Some(curve_differences(&check, run, opts.problem.friction, 1.0));
+    }
+    estimate.update_total();
+    Ok(())
+}
+
+/// Drops the truncation part of an estimate (a check made beside the run that the caller does
+/// not use).
+pub fn drop_truncation(estimate: &mut RunEstimate) {
+    estimate.truncation = None;
+    estimate.update_total();
+}
+
 /// The integration part of a run's error estimate: the relative L2 differences `D` of its curves
 /// from a re-run of the same system at `F`× its rtol and atol ([`check_factor`]), divided by
 /// `|F^(2/3) − 1|` (BDF2, [`INTEGRATION_ORDER_EXPONENT`]; `|F − 1|` for a DIRK method,

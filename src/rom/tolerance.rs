@@ -67,11 +67,17 @@
 //! and ν grows when that part exceeds θ·TOL and the total misses.
 //!
 //! The last round's run is the result; its estimate then gains the integration part
-//! ([`super::estimate::integration_errors`]: one more run at 2× looser tolerances, its difference scaled to this
-//! run's error by the BDF2 error model — that run does not depend on the one it checks, so every
-//! round at the user's tolerances starts it beside its own run on a second thread, and a round
-//! that is not the last discards it), and `met` says whether the
-//! total meets TOL. When it does not — nothing left to add, or the integration error of the
+//! ([`super::estimate::integration_errors`]: one more run at other tolerances, its difference
+//! scaled to this run's error by the BDF2 error model), and `met` says whether the total meets
+//! TOL. Both checks are re-runs that do not depend on the run they check. A round makes them
+//! only if it may be the result (its correction meets TOL, or nothing is left to change), the
+//! two beside each other on a second core; a round *expected* to be the result starts them
+//! beside its own run instead: one that repeats the previous model (the ranking round's at the
+//! user's tolerances, or tighter ones), grows ν, or adds every attachment mode the previous
+//! estimate asked for (no cap cut the selection and no tangential modes wait for the normal
+//! ones). The expectation only moves work in time: a check made beside a run whose correction
+//! then misses TOL is dropped, and every estimate and model is the one the sequential order
+//! gives, bit for bit. When it does not — nothing left to add, or the integration error of the
 //! user's tolerances above TOL — the best model is returned with `met = false` (the CLI warns;
 //! tighter `--rtol/--atol` lower the integration floor).
 
@@ -91,7 +97,7 @@ use crate::reduction::{
     Quantity, DEFAULT_DROP_TOL,
 };
 use crate::rom::estimate::{
-    add_truncation_check, beside, loosened, run_estimated_with, Checks, RunEstimate,
+    add_checks, beside, drop_truncation, loosened, run_estimated_with, Checks, RunEstimate,
 };
 use crate::rom::statics::{reduced_contact_static_restarting, scaled_load, ReducedStatic};
 use crate::system::{ReducedSystem, Scene};
@@ -239,6 +245,9 @@ pub struct ToleranceModel {
     pub estimate_s: f64,
     /// The transient options of the result's run (the integration tolerances chosen).
     pub transient: TransientOptions,
+    /// CPU time of the process over the whole tolerance model (setup, rounds, the result's
+    /// run and estimate; every thread, including other work the process does meanwhile), s.
+    pub cpu_s: f64,
 }
 
 /// What the tolerance model chose, as the outputs report it (`"tolerance"` in a run's JSON).
@@ -261,6 +270,9 @@ pub struct ToleranceChoice {
     pub setup_s: f64,
     /// Wall time of the result's estimate after its run, s.
     pub estimate_s: f64,
+    /// CPU time of the process over the whole tolerance model (offline, online and the
+    /// result's estimate; every thread), s.
+    pub cpu_s: f64,
     /// Every round, the last one the result.
     pub rounds: Vec<Round>,
     /// The integration tolerances of the result's run: CVODE's rtol and atol (mm).
@@ -281,6 +293,7 @@ pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<Toleran
     check_tolerance(tol)?;
     let on = controlled_quantities(opts.quantities, opts.transient.problem.friction)?;
     let start = Instant::now();
+    let cpu_start = process_cpu_s();
     let mut nu = opts.nu;
     let (flex, cb) = beside(|| JointFlexibility::new(model), || craig_bampton(model, nu));
     let (flex, mut cb) = (flex?, cb?);
@@ -289,6 +302,8 @@ pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<Toleran
     let mut rounds = Vec::new();
     // The Craig–Bampton round only ranks the pairs: looser tolerances (module docs).
     let mut ranking = true;
+    // Whether the round is expected to be the result (its checks then go beside its run).
+    let mut expect_result = false;
     // The integration tolerances: the user's, or the paper's times s (integration_looseness).
     let mut looseness = match opts.integration {
         IntegrationTolerances::FromTolerance => integration_looseness_for(tol, on),
@@ -302,12 +317,13 @@ pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<Toleran
             &opts.transient,
             looseness * if ranking { RANKING_LOOSENING } else { 1.0 },
         );
-        // Any round at the user's tolerances may be the result: its integration check runs
-        // beside it (on a second core; unused when the round is not the last).
+        // A round expected to be the result makes its two checks beside its run (on a second
+        // core); any other round makes them after its correction, only if it may be the result.
         let scene = Scene::of(model);
+        let speculate = !ranking && expect_result;
         let checks = Checks {
-            integration: !ranking,
-            truncation: false,
+            integration: speculate,
+            truncation: speculate,
         };
         let (run, estimate) = run_estimated_with(
             model,
@@ -321,9 +337,24 @@ pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<Toleran
         let run = run.into_result()?;
         let mut estimate = estimate?;
         // A round whose correction meets the tolerance may be the result: the truncation
-        // check's re-run (the next fixed-interface modes) decides (module docs).
+        // check's re-run (the next fixed-interface modes) decides (module docs), and its
+        // integration check goes beside it.
         if !ranking && worst(&estimate.reduction, on) <= tol {
-            add_truncation_check(model, &mut estimate, &run, &scene, &transient)?;
+            let both = Checks {
+                integration: true,
+                truncation: true,
+            };
+            add_checks(
+                model,
+                &mut estimate,
+                &run,
+                rom.clone(),
+                &scene,
+                &transient,
+                both,
+            )?;
+        } else if estimate.truncation.is_some() {
+            drop_truncation(&mut estimate);
         }
         let eta = worst(&estimate.model_error(), on);
         let d = &estimate.detail;
@@ -344,8 +375,13 @@ pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<Toleran
             ranking,
         });
         let mut changed = false;
+        // The next round repeats this model (tighter) or changes it where the estimate
+        // asked for no more than the round adds: expected to be the result.
+        expect_result = true;
         if eta > tol && rounds.len() < opts.max_rounds {
-            changed = chosen.enrich(&estimate, on, tol, cb.ncols());
+            let enriched = chosen.enrich(&estimate, on, tol, cb.ncols());
+            changed = enriched.changed;
+            expect_result = enriched.complete;
             // The truncated modes are driven by the run's contact forces: while those are wrong
             // the truncation part is too, so ν grows only once the joint part is within its share.
             let part = SELECTION_MARGIN * tol;
@@ -357,12 +393,30 @@ pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<Toleran
                 nu += NU_STEP;
                 cb = craig_bampton(model, nu)?;
                 changed = true;
+                expect_result = true;
             }
         }
         let was_ranking = std::mem::replace(&mut ranking, false);
         if !changed && was_ranking {
             // A ranking run is never the result: the same model again at the user's tolerances.
             continue;
+        }
+        if !changed && estimate.integration.is_none() {
+            // The result, or the same model again if its integration misses: its integration
+            // check (when the correction missed, no round made it).
+            let only = Checks {
+                integration: true,
+                truncation: false,
+            };
+            add_checks(
+                model,
+                &mut estimate,
+                &run,
+                rom.clone(),
+                &scene,
+                &transient,
+                only,
+            )?;
         }
         // The estimate misses the tolerance at loosened integration tolerances: the same model
         // again, ten times tighter (the reduction part is within its share, or the loop would
@@ -389,9 +443,17 @@ pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<Toleran
                 offline_s,
                 estimate_s,
                 transient,
+                cpu_s: process_cpu_s() - cpu_start,
             });
         }
     }
+}
+
+/// CPU time of the process (every thread), s (NaN where unavailable).
+fn process_cpu_s() -> f64 {
+    cpu_time::ProcessTime::try_now()
+        .map(|t| t.as_duration().as_secs_f64())
+        .unwrap_or(f64::NAN)
 }
 
 /// The quantities a tolerance model controls: `asked` (`None`: all the run produces), checked
@@ -446,8 +508,15 @@ impl Chosen {
     /// docs, "Choosing S"): normal ones while the joint part of the ‖f_c‖ estimate (or of u_y)
     /// exceeds its share and a controlled quantity depends on the normal forces, tangential ones
     /// while the joint part of the ‖f_R‖ estimate exceeds its share and ‖f_R‖ or D is
-    /// controlled. Returns whether anything was added.
-    fn enrich(&mut self, estimate: &RunEstimate, on: Quantities, tol: f64, cb_size: usize) -> bool {
+    /// controlled. Returns whether anything was added, and whether that is all the estimate
+    /// asked for (no cap cut the selection, no tangential modes wait for the normal ones).
+    fn enrich(
+        &mut self,
+        estimate: &RunEstimate,
+        on: Quantities,
+        tol: f64,
+        cb_size: usize,
+    ) -> Enriched {
         let d = &estimate.detail;
         let part = SELECTION_MARGIN * tol;
         let normal_matters = [
@@ -461,8 +530,12 @@ impl Chosen {
             || (on.contains(Quantity::MasterUy)
                 && estimate.reduction.master_uy.unwrap_or(0.0) > part);
         let mut changed = false;
+        let mut complete = false;
+        let friction_matters =
+            on.contains(Quantity::FrictionForce) || on.contains(Quantity::Dissipation);
+        let wants_tangential = friction_matters && d.joint_friction.unwrap_or(0.0) > part;
         if wants_normal {
-            if let Some(add) = more_pairs(
+            if let Some((add, all)) = more_pairs(
                 &d.pair_error,
                 d.corrected_joint_norm2,
                 |k| self.pairs.contains(&k),
@@ -472,16 +545,15 @@ impl Chosen {
                 self.pairs.extend(add);
                 self.pairs.sort_unstable();
                 changed = true;
+                complete = all && !wants_tangential;
             }
         }
-        let friction_matters =
-            on.contains(Quantity::FrictionForce) || on.contains(Quantity::Dissipation);
         // The cone of a pair's friction force is μ|p_n|: while the normal forces are being
         // corrected, the tangential errors are theirs, so tangential modes wait for them.
-        if !changed && friction_matters && d.joint_friction.unwrap_or(0.0) > part {
+        if !changed && wants_tangential {
             let tangential = &self.tangential;
             let held = |k: usize| tangential.iter().filter(|&&j| j == k).count();
-            if let Some(add) = more_pairs(
+            if let Some((add, all)) = more_pairs(
                 &d.pair_tangential_error,
                 d.corrected_joint_friction_norm2,
                 |k| held(k) >= 2,
@@ -496,10 +568,20 @@ impl Chosen {
                     self.tangential.push(k);
                 }
                 changed = true;
+                complete = all;
             }
         }
-        changed
+        Enriched { changed, complete }
     }
+}
+
+/// What [`Chosen::enrich`] did.
+#[derive(Clone, Copy, Debug)]
+struct Enriched {
+    /// Attachment modes were added.
+    changed: bool,
+    /// They are all the estimate asked for: the next round is expected to meet the tolerance.
+    complete: bool,
 }
 
 /// The principal direction of the moments `[Σ p_1², Σ p_1 p_2, Σ p_2²]` of a pair's tangential
@@ -568,13 +650,14 @@ fn reduced_on(
 /// The pairs to add after a round whose estimate missed `tol` (module docs, step 3): ranked by
 /// their shares `errors` of the estimate (N², against the corrected curve's `norm2`), those not
 /// `held` already, at most `cap` of them; `None` when no pair outside carries any of the error.
+/// The flag says whether the pairs left out are within their share (the cap did not cut).
 fn more_pairs(
     errors: &[f64],
     norm2: f64,
     held: impl Fn(usize) -> bool,
     tol: f64,
     cap: usize,
-) -> Option<Vec<usize>> {
+) -> Option<(Vec<usize>, bool)> {
     let mut cand: Vec<(usize, f64)> = errors
         .iter()
         .enumerate()
@@ -595,7 +678,8 @@ fn more_pairs(
         add.push(k);
         left -= e;
     }
-    (!add.is_empty()).then_some(add)
+    let all = left <= allowed;
+    (!add.is_empty()).then_some((add, all))
 }
 
 /// The tolerance-chosen model of the contact statics ([`static_tolerance_model`]).

@@ -12,7 +12,9 @@ use jointrom::reduction::{
     build_basis, BasisKind, BasisOptions, JointFlexibility, Quantities, Quantity, RunStates,
 };
 use jointrom::rom::compare::JointCurves;
-use jointrom::rom::estimate::{add_truncation_check, integration_errors, pair_law, run_estimated};
+use jointrom::rom::estimate::{
+    add_checks, add_truncation_check, integration_errors, pair_law, run_estimated, Checks,
+};
 use jointrom::rom::tolerance::{static_tolerance_model, tolerance_model, ToleranceOptions};
 use jointrom::system::{ReducedSystem, Scene};
 
@@ -352,6 +354,7 @@ fn concurrent_integration_check_equals_the_sequential_one() {
     let run = run.into_result().unwrap();
     let est = est.unwrap();
     let beside = est.integration.unwrap();
+    let rom_again = rom.clone();
     let after = integration_errors(rom, &scene, &opts, &run).unwrap();
     assert_eq!(beside.contact_force, after.contact_force);
     assert_eq!(beside.friction_force, after.friction_force);
@@ -365,6 +368,19 @@ fn concurrent_integration_check_equals_the_sequential_one() {
     assert_eq!(later.truncation, Some(truncation));
     assert_eq!(later.total, est.total);
     assert!(truncation.master_uy.unwrap() > 0.0);
+    // Both checks made after the run, beside each other, equal the ones made beside the run
+    // (what the tolerance model relies on when it moves them).
+    let mut both = est.clone();
+    both.truncation = None;
+    both.integration = None;
+    let checks = Checks {
+        integration: true,
+        truncation: true,
+    };
+    add_checks(&m, &mut both, &run, rom_again, &scene, &opts, checks).unwrap();
+    assert_eq!(both.truncation, est.truncation);
+    assert_eq!(both.integration, est.integration);
+    assert_eq!(both.total, est.total);
 }
 
 /// The estimate of a fixed model (the paper's a-priori TVD, Craig–Bampton alone, g = 0, and the
