@@ -211,6 +211,24 @@ pub struct Round {
     pub estimate_s: f64,
     /// The round only ranked the pairs: its run at [`RANKING_LOOSENING`]× looser tolerances.
     pub ranking: bool,
+    /// Where the round made its re-runs (the truncation and integration checks).
+    pub checks: ReRuns,
+}
+
+/// Where a round of [`tolerance_model`] made its re-runs, the truncation and integration checks
+/// (module docs): `"checks"` of a round in the JSON.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ReRuns {
+    /// None: its correction missed the tolerance and it was not the result (or it ranked).
+    None,
+    /// Beside its run: it was expected to be the result.
+    BesideRun,
+    /// Beside its run, and the truncation part dropped: its correction missed the tolerance
+    /// (the integration part is kept, should the round still be the result).
+    Dropped,
+    /// After its correction (which met the tolerance), or as the result.
+    AfterCorrection,
 }
 
 /// The tolerance-chosen reduced model and its run.
@@ -241,7 +259,8 @@ pub struct ToleranceModel {
     /// flexibility, the earlier rounds' runs and estimates, the result's basis), s.
     pub offline_s: f64,
     /// Wall time of the result's estimate after its run: the quasi-static joint correction and
-    /// the wait for the integration check (which runs beside the run on a second thread), s.
+    /// the truncation and integration checks (or the wait for them, when they ran beside the
+    /// run), s.
     pub estimate_s: f64,
     /// The transient options of the result's run (the integration tolerances chosen).
     pub transient: TransientOptions,
@@ -339,7 +358,15 @@ pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<Toleran
         // A round whose correction meets the tolerance may be the result: the truncation
         // check's re-run (the next fixed-interface modes) decides (module docs), and its
         // integration check goes beside it.
+        let mut made = if speculate {
+            ReRuns::BesideRun
+        } else {
+            ReRuns::None
+        };
         if !ranking && worst(&estimate.reduction, on) <= tol {
+            if !speculate {
+                made = ReRuns::AfterCorrection;
+            }
             let both = Checks {
                 integration: true,
                 truncation: true,
@@ -353,8 +380,9 @@ pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<Toleran
                 &transient,
                 both,
             )?;
-        } else if estimate.truncation.is_some() {
+        } else if speculate {
             drop_truncation(&mut estimate);
+            made = ReRuns::Dropped;
         }
         let eta = worst(&estimate.model_error(), on);
         let d = &estimate.detail;
@@ -373,6 +401,7 @@ pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<Toleran
             basis_s,
             estimate_s: round_start.elapsed().as_secs_f64() - basis_s - run.wall_s,
             ranking,
+            checks: made,
         });
         let mut changed = false;
         // The next round repeats this model (tighter) or changes it where the estimate
@@ -417,6 +446,10 @@ pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<Toleran
                 &transient,
                 only,
             )?;
+            if let Some(last) = rounds.last_mut() {
+                last.estimate_s = round_start.elapsed().as_secs_f64() - basis_s - run.wall_s;
+                last.checks = ReRuns::AfterCorrection;
+            }
         }
         // The estimate misses the tolerance at loosened integration tolerances: the same model
         // again, ten times tighter (the reduction part is within its share, or the loop would

@@ -15,7 +15,7 @@ use jointrom::rom::compare::JointCurves;
 use jointrom::rom::estimate::{
     add_checks, add_truncation_check, integration_errors, pair_law, run_estimated, Checks,
 };
-use jointrom::rom::tolerance::{static_tolerance_model, tolerance_model, ToleranceOptions};
+use jointrom::rom::tolerance::{static_tolerance_model, tolerance_model, ReRuns, ToleranceOptions};
 use jointrom::system::{ReducedSystem, Scene};
 
 use crate::common::{jointrom_err, jointrom_json, model, reference_json};
@@ -139,11 +139,12 @@ fn tolerance_model_meets_the_stored_full_reference() {
 
 /// The lap joint (`cases/lap_joint.json`: unequal sheets, off-node welds, its own load; not a
 /// scene the estimator was built on) at TOL 1e-2: met, every true error within it (D's too),
-/// the estimates of ‖f_c‖, ‖f_R‖ and u_y within 0.5–10× of their true errors. D's estimate is
-/// not asserted: its true error, a constant offset of 2.0e-4 from t ≈ 0.02 s on (the stored
-/// reference is 6e-6 from a run at rtol 1e-9), is estimated at 0.34× over the run and 0.22× at
-/// the end since the correction sums D with its own slip (0.69× and 0.49× before, with the
-/// run's slip, which read 18–37× elsewhere; docs/validation/error-control.md).
+/// the estimates of ‖f_c‖, ‖f_R‖ and u_y within 0.5–10× of their true errors, and the result
+/// carries both re-runs' parts. D's estimate is not asserted: its true error, 1.9e-4 drifting in
+/// from t ≈ 0.02 s on (the stored reference is 6e-6 from a run at rtol 1e-9), is estimated at
+/// 0.32× over the run and 0.21× at the end — about half of it is fixed-interface truncation that
+/// the truncation check under-reads, the rest below the quadrature of D over the output states
+/// (docs/validation/error-control.md).
 #[test]
 fn tolerance_model_meets_the_lap_joint_reference() {
     let m =
@@ -153,6 +154,15 @@ fn tolerance_model_meets_the_lap_joint_reference() {
     let reference = JointCurves::read(&path).unwrap();
     let t = tolerance_model(&m, &ToleranceOptions::new(1e-2)).unwrap();
     assert!(t.met, "not met ({:?})", t.estimate.total);
+    assert!(t.estimate.integration.is_some() && t.estimate.truncation.is_some());
+    // Only the result made the re-runs (no round threw an integration check away).
+    let (last, earlier) = t.rounds.split_last().unwrap();
+    assert_ne!(last.checks, ReRuns::None);
+    assert!(
+        earlier.iter().all(|r| r.checks == ReRuns::None),
+        "{:?}",
+        t.rounds.iter().map(|r| r.checks).collect::<Vec<_>>()
+    );
     let truth = reference.errors(&t.run.curves);
     let est = &t.estimate.total;
     assert!(truth.dissipated_end.unwrap() <= 1e-2);
