@@ -112,6 +112,24 @@ pub struct Checks {
     pub truncation: bool,
 }
 
+impl Checks {
+    /// Both re-runs.
+    pub const BOTH: Checks = Checks {
+        integration: true,
+        truncation: true,
+    };
+    /// No re-run.
+    pub const NONE: Checks = Checks {
+        integration: false,
+        truncation: false,
+    };
+    /// The integration check alone.
+    pub const INTEGRATION: Checks = Checks {
+        integration: true,
+        truncation: false,
+    };
+}
+
 impl RunEstimate {
     /// The error of the reduced model alone: the reduction and truncation parts (root sum of
     /// squares), without the integration part.

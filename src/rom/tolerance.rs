@@ -340,9 +340,10 @@ pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<Toleran
         // core); any other round makes them after its correction, only if it may be the result.
         let scene = Scene::of(model);
         let speculate = !ranking && expect_result;
-        let checks = Checks {
-            integration: speculate,
-            truncation: speculate,
+        let checks = if speculate {
+            Checks::BOTH
+        } else {
+            Checks::NONE
         };
         let (run, estimate) = run_estimated_with(
             model,
@@ -355,35 +356,9 @@ pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<Toleran
         )?;
         let run = run.into_result()?;
         let mut estimate = estimate?;
-        // A round whose correction meets the tolerance may be the result: the truncation
-        // check's re-run (the next fixed-interface modes) decides (module docs), and its
-        // integration check goes beside it.
-        let mut made = if speculate {
-            ReRuns::BesideRun
-        } else {
-            ReRuns::None
-        };
-        if !ranking && worst(&estimate.reduction, on) <= tol {
-            if !speculate {
-                made = ReRuns::AfterCorrection;
-            }
-            let both = Checks {
-                integration: true,
-                truncation: true,
-            };
-            add_checks(
-                model,
-                &mut estimate,
-                &run,
-                rom.clone(),
-                &scene,
-                &transient,
-                both,
-            )?;
-        } else if speculate {
-            drop_truncation(&mut estimate);
-            made = ReRuns::Dropped;
-        }
+        let candidate = !ranking && worst(&estimate.reduction, on) <= tol;
+        let recheck = (&rom, &run, &scene, &transient);
+        let made = round_checks(model, recheck, &mut estimate, speculate, candidate)?;
         let eta = worst(&estimate.model_error(), on);
         let d = &estimate.detail;
         rounds.push(Round {
@@ -433,18 +408,15 @@ pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<Toleran
         if !changed && estimate.integration.is_none() {
             // The result, or the same model again if its integration misses: its integration
             // check (when the correction missed, no round made it).
-            let only = Checks {
-                integration: true,
-                truncation: false,
-            };
+            let (rom, run, scene, opts) = recheck;
             add_checks(
                 model,
                 &mut estimate,
-                &run,
+                run,
                 rom.clone(),
-                &scene,
-                &transient,
-                only,
+                scene,
+                opts,
+                Checks::INTEGRATION,
             )?;
             if let Some(last) = rounds.last_mut() {
                 last.estimate_s = round_start.elapsed().as_secs_f64() - basis_s - run.wall_s;
@@ -479,6 +451,32 @@ pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<Toleran
                 cpu_s: process_cpu_s() - cpu_start,
             });
         }
+    }
+}
+
+/// The re-runs of a round (module docs), given as its system, run, scene and transient options:
+/// a round whose correction meets the tolerance (`candidate`) may be the result, so the
+/// truncation check's re-run decides (the next fixed-interface modes) and its integration check
+/// goes beside it — already made beside the run when `speculate`; a speculative truncation part
+/// of a round that is no candidate is dropped. Returns where the re-runs were made.
+fn round_checks(
+    model: &Model,
+    (rom, run, scene, opts): (&ReducedSystem, &Run, &Scene, &TransientOptions),
+    estimate: &mut RunEstimate,
+    speculate: bool,
+    candidate: bool,
+) -> Result<ReRuns, Error> {
+    match (candidate, speculate) {
+        (true, true) => Ok(ReRuns::BesideRun),
+        (true, false) => {
+            add_checks(model, estimate, run, rom.clone(), scene, opts, Checks::BOTH)?;
+            Ok(ReRuns::AfterCorrection)
+        }
+        (false, true) => {
+            drop_truncation(estimate);
+            Ok(ReRuns::Dropped)
+        }
+        (false, false) => Ok(ReRuns::None),
     }
 }
 
