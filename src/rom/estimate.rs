@@ -10,11 +10,12 @@
 //!   ([`crate::reduction::estimate`]): the pair forces the full model would carry under the
 //!   reduced run's own motion, from the exact pair-space flexibility;
 //! - the **truncation** part ([`truncation_check_run`]): the run against a re-run of a richer
-//!   model, its basis and the next fixed-interface modes ([`TRUNCATION_CHECK_MODES`]) beyond
-//!   it. The correction above treats those modes quasi-statically plus a first-order dynamic
-//!   excess, driven by the run's own forces: it cannot see that they change the pair forces,
-//!   through them the friction's damping and through that the global motion and the dissipated
-//!   energy. The re-run sees it, as the next step of the tolerance model's ν would;
+//!   model, its basis and every fixed-interface mode the estimator holds beyond it (the lowest
+//!   [`TRUNCATION_MODES`]). The correction above treats those modes quasi-statically plus a
+//!   first-order dynamic excess, driven by the run's own forces: it cannot see that they change
+//!   the pair forces, through them the friction's damping and through that the global motion
+//!   and the dissipated energy. The re-run sees it — for all of them, since the modes that
+//!   carry a scene's error need not be the next ν step's;
 //! - the **integration** part ([`integration_errors`]): the run against a re-run of the same
 //!   system at other tolerances ([`check_factor`]), scaled to the run's own error by the BDF2
 //!   error model.
@@ -39,7 +40,7 @@ use crate::integrate::{integrate, ProblemOptions, Run, TransientOptions};
 use crate::joint::law::PairLaw;
 use crate::model::Model;
 #[cfg(doc)]
-use crate::reduction::estimate::TRUNCATION_CHECK_MODES;
+use crate::reduction::estimate::TRUNCATION_MODES;
 use crate::reduction::{
     modal_rotation, CurveErrors, ErrorEstimator, Estimate, JointFlexibility, RunStates,
 };
@@ -335,7 +336,7 @@ fn curve_differences(check: &Run, run: &Run, friction: bool, scale: f64) -> Curv
 }
 
 /// The reduced system of the truncation check of `estimator`'s model: its basis Φ and the
-/// next [`TRUNCATION_CHECK_MODES`] fixed-interface modes beyond it
+/// truncated fixed-interface modes beyond it (of the lowest [`TRUNCATION_MODES`])
 /// ([`ErrorEstimator::truncation_check_basis`]), M-orthonormalized and rotated to the reduced
 /// eigenbasis like every basis; `None` when no mode is beyond Φ.
 pub fn truncation_check_system(

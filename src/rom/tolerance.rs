@@ -62,9 +62,9 @@
 //! the same round as the pairs would make every model [`NU_STEP`] columns larger for nothing.
 //! The rounds' e_k come from the joint part alone, so truncation does not masquerade as pair
 //! error. A round whose correction meets TOL may be the result: it also gets the estimate's
-//! truncation check ([`super::estimate::add_truncation_check`], a re-run with the next
-//! [`NU_STEP`] fixed-interface modes, which sees their back-coupling into the global motion),
-//! and ν grows when that part exceeds θ·TOL and the total misses.
+//! truncation check ([`super::estimate::add_truncation_check`], a re-run with every truncated
+//! fixed-interface mode the estimator holds, which sees their back-coupling into the global
+//! motion), and ν grows when that part exceeds θ·TOL and the total misses.
 //!
 //! The last round's run is the result; its estimate then gains the integration part
 //! ([`super::estimate::integration_errors`]: one more run at other tolerances, its difference
@@ -89,7 +89,7 @@ use crate::error::{Error, RomError};
 use crate::integrate::{Run, TransientOptions};
 use crate::joint::statics::ContactOptions;
 use crate::model::Model;
-use crate::reduction::estimate::{TRUNCATION_CHECK_MODES, TRUNCATION_MODES};
+use crate::reduction::estimate::TRUNCATION_MODES;
 #[cfg(doc)]
 use crate::reduction::Estimate;
 use crate::reduction::{
@@ -626,10 +626,10 @@ fn main_direction(m: [f64; 3]) -> [f64; 2] {
 /// estimate only ranks the pairs (module docs, "Choosing S").
 pub const RANKING_LOOSENING: f64 = 10.0;
 
-/// Fixed-interface modes added to ν when the truncation part of the estimate exceeds its share:
-/// the modes the estimate's truncation check adds ([`TRUNCATION_CHECK_MODES`]), so the check
-/// measures what this step removes.
-pub const NU_STEP: usize = TRUNCATION_CHECK_MODES;
+/// Fixed-interface modes added to ν when the truncation part of the estimate exceeds its share
+/// (the paper's ν = 10 at a time; the truncation check then measures the modes beyond the new
+/// ν again).
+pub const NU_STEP: usize = 10;
 
 /// The largest ν the enrichment uses: [`TRUNCATION_MODES`] − [`NU_STEP`], so that the estimate
 /// still checks [`NU_STEP`] modes beyond the basis.
