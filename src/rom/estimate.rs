@@ -10,11 +10,12 @@
 //!   ([`crate::reduction::estimate`]): the pair forces the full model would carry under the
 //!   reduced run's own motion, from the exact pair-space flexibility;
 //! - the **truncation** part ([`truncation_check_run`]): the run against a re-run of a richer
-//!   model, its basis and the next fixed-interface modes ([`TRUNCATION_CHECK_MODES`]) beyond
-//!   it. The correction above treats those modes quasi-statically plus a first-order dynamic
-//!   excess, driven by the run's own forces: it cannot see that they change the pair forces,
-//!   through them the friction's damping and through that the global motion and the dissipated
-//!   energy. The re-run sees it, as the next step of the tolerance model's ν would;
+//!   model, its basis and every fixed-interface mode the estimator holds beyond it (the lowest
+//!   [`TRUNCATION_MODES`]). The correction above treats those modes quasi-statically plus a
+//!   first-order dynamic excess, driven by the run's own forces: it cannot see that they change
+//!   the pair forces, through them the friction's damping and through that the global motion
+//!   and the dissipated energy. The re-run sees it — for all of them, since the modes that
+//!   carry a scene's error need not be the next ν step's;
 //! - the **integration** part ([`integration_errors`]): the run against a re-run of the same
 //!   system at other tolerances ([`check_factor`]), scaled to the run's own error by the BDF2
 //!   error model.
@@ -39,7 +40,7 @@ use crate::integrate::{integrate, ProblemOptions, Run, TransientOptions};
 use crate::joint::law::PairLaw;
 use crate::model::Model;
 #[cfg(doc)]
-use crate::reduction::estimate::TRUNCATION_CHECK_MODES;
+use crate::reduction::estimate::TRUNCATION_MODES;
 use crate::reduction::{
     modal_rotation, CurveErrors, ErrorEstimator, Estimate, JointFlexibility, RunStates,
 };
@@ -112,6 +113,24 @@ pub struct Checks {
     pub truncation: bool,
 }
 
+impl Checks {
+    /// Both re-runs.
+    pub const BOTH: Checks = Checks {
+        integration: true,
+        truncation: true,
+    };
+    /// No re-run.
+    pub const NONE: Checks = Checks {
+        integration: false,
+        truncation: false,
+    };
+    /// The integration check alone.
+    pub const INTEGRATION: Checks = Checks {
+        integration: true,
+        truncation: false,
+    };
+}
+
 impl RunEstimate {
     /// The error of the reduced model alone: the reduction and truncation parts (root sum of
     /// squares), without the integration part.
@@ -153,6 +172,60 @@ pub fn add_truncation_check(
     estimate.truncation = Some(curve_differences(&check, run, opts.problem.friction, 1.0));
     estimate.update_total();
     Ok(())
+}
+
+/// Adds to the estimate of `run` (of the reduced system `rom`, at its options `opts`) the
+/// parts it lacks of those asked for: the truncation check ([`add_truncation_check`]) when
+/// `truncation`, the integration check ([`integration_errors`]) when `integration`. The two
+/// re-runs do not depend on each other and go beside each other (on a second core); each part
+/// is the one a check made beside the run would give, bit for bit.
+///
+/// # Errors
+/// A re-run's basis fails, or a re-run does not finish.
+pub fn add_checks(
+    model: &Model,
+    estimate: &mut RunEstimate,
+    run: &Run,
+    rom: ReducedSystem,
+    scene: &Scene,
+    opts: &TransientOptions,
+    checks: Checks,
+) -> Result<(), Error> {
+    let want_integration = checks.integration && estimate.integration.is_none();
+    let basis = match &estimate.truncation_basis {
+        Some(b) if checks.truncation && estimate.truncation.is_none() => Some(b),
+        _ => None,
+    };
+    let (integration, truncation) = beside(
+        || {
+            want_integration
+                .then(|| integration_check_run(rom, scene, opts))
+                .transpose()
+        },
+        || {
+            basis
+                .map(|b| {
+                    let rich = truncation_check_system_of(model, b)?;
+                    truncation_check_run(rich, scene, opts)
+                })
+                .transpose()
+        },
+    );
+    if let Some(check) = integration? {
+        estimate.integration = Some(integration_errors_from(&check, run, opts));
+    }
+    if let Some(check) = truncation? {
+        estimate.truncation = Some(curve_differences(&check, run, opts.problem.friction, 1.0));
+    }
+    estimate.update_total();
+    Ok(())
+}
+
+/// Drops the truncation part of an estimate (a check made beside the run that the caller does
+/// not use).
+pub fn drop_truncation(estimate: &mut RunEstimate) {
+    estimate.truncation = None;
+    estimate.update_total();
 }
 
 /// The integration part of a run's error estimate: the relative L2 differences `D` of its curves
@@ -263,7 +336,7 @@ fn curve_differences(check: &Run, run: &Run, friction: bool, scale: f64) -> Curv
 }
 
 /// The reduced system of the truncation check of `estimator`'s model: its basis Φ and the
-/// next [`TRUNCATION_CHECK_MODES`] fixed-interface modes beyond it
+/// truncated fixed-interface modes beyond it (of the lowest [`TRUNCATION_MODES`])
 /// ([`ErrorEstimator::truncation_check_basis`]), M-orthonormalized and rotated to the reduced
 /// eigenbasis like every basis; `None` when no mode is beyond Φ.
 pub fn truncation_check_system(

@@ -165,6 +165,7 @@ fn run_tolerance(
         offline_s,
         estimate_s,
         transient,
+        cpu_s,
     } = tolerance_model(model, &topts)?;
     let frames = match (every, &rom.phi) {
         (Some(every), Some(phi)) => {
@@ -191,6 +192,7 @@ fn run_tolerance(
             nu,
             setup_s,
             estimate_s,
+            cpu_s,
             rounds,
             rtol: transient.ode.rtol,
             atol: transient.ode.atol,

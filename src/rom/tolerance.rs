@@ -62,16 +62,22 @@
 //! the same round as the pairs would make every model [`NU_STEP`] columns larger for nothing.
 //! The rounds' e_k come from the joint part alone, so truncation does not masquerade as pair
 //! error. A round whose correction meets TOL may be the result: it also gets the estimate's
-//! truncation check ([`super::estimate::add_truncation_check`], a re-run with the next
-//! [`NU_STEP`] fixed-interface modes, which sees their back-coupling into the global motion),
-//! and ν grows when that part exceeds θ·TOL and the total misses.
+//! truncation check ([`super::estimate::add_truncation_check`], a re-run with every truncated
+//! fixed-interface mode the estimator holds, which sees their back-coupling into the global
+//! motion), and ν grows when that part exceeds θ·TOL and the total misses.
 //!
 //! The last round's run is the result; its estimate then gains the integration part
-//! ([`super::estimate::integration_errors`]: one more run at 2× looser tolerances, its difference scaled to this
-//! run's error by the BDF2 error model — that run does not depend on the one it checks, so every
-//! round at the user's tolerances starts it beside its own run on a second thread, and a round
-//! that is not the last discards it), and `met` says whether the
-//! total meets TOL. When it does not — nothing left to add, or the integration error of the
+//! ([`super::estimate::integration_errors`]: one more run at other tolerances, its difference
+//! scaled to this run's error by the BDF2 error model), and `met` says whether the total meets
+//! TOL. Both checks are re-runs that do not depend on the run they check. A round makes them
+//! only if it may be the result (its correction meets TOL, or nothing is left to change), the
+//! two beside each other on a second core; a round *expected* to be the result starts them
+//! beside its own run instead: one that repeats the previous model (the ranking round's at the
+//! user's tolerances, or tighter ones), grows ν, or adds every attachment mode the previous
+//! estimate asked for (no cap cut the selection and no tangential modes wait for the normal
+//! ones). The expectation only moves work in time: a check made beside a run whose correction
+//! then misses TOL is dropped, and every estimate and model is the one the sequential order
+//! gives, bit for bit. When it does not — nothing left to add, or the integration error of the
 //! user's tolerances above TOL — the best model is returned with `met = false` (the CLI warns;
 //! tighter `--rtol/--atol` lower the integration floor).
 
@@ -83,7 +89,7 @@ use crate::error::{Error, RomError};
 use crate::integrate::{Run, TransientOptions};
 use crate::joint::statics::ContactOptions;
 use crate::model::Model;
-use crate::reduction::estimate::{TRUNCATION_CHECK_MODES, TRUNCATION_MODES};
+use crate::reduction::estimate::TRUNCATION_MODES;
 #[cfg(doc)]
 use crate::reduction::Estimate;
 use crate::reduction::{
@@ -91,7 +97,7 @@ use crate::reduction::{
     Quantity, DEFAULT_DROP_TOL,
 };
 use crate::rom::estimate::{
-    add_truncation_check, beside, loosened, run_estimated_with, Checks, RunEstimate,
+    add_checks, beside, drop_truncation, loosened, run_estimated_with, Checks, RunEstimate,
 };
 use crate::rom::statics::{reduced_contact_static_restarting, scaled_load, ReducedStatic};
 use crate::system::{ReducedSystem, Scene};
@@ -205,6 +211,24 @@ pub struct Round {
     pub estimate_s: f64,
     /// The round only ranked the pairs: its run at [`RANKING_LOOSENING`]× looser tolerances.
     pub ranking: bool,
+    /// Where the round made its re-runs (the truncation and integration checks).
+    pub checks: ReRuns,
+}
+
+/// Where a round of [`tolerance_model`] made its re-runs, the truncation and integration checks
+/// (module docs): `"checks"` of a round in the JSON.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ReRuns {
+    /// None: its correction missed the tolerance and it was not the result (or it ranked).
+    None,
+    /// Beside its run: it was expected to be the result.
+    BesideRun,
+    /// Beside its run, and the truncation part dropped: its correction missed the tolerance
+    /// (the integration part is kept, should the round still be the result).
+    Dropped,
+    /// After its correction (which met the tolerance), or as the result.
+    AfterCorrection,
 }
 
 /// The tolerance-chosen reduced model and its run.
@@ -235,10 +259,14 @@ pub struct ToleranceModel {
     /// flexibility, the earlier rounds' runs and estimates, the result's basis), s.
     pub offline_s: f64,
     /// Wall time of the result's estimate after its run: the quasi-static joint correction and
-    /// the wait for the integration check (which runs beside the run on a second thread), s.
+    /// the truncation and integration checks (or the wait for them, when they ran beside the
+    /// run), s.
     pub estimate_s: f64,
     /// The transient options of the result's run (the integration tolerances chosen).
     pub transient: TransientOptions,
+    /// CPU time of the process over the whole tolerance model (setup, rounds, the result's
+    /// run and estimate; every thread, including other work the process does meanwhile), s.
+    pub cpu_s: f64,
 }
 
 /// What the tolerance model chose, as the outputs report it (`"tolerance"` in a run's JSON).
@@ -261,6 +289,9 @@ pub struct ToleranceChoice {
     pub setup_s: f64,
     /// Wall time of the result's estimate after its run, s.
     pub estimate_s: f64,
+    /// CPU time of the process over the whole tolerance model (offline, online and the
+    /// result's estimate; every thread), s.
+    pub cpu_s: f64,
     /// Every round, the last one the result.
     pub rounds: Vec<Round>,
     /// The integration tolerances of the result's run: CVODE's rtol and atol (mm).
@@ -281,6 +312,7 @@ pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<Toleran
     check_tolerance(tol)?;
     let on = controlled_quantities(opts.quantities, opts.transient.problem.friction)?;
     let start = Instant::now();
+    let cpu_start = process_cpu_s();
     let mut nu = opts.nu;
     let (flex, cb) = beside(|| JointFlexibility::new(model), || craig_bampton(model, nu));
     let (flex, mut cb) = (flex?, cb?);
@@ -289,6 +321,8 @@ pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<Toleran
     let mut rounds = Vec::new();
     // The Craig–Bampton round only ranks the pairs: looser tolerances (module docs).
     let mut ranking = true;
+    // Whether the round is expected to be the result (its checks then go beside its run).
+    let mut expect_result = false;
     // The integration tolerances: the user's, or the paper's times s (integration_looseness).
     let mut looseness = match opts.integration {
         IntegrationTolerances::FromTolerance => integration_looseness_for(tol, on),
@@ -302,12 +336,14 @@ pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<Toleran
             &opts.transient,
             looseness * if ranking { RANKING_LOOSENING } else { 1.0 },
         );
-        // Any round at the user's tolerances may be the result: its integration check runs
-        // beside it (on a second core; unused when the round is not the last).
+        // A round expected to be the result makes its two checks beside its run (on a second
+        // core); any other round makes them after its correction, only if it may be the result.
         let scene = Scene::of(model);
-        let checks = Checks {
-            integration: !ranking,
-            truncation: false,
+        let speculate = !ranking && expect_result;
+        let checks = if speculate {
+            Checks::BOTH
+        } else {
+            Checks::NONE
         };
         let (run, estimate) = run_estimated_with(
             model,
@@ -320,11 +356,9 @@ pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<Toleran
         )?;
         let run = run.into_result()?;
         let mut estimate = estimate?;
-        // A round whose correction meets the tolerance may be the result: the truncation
-        // check's re-run (the next fixed-interface modes) decides (module docs).
-        if !ranking && worst(&estimate.reduction, on) <= tol {
-            add_truncation_check(model, &mut estimate, &run, &scene, &transient)?;
-        }
+        let candidate = !ranking && worst(&estimate.reduction, on) <= tol;
+        let recheck = (&rom, &run, &scene, &transient);
+        let made = round_checks(model, recheck, &mut estimate, speculate, candidate)?;
         let eta = worst(&estimate.model_error(), on);
         let d = &estimate.detail;
         rounds.push(Round {
@@ -342,10 +376,16 @@ pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<Toleran
             basis_s,
             estimate_s: round_start.elapsed().as_secs_f64() - basis_s - run.wall_s,
             ranking,
+            checks: made,
         });
         let mut changed = false;
+        // The next round repeats this model (tighter) or changes it where the estimate
+        // asked for no more than the round adds: expected to be the result.
+        expect_result = true;
         if eta > tol && rounds.len() < opts.max_rounds {
-            changed = chosen.enrich(&estimate, on, tol, cb.ncols());
+            let enriched = chosen.enrich(&estimate, on, tol, cb.ncols());
+            changed = enriched.changed;
+            expect_result = enriched.complete;
             // The truncated modes are driven by the run's contact forces: while those are wrong
             // the truncation part is too, so ν grows only once the joint part is within its share.
             let part = SELECTION_MARGIN * tol;
@@ -357,12 +397,31 @@ pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<Toleran
                 nu += NU_STEP;
                 cb = craig_bampton(model, nu)?;
                 changed = true;
+                expect_result = true;
             }
         }
         let was_ranking = std::mem::replace(&mut ranking, false);
         if !changed && was_ranking {
             // A ranking run is never the result: the same model again at the user's tolerances.
             continue;
+        }
+        if !changed && estimate.integration.is_none() {
+            // The result, or the same model again if its integration misses: its integration
+            // check (when the correction missed, no round made it).
+            let (rom, run, scene, opts) = recheck;
+            add_checks(
+                model,
+                &mut estimate,
+                run,
+                rom.clone(),
+                scene,
+                opts,
+                Checks::INTEGRATION,
+            )?;
+            if let Some(last) = rounds.last_mut() {
+                last.estimate_s = round_start.elapsed().as_secs_f64() - basis_s - run.wall_s;
+                last.checks = ReRuns::AfterCorrection;
+            }
         }
         // The estimate misses the tolerance at loosened integration tolerances: the same model
         // again, ten times tighter (the reduction part is within its share, or the loop would
@@ -389,9 +448,43 @@ pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<Toleran
                 offline_s,
                 estimate_s,
                 transient,
+                cpu_s: process_cpu_s() - cpu_start,
             });
         }
     }
+}
+
+/// The re-runs of a round (module docs), given as its system, run, scene and transient options:
+/// a round whose correction meets the tolerance (`candidate`) may be the result, so the
+/// truncation check's re-run decides (the next fixed-interface modes) and its integration check
+/// goes beside it — already made beside the run when `speculate`; a speculative truncation part
+/// of a round that is no candidate is dropped. Returns where the re-runs were made.
+fn round_checks(
+    model: &Model,
+    (rom, run, scene, opts): (&ReducedSystem, &Run, &Scene, &TransientOptions),
+    estimate: &mut RunEstimate,
+    speculate: bool,
+    candidate: bool,
+) -> Result<ReRuns, Error> {
+    match (candidate, speculate) {
+        (true, true) => Ok(ReRuns::BesideRun),
+        (true, false) => {
+            add_checks(model, estimate, run, rom.clone(), scene, opts, Checks::BOTH)?;
+            Ok(ReRuns::AfterCorrection)
+        }
+        (false, true) => {
+            drop_truncation(estimate);
+            Ok(ReRuns::Dropped)
+        }
+        (false, false) => Ok(ReRuns::None),
+    }
+}
+
+/// CPU time of the process (every thread), s (NaN where unavailable).
+fn process_cpu_s() -> f64 {
+    cpu_time::ProcessTime::try_now()
+        .map(|t| t.as_duration().as_secs_f64())
+        .unwrap_or(f64::NAN)
 }
 
 /// The quantities a tolerance model controls: `asked` (`None`: all the run produces), checked
@@ -446,8 +539,15 @@ impl Chosen {
     /// docs, "Choosing S"): normal ones while the joint part of the ‖f_c‖ estimate (or of u_y)
     /// exceeds its share and a controlled quantity depends on the normal forces, tangential ones
     /// while the joint part of the ‖f_R‖ estimate exceeds its share and ‖f_R‖ or D is
-    /// controlled. Returns whether anything was added.
-    fn enrich(&mut self, estimate: &RunEstimate, on: Quantities, tol: f64, cb_size: usize) -> bool {
+    /// controlled. Returns whether anything was added, and whether that is all the estimate
+    /// asked for (no cap cut the selection, no tangential modes wait for the normal ones).
+    fn enrich(
+        &mut self,
+        estimate: &RunEstimate,
+        on: Quantities,
+        tol: f64,
+        cb_size: usize,
+    ) -> Enriched {
         let d = &estimate.detail;
         let part = SELECTION_MARGIN * tol;
         let normal_matters = [
@@ -461,8 +561,12 @@ impl Chosen {
             || (on.contains(Quantity::MasterUy)
                 && estimate.reduction.master_uy.unwrap_or(0.0) > part);
         let mut changed = false;
+        let mut complete = false;
+        let friction_matters =
+            on.contains(Quantity::FrictionForce) || on.contains(Quantity::Dissipation);
+        let wants_tangential = friction_matters && d.joint_friction.unwrap_or(0.0) > part;
         if wants_normal {
-            if let Some(add) = more_pairs(
+            if let Some((add, all)) = more_pairs(
                 &d.pair_error,
                 d.corrected_joint_norm2,
                 |k| self.pairs.contains(&k),
@@ -472,16 +576,15 @@ impl Chosen {
                 self.pairs.extend(add);
                 self.pairs.sort_unstable();
                 changed = true;
+                complete = all && !wants_tangential;
             }
         }
-        let friction_matters =
-            on.contains(Quantity::FrictionForce) || on.contains(Quantity::Dissipation);
         // The cone of a pair's friction force is μ|p_n|: while the normal forces are being
         // corrected, the tangential errors are theirs, so tangential modes wait for them.
-        if !changed && friction_matters && d.joint_friction.unwrap_or(0.0) > part {
+        if !changed && wants_tangential {
             let tangential = &self.tangential;
             let held = |k: usize| tangential.iter().filter(|&&j| j == k).count();
-            if let Some(add) = more_pairs(
+            if let Some((add, all)) = more_pairs(
                 &d.pair_tangential_error,
                 d.corrected_joint_friction_norm2,
                 |k| held(k) >= 2,
@@ -496,10 +599,20 @@ impl Chosen {
                     self.tangential.push(k);
                 }
                 changed = true;
+                complete = all;
             }
         }
-        changed
+        Enriched { changed, complete }
     }
+}
+
+/// What [`Chosen::enrich`] did.
+#[derive(Clone, Copy, Debug)]
+struct Enriched {
+    /// Attachment modes were added.
+    changed: bool,
+    /// They are all the estimate asked for: the next round is expected to meet the tolerance.
+    complete: bool,
 }
 
 /// The principal direction of the moments `[Σ p_1², Σ p_1 p_2, Σ p_2²]` of a pair's tangential
@@ -513,10 +626,10 @@ fn main_direction(m: [f64; 3]) -> [f64; 2] {
 /// estimate only ranks the pairs (module docs, "Choosing S").
 pub const RANKING_LOOSENING: f64 = 10.0;
 
-/// Fixed-interface modes added to ν when the truncation part of the estimate exceeds its share:
-/// the modes the estimate's truncation check adds ([`TRUNCATION_CHECK_MODES`]), so the check
-/// measures what this step removes.
-pub const NU_STEP: usize = TRUNCATION_CHECK_MODES;
+/// Fixed-interface modes added to ν when the truncation part of the estimate exceeds its share
+/// (the paper's ν = 10 at a time; the truncation check then measures the modes beyond the new
+/// ν again).
+pub const NU_STEP: usize = 10;
 
 /// The largest ν the enrichment uses: [`TRUNCATION_MODES`] − [`NU_STEP`], so that the estimate
 /// still checks [`NU_STEP`] modes beyond the basis.
@@ -568,13 +681,14 @@ fn reduced_on(
 /// The pairs to add after a round whose estimate missed `tol` (module docs, step 3): ranked by
 /// their shares `errors` of the estimate (N², against the corrected curve's `norm2`), those not
 /// `held` already, at most `cap` of them; `None` when no pair outside carries any of the error.
+/// The flag says whether the pairs left out are within their share (the cap did not cut).
 fn more_pairs(
     errors: &[f64],
     norm2: f64,
     held: impl Fn(usize) -> bool,
     tol: f64,
     cap: usize,
-) -> Option<Vec<usize>> {
+) -> Option<(Vec<usize>, bool)> {
     let mut cand: Vec<(usize, f64)> = errors
         .iter()
         .enumerate()
@@ -595,7 +709,8 @@ fn more_pairs(
         add.push(k);
         left -= e;
     }
-    (!add.is_empty()).then_some(add)
+    let all = left <= allowed;
+    (!add.is_empty()).then_some((add, all))
 }
 
 /// The tolerance-chosen model of the contact statics ([`static_tolerance_model`]).
