@@ -11,7 +11,7 @@
 //! ```
 //!
 //! Bounds (each run, each rank count), measured values in `docs/distributed.md`:
-//! - frequencies: relative difference ≤ 1e-8 (the issue's bound);
+//! - frequencies: relative difference ≤ 1e-8 (the target's bound);
 //! - span of the ν modes: sine of the largest M-principal angle ≤ 1e-8, SLEPc's modes
 //!   M-orthonormal to 1e-10 and each pair's backward error on jointrom's K_ii, M_ii ≤ 1e-12;
 //! - the TVD solve `K Z = R`: MUMPS's backward error ≤ 1e-14, and Z within 1e-6 of the native

@@ -8,7 +8,7 @@
 //!   the whole 0.2 s: g = 0 (Craig–Bampton only) misses the contact force by a factor of ~40, the
 //!   w(g)-chosen g (w ≥ 0.999, g = 19) by ~30 % in ‖f_c‖ (the static study finds the same gap,
 //!   see `jointrom::studies::convergence`), and the largest POD basis (all 51 POD modes) meets
-//!   the 2 %.
+//!   the 2 % target.
 
 use jointrom::integrate::{run, Curves, TransientOptions};
 use jointrom::reduction::{build_basis, BasisKind, BasisOptions};
@@ -133,7 +133,7 @@ fn full_model_short_window_reproduces_the_stored_reference() {
 }
 
 /// Friction off (the paper's Section 4.1.3 comparison): g = 0 fails, the w(g)-chosen g is ~40 %
-/// off in ‖f_c‖ (the 2 % is not met), all 51 POD modes meet it.
+/// off in ‖f_c‖ (the 2 % target is not met), all 51 POD modes meet it.
 #[test]
 fn rom_against_full_reference_friction_off() {
     let r = reference("friction_bar_full_friction_off");

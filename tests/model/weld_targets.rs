@@ -1,4 +1,4 @@
-//! Issue 13's targets on the built-in scenes (the default model: DKMQ sheets, area welds with
+//! The weld model's targets on the built-in scenes (the default model: DKMQ sheets, area welds with
 //! their neighbourhoods re-meshed): against the converged solid of
 //! `scripts/solid_reference.py` on the paper's mesh, and under refinement of the sheets
 //! (`cases/scale/*_x2.json`, `*_x4.json`, made by `scripts/refine_case.py`).

@@ -212,7 +212,7 @@ fn measure(name: &str, gs: &[usize]) -> Moved {
 /// welds), the multilayer's vibration modes by up to 3.5e-8 (three pairs of modes 1.7e-4 …
 /// 2.8e-4 apart; their residuals are at the round-off of `‖K‖ ‖φ‖`). Hence the measured
 /// `|Δw| ≤ 2.4e-7` (multilayer) and `≤ 2.0e-10` (friction bar) and `‖f_c‖` within 4.4e-7; the
-/// bounds are those with margin (‖f_c‖: the 1e-6).
+/// bounds are those with margin (‖f_c‖: the target's 1e-6).
 #[test]
 fn tvd_basis_ignores_round_off_of_k_and_m() {
     for (name, gs, w_bound) in [

@@ -95,7 +95,7 @@ fn tiny_sweep_reports_failures_as_cells() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
-/// The whole map of the issue (minutes): `STABILITY_OUT=dir cargo test --release --test studies
+/// The whole stability map (minutes): `STABILITY_OUT=dir cargo test --release --test studies
 /// -- --ignored stability::full_map` (until `jointrom stability` is wired into the CLI). Optional
 /// `STABILITY_BUDGET` (s per cell) and `STABILITY_FULL_END` (s).
 #[test]
