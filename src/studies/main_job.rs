@@ -575,9 +575,13 @@ pub fn report_backbone(
         amplitudes: log_range(1e-8 * base, 1e-4 * base, if quick { 3 } else { 5 })?,
         preload: 1.0,
         cycles: 2,
-        transient: TransientOptions {
-            budget_s: Some(60.0),
-            ..TransientOptions::default()
+        transient: {
+            let mut t = TransientOptions {
+                budget_s: Some(60.0),
+                ..TransientOptions::default()
+            };
+            t.ode.atol = crate::studies::backbone::DEFAULT_ATOL;
+            t
         },
     };
     let spec = crate::rom::ModelSpec::Basis {

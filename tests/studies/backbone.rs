@@ -513,3 +513,33 @@ fn a_ring_down_whose_energy_balance_misses_is_named_with_its_amplitude() {
     let ok = decay(PRESS, [1.0, 0.0], f_lin, 1.0, false);
     assert!(ok.warnings(1, 3).is_empty(), "{:?}", ok.warnings(1, 3));
 }
+
+/// The command's ring-downs run a decade below the transient's absolute tolerance unless told
+/// otherwise: the default is `--atol 1e-7` (the same steps), not the transient's 1e-6.
+#[test]
+fn backbone_command_defaults_to_a_decade_below_the_transients_atol() {
+    let steps = |extra: &[&str]| {
+        let mut args = vec![
+            "backbone",
+            "friction_bar",
+            "--model",
+            "tvd",
+            "--modes",
+            "1",
+            "--amplitudes",
+            "3.162e-4",
+            "--cycles",
+            "1",
+            "--preload",
+            "1",
+            "--json",
+        ];
+        args.extend_from_slice(extra);
+        let v = crate::common::jointrom_json(args);
+        v["backbone"]["modes"][0]["ring_downs"][0]["steps"].clone()
+    };
+    let default = steps(&[]);
+    assert!(default.as_u64().is_some_and(|s| s > 0), "{default}");
+    assert_eq!(default, steps(&["--atol", "1e-7"]));
+    assert_ne!(default, steps(&["--atol", "1e-6"]));
+}
