@@ -85,8 +85,8 @@ pub struct ReducedSystem {
     /// [`SecondOrderSystem::newton_update`] changed them since the factorization.
     gamma_factored: f64,
     kc_factored: Vec<f64>,
-    /// Scratch of [`SecondOrderSystem::newton_update`]: the update's columns `W` (r × 3w) and
-    /// weights `α`, `A ← A + W diag(α) Wᵀ`.
+    /// Scratch of [`SecondOrderSystem::newton_update`]: the update's columns `W` (r × k, k at
+    /// most `update_columns`) and weights `α`, `A ← A + W diag(α) Wᵀ`.
     update_w: Mat<f64>,
     update_alpha: Col<f64>,
     /// The Newton factor as diagonal plus low rank when the basis is the reduced eigenbasis
@@ -116,6 +116,13 @@ fn col_major(a: &Mat<f64>) -> Vec<f64> {
         out.extend(a.col(j).iter().copied());
     }
     out
+}
+
+/// The most columns a rank update of the dense Newton factor takes (module docs): k columns cost
+/// ~2kr² flops against a factorization's r³/3, so k ≤ r/6, and a change has at most three per
+/// pair (`rows` = 3w).
+fn update_columns(r: usize, rows: usize) -> usize {
+    (r / 6).min(rows)
 }
 
 /// The eigenpairs `(λ, v)` (v unit, in the pair's rows normal, t1, t2) of a change of a pair's
@@ -309,8 +316,8 @@ impl ReducedSystem {
             newton_ok: false,
             gamma_factored: 0.0,
             kc_factored: vec![0.0; 3 * w3],
-            update_w: Mat::zeros(r, w3),
-            update_alpha: Col::zeros(w3),
+            update_w: Mat::zeros(r, update_columns(r, w3)),
+            update_alpha: Col::zeros(update_columns(r, w3)),
             modal,
             modal_used: false,
             active: Mat::zeros(w3, r),
@@ -380,8 +387,8 @@ impl Clone for ReducedSystem {
             newton_ok: false,
             gamma_factored: 0.0,
             kc_factored: vec![0.0; 3 * self.b_phi.nrows()],
-            update_w: Mat::zeros(self.r, self.b_phi.nrows()),
-            update_alpha: Col::zeros(self.b_phi.nrows()),
+            update_w: Mat::zeros(self.r, update_columns(self.r, self.b_phi.nrows())),
+            update_alpha: Col::zeros(update_columns(self.r, self.b_phi.nrows())),
             modal: self.modal.clone(),
             modal_used: false,
             active: Mat::zeros(self.b_phi.nrows(), self.r),
@@ -563,8 +570,8 @@ impl SecondOrderSystem for ReducedSystem {
                 if lambda == 0.0 {
                     continue;
                 }
-                // k columns cost ~2kr² flops against a factorization's r³/3 (module docs).
-                if cols == self.update_alpha.nrows() || 6 * (cols + 1) > r {
+                // The scratch holds the most columns worth an update (`update_columns`).
+                if cols == self.update_alpha.nrows() {
                     return false;
                 }
                 let row = |a: usize| &self.b_rows[(3 * i + a) * r..(3 * i + a + 1) * r];
