@@ -850,6 +850,12 @@ pub struct Estimate {
     /// The corrected dissipated energy D*(t) from the output states (module docs, "Friction"),
     /// N·mm (empty without friction).
     pub corrected_dissipated: Vec<f64>,
+    /// Per pair, `Σ_t (D_k(t) − D_k*(t))²` (N²·mm²): where the run's dissipated energy differs
+    /// from the correction's, pair by pair (empty without friction). `D − D* = Σ_k (D_k − D_k*)`,
+    /// so the pairs' shares bound the error of D by their sum (not in quadrature).
+    pub pair_dissipation_error: Vec<f64>,
+    /// Per pair, `D_k(T) − D_k*(T)` at the last output (N·mm; empty without friction).
+    pub pair_dissipation_end: Vec<f64>,
 }
 
 impl Estimate {
@@ -907,6 +913,11 @@ struct Dissipation {
     corrected: Vec<f64>,
     /// The last output's forces and slips.
     last: Option<OutputState>,
+    /// Per pair, the run's and the correction's D so far, N·mm.
+    pair_run: Vec<f64>,
+    pair_corrected: Vec<f64>,
+    /// Per pair, `Σ_t (D_k − D_k*)²` over the outputs so far, N²·mm².
+    pair_error: Vec<f64>,
 }
 
 impl Dissipation {
@@ -930,13 +941,30 @@ impl Dissipation {
                 // each with its own slip: the run's memory, the corrected state's.
                 let ds = s[i] - s0[i];
                 if ds != 0.0 && p[n] != 0.0 && p0[n] != 0.0 {
-                    d += 0.5 * (p[r] + p0[r]) * ds;
+                    let e = 0.5 * (p[r] + p0[r]) * ds;
+                    d += e;
+                    self.pair_run[i / 2] += e;
                 }
                 let ds = slip[i] - slip0[i];
                 if ds != 0.0 && pc[n] != 0.0 && pc0[n] != 0.0 && ds.is_finite() {
-                    dc += 0.5 * (pc[r] + pc0[r]) * ds;
+                    let e = 0.5 * (pc[r] + pc0[r]) * ds;
+                    dc += e;
+                    self.pair_corrected[i / 2] += e;
                 }
             }
+        } else {
+            let w = s.len() / 2;
+            self.pair_run = vec![0.0; w];
+            self.pair_corrected = vec![0.0; w];
+            self.pair_error = vec![0.0; w];
+        }
+        for ((e, a), b) in self
+            .pair_error
+            .iter_mut()
+            .zip(&self.pair_run)
+            .zip(&self.pair_corrected)
+        {
+            *e += (a - b).powi(2);
         }
         self.run.push(d);
         self.corrected.push(dc);
@@ -1119,6 +1147,13 @@ impl ErrorEstimator<'_> {
                 .flatten(),
             dissipated_end: law.friction.then(|| dissipation.end_error()).flatten(),
         };
+        out.pair_dissipation_end = dissipation
+            .pair_run
+            .iter()
+            .zip(&dissipation.pair_corrected)
+            .map(|(a, b)| a - b)
+            .collect();
+        out.pair_dissipation_error = dissipation.pair_error;
         out.corrected_dissipated = dissipation.corrected;
         out.corrected_contact_force = fc;
         out.corrected_friction_force = fr;

@@ -8,8 +8,12 @@
 //! `K⁻¹ B_{t,k}ᵀ d_k` by the same selection on the tangential shares
 //! `e_{t,k} = Σ_t |p_{t,k} − p_{t,k}*|²` ([`Estimate::pair_tangential_error`]), first in the
 //! pair's main direction of friction, later across it, and only in rounds that add no normal
-//! modes (the friction cone follows the normal force). With ‖f_R‖ or D controlled the
-//! integration starts ten times tighter ([`integration_looseness_for`]).
+//! modes (the friction cone follows the normal force). D, a sum of what each pair dissipates,
+//! has its own rule when neither force rule adds anything: the pairs with the largest shares
+//! `σ_k` of its error ([`Estimate::pair_dissipation_error`]; the shares bound it by their sum)
+//! get their normal attachment mode, or their next tangential one if they hold it already.
+//! With ‖f_R‖ or D controlled the integration starts ten times tighter
+//! ([`integration_looseness_for`]).
 //!
 //! ## Why not the paper's w(g)
 //!
@@ -602,8 +606,98 @@ impl Chosen {
                 complete = all;
             }
         }
+        // D is a sum over the pairs of what each dissipates: where its estimate misses while
+        // the forces are within their shares, the pairs that dissipate wrongly get their normal
+        // attachment mode first (their friction limit μ|p_n| and so their share of the slip),
+        // then tangential ones (the structure's tangential compliance at the pair).
+        let dissipation = [
+            estimate.reduction.dissipated,
+            estimate.reduction.dissipated_end,
+        ]
+        .into_iter()
+        .flatten()
+        .fold(0.0, f64::max);
+        if !changed && on.contains(Quantity::Dissipation) && dissipation > part {
+            let scores = dissipation_shares(d);
+            let tangential = &self.tangential;
+            let held = |k: usize| tangential.iter().filter(|&&j| j == k).count();
+            let pairs = &self.pairs;
+            if let Some((add, all)) = more_pairs_summed(
+                &scores,
+                |k| pairs.contains(&k) && held(k) >= 2,
+                tol,
+                (self.pairs.len() + self.tangential.len()).max(cb_size),
+            ) {
+                for k in add {
+                    if !self.pairs.contains(&k) {
+                        self.pairs.push(k);
+                        continue;
+                    }
+                    let main = main_direction(d.pair_tangential_moment[k]);
+                    let first = !self.tangential.contains(&k);
+                    self.directions
+                        .push(if first { main } else { [-main[1], main[0]] });
+                    self.tangential.push(k);
+                }
+                self.pairs.sort_unstable();
+                changed = true;
+                complete = all;
+            }
+        }
         Enriched { changed, complete }
     }
+}
+
+/// Each pair's relative share of the error of D: the larger of `‖D_k − D_k*‖_L2 / ‖D*‖_L2`
+/// and `|D_k(T) − D_k*(T)| / |D*(T)|` ([`Estimate::pair_dissipation_error`]). Their sum over
+/// any set of pairs bounds what those pairs contribute to either measure of D's error.
+fn dissipation_shares(d: &crate::reduction::Estimate) -> Vec<f64> {
+    let norm = d
+        .corrected_dissipated
+        .iter()
+        .map(|v| v * v)
+        .sum::<f64>()
+        .sqrt();
+    let end = d.corrected_dissipated.last().map_or(0.0, |v| v.abs());
+    d.pair_dissipation_error
+        .iter()
+        .zip(&d.pair_dissipation_end)
+        .map(|(e2, e_end)| {
+            let over = if norm > 0.0 { e2.sqrt() / norm } else { 0.0 };
+            let at_end = if end > 0.0 { e_end.abs() / end } else { 0.0 };
+            over.max(at_end)
+        })
+        .collect()
+}
+
+/// The pairs to add by shares that bound the error by their sum: the fewest, largest first, that
+/// leave `Σ_{k left} share_k ≤ θ · TOL`, at most `cap` of them, and whether that is all of them.
+/// `None` when no pair outside the `held` ones has a share.
+fn more_pairs_summed(
+    shares: &[f64],
+    held: impl Fn(usize) -> bool,
+    tol: f64,
+    cap: usize,
+) -> Option<(Vec<usize>, bool)> {
+    let mut cand: Vec<(usize, f64)> = shares
+        .iter()
+        .enumerate()
+        .filter(|(k, e)| **e > 0.0 && !held(*k))
+        .map(|(k, e)| (k, *e))
+        .collect();
+    cand.sort_by(|a, b| b.1.total_cmp(&a.1).then(a.0.cmp(&b.0)));
+    let allowed = SELECTION_MARGIN * tol;
+    let mut left: f64 = cand.iter().map(|c| c.1).sum();
+    let mut add = Vec::new();
+    for (k, e) in cand {
+        if left <= allowed || add.len() >= cap {
+            break;
+        }
+        add.push(k);
+        left -= e;
+    }
+    let all = left <= allowed;
+    (!add.is_empty()).then_some((add, all))
 }
 
 /// What [`Chosen::enrich`] did.
@@ -781,5 +875,28 @@ pub fn check_tolerance(tol: f64) -> Result<(), Error> {
         Ok(())
     } else {
         Err(RomError::Tolerance { tolerance: tol }.into())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn summed_selection_adds_the_largest_shares_until_the_rest_fits() {
+        // θ·TOL = 0.5e-2: the rest after adding 0 (4e-3 + 2e-3 + 1e-3 = 7e-3) misses, after
+        // adding 0 and 3 (3e-3) it fits; pair 1 is held.
+        let shares = [6e-3, 9e-3, 1e-3, 4e-3, 2e-3, 0.0];
+        let (add, all) = more_pairs_summed(&shares, |k| k == 1, 1e-2, 10).unwrap();
+        assert_eq!(add, vec![0, 3]);
+        assert!(all);
+        // The cap stops it short, and says so.
+        let (add, all) = more_pairs_summed(&shares, |k| k == 1, 1e-2, 1).unwrap();
+        assert_eq!(add, vec![0]);
+        assert!(!all);
+        // Nothing outside the held pairs carries a share: nothing to add.
+        assert!(more_pairs_summed(&shares, |k| k != 5, 1e-2, 10).is_none());
+        // Already within its share: nothing to add.
+        assert!(more_pairs_summed(&[1e-3, 2e-3], |_| false, 1e-2, 10).is_none());
     }
 }

@@ -230,6 +230,38 @@ fn dissipation_estimate_follows_the_corrected_slip() {
             "{what} effectivity {eff} ({est} / {truth})"
         );
     }
+    // The pairs' shares of D's error add up to it: at the end exactly (D − D* = Σ_k (D_k −
+    // D_k*)), over the run as a bound (the triangle inequality), so a rule that adds the pairs
+    // with the largest shares removes what they contribute.
+    let d = &t.estimate.detail;
+    let w = m.pair_count();
+    assert_eq!(d.pair_dissipation_error.len(), w);
+    assert_eq!(d.pair_dissipation_end.len(), w);
+    let d_end = *d.corrected_dissipated.last().unwrap();
+    let end_sum: f64 = d.pair_dissipation_end.iter().sum();
+    let end_err = d.errors.dissipated_end.unwrap();
+    assert!(
+        ((end_sum / d_end).abs() - end_err).abs() <= 1e-9 * end_err.max(1e-12),
+        "Σ_k (D_k − D_k*)(T) / D*(T) = {} against D(T)'s {end_err}",
+        end_sum / d_end
+    );
+    let norm = d
+        .corrected_dissipated
+        .iter()
+        .map(|v| v * v)
+        .sum::<f64>()
+        .sqrt();
+    let bound: f64 = d
+        .pair_dissipation_error
+        .iter()
+        .map(|e| e.sqrt())
+        .sum::<f64>()
+        / norm;
+    let over_run = d.errors.dissipated.unwrap();
+    assert!(
+        bound >= over_run * (1.0 - 1e-12) && bound > 0.0,
+        "Σ_k ‖D_k − D_k*‖ / ‖D*‖ = {bound} below D's {over_run}"
+    );
 }
 
 /// Bad `--tolerance-on` lists are errors naming the flag.
