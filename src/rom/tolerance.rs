@@ -139,7 +139,7 @@ pub enum IntegrationTolerances {
 /// The factor `s` on the paper's Table 1 rtol and atol (1e-8, 1e-6 mm) at which the tolerance
 /// model of tolerance `tol` starts: `s = clamp(tol / 1e-4, 1, 1e4)` — ten times looser per
 /// decade of tolerance above 1e-4, the paper's tolerances from 1e-4 down. The estimate, whose
-/// integration part is a re-run ten times tighter ([`super::estimate::integration_errors`]),
+/// integration part is a re-run √10 times tighter ([`super::estimate::integration_errors`]),
 /// checks the choice: while its total misses TOL, `s` drops tenfold and the model is re-run,
 /// down to `s = 1`.
 pub fn integration_looseness(tol: f64) -> f64 {
