@@ -623,22 +623,33 @@ impl Truncation {
         let outputs = t.len();
         let rho = self.psi_m.transpose() * load - &self.psi_k_phi * q - self.b_psi.transpose() * p;
         let mut out = Mat::<f64>::zeros(m, outputs);
+        // The outputs are nearly equally spaced: their steps take a few distinct values (in
+        // the last bits), so each mode's rotation is computed once per distinct step.
+        let mut distinct: Vec<f64> = Vec::new();
+        let mut index = std::collections::HashMap::new();
+        let step_of: Vec<usize> = (0..outputs.saturating_sub(1))
+            .map(|j| {
+                let h = t[j + 1] - t[j];
+                *index.entry(h.to_bits()).or_insert_with(|| {
+                    distinct.push(h);
+                    distinct.len() - 1
+                })
+            })
+            .collect();
+        let mut rotation = vec![(0.0, 1.0); distinct.len()];
         for i in 0..m {
             let w2 = self.omega2[i];
             let w = w2.sqrt();
+            for (r, h) in rotation.iter_mut().zip(&distinct) {
+                *r = (w * h).sin_cos();
+            }
             let mut d = -rho[(i, 0)] / w2;
             let mut slope_prev = 0.0;
             let mut rate = 0.0;
-            // The outputs are mostly equally spaced: the rotation of the last step again.
-            let mut step = (f64::NAN, 0.0, 1.0);
             out[(i, 0)] = d;
             for j in 0..outputs.saturating_sub(1) {
                 let h = t[j + 1] - t[j];
-                if h.to_bits() != step.0.to_bits() {
-                    let (sn, cs) = (w * h).sin_cos();
-                    step = (h, sn, cs);
-                }
-                let (sn, cs) = (step.1, step.2);
+                let (sn, cs) = rotation[step_of[j]];
                 let slope = if h > 0.0 {
                     (rho[(i, j + 1)] - rho[(i, j)]) / h
                 } else {
