@@ -462,24 +462,43 @@ impl JointFlexibility {
     }
 
     /// The estimator of a reduced model on the basis `phi` (n × r) of `model`: `G = B K⁻¹ M Φ`
-    /// and `G_m = E_mᵀ K⁻¹ M Φ` from r refined solves.
+    /// and `G_m = E_mᵀ K⁻¹ M Φ` from r refined solves, and the truncated modes beyond Φ.
     pub fn estimator<'a>(
         &'a self,
         model: &Model,
         rom: &ReducedSystem,
     ) -> Result<ErrorEstimator<'a>, Error> {
+        self.estimator_with(model, rom, true)
+    }
+
+    /// [`JointFlexibility::estimator`], with the truncation part only if `truncation`: without
+    /// it the estimate is the joint part alone ([`Estimate::truncation`] `None`), one correction
+    /// per output instead of two and no truncated modes set up — for a run whose estimate only
+    /// ranks the pairs (the tolerance model's first round).
+    pub fn estimator_with<'a>(
+        &'a self,
+        model: &Model,
+        rom: &ReducedSystem,
+        truncation: bool,
+    ) -> Result<ErrorEstimator<'a>, Error> {
         let phi = self.basis_of(rom)?;
         let m_phi = sym_mul_mat(&model.mass, phi.as_ref());
         let y = solve_refined_owned(&self.stiffness, &self.chol, m_phi);
+        let truncation = if truncation {
+            let modes = self.truncation_modes(model)?;
+            Some(Truncation::new(
+                model,
+                phi.as_ref(),
+                modes.as_ref().as_ref(),
+            )?)
+        } else {
+            None
+        };
         Ok(ErrorEstimator {
             flex: self,
             g: self.joint.reduce(y.as_ref()),
             g_m: Mat::from_fn(6, y.ncols(), |d, j| y[(self.master[d], j)]),
-            truncation: Truncation::new(
-                model,
-                phi.as_ref(),
-                self.truncation_modes(model)?.as_ref().as_ref(),
-            )?,
+            truncation,
             rom: rom.clone(),
         })
     }
@@ -488,7 +507,7 @@ impl JointFlexibility {
     /// computed on first use: only the transient estimate needs them (not the pair-space
     /// statics), and its first use is on the second core beside a reduced run
     /// ([`crate::rom::estimate::run_estimated`]).
-    fn truncation_modes(&self, model: &Model) -> Result<Arc<Mat<f64>>, Error> {
+    pub(crate) fn truncation_modes(&self, model: &Model) -> Result<Arc<Mat<f64>>, Error> {
         // Not held while computing: the modes' solves may run on rayon's pool, and a worker
         // waiting there can take another estimator's job that wants this lock (the deadlock
         // class of `rom::estimate::beside`). Two estimators may both compute them: the
@@ -549,7 +568,8 @@ pub struct ErrorEstimator<'a> {
     g: Mat<f64>,
     /// `G_m = E_mᵀ K⁻¹ M Φ` (6 × r).
     g_m: Mat<f64>,
-    truncation: Truncation,
+    /// The truncated modes (`None`: the estimate is the joint part alone).
+    truncation: Option<Truncation>,
     rom: ReducedSystem,
 }
 
@@ -976,7 +996,7 @@ impl ErrorEstimator<'_> {
     /// a scene's error need not be the next ones (the lap joint's dissipated energy at ν = 10
     /// is changed little by modes 11–20 and mostly by 21–30).
     pub fn truncation_check_basis(&self) -> Option<Mat<f64>> {
-        let extra = &self.truncation.ordered;
+        let extra = &self.truncation.as_ref()?.ordered;
         let phi = self.rom.phi.as_ref()?;
         (extra.ncols() > 0).then(|| {
             Mat::from_fn(phi.nrows(), phi.ncols() + extra.ncols(), |i, j| {
@@ -1008,8 +1028,12 @@ impl ErrorEstimator<'_> {
         // kinematics for every output at once (small: modes × outputs, 6 × outputs).
         let q_all = MatRef::from_column_major_slice(states.q, r, outputs);
         let p_all = MatRef::from_column_major_slice(states.p, 3 * w, outputs);
-        let excess = self.truncation.excess(states.t, &load, q_all, p_all);
-        let x_hat = &self.flex.c * &load - &self.g_m * &qdd + &self.truncation.psi_m * &excess;
+        let mut x_hat = &self.flex.c * &load - &self.g_m * &qdd;
+        let excess = self.truncation.as_ref().map(|tr| {
+            let excess = tr.excess(states.t, &load, q_all, p_all);
+            x_hat += &tr.psi_m * &excess;
+            excess
+        });
         let mut out = Estimate {
             pair_error: vec![0.0; w],
             ..Default::default()
@@ -1046,7 +1070,6 @@ impl ErrorEstimator<'_> {
                     }
                 }
             }
-            let u_hat = &u_joint + &self.truncation.b_psi * excess.subcols(first, cols);
             // The two corrections are independent sequences over the outputs (each warm-starts
             // from its own previous active set): one per core, the same bits as one after the
             // other.
@@ -1069,19 +1092,27 @@ impl ErrorEstimator<'_> {
                     })
                     .collect()
             };
-            // The joint part alone (no truncated-mode dynamics) ranks the pairs.
-            let (full, joint) = rayon::join(
-                || series(&mut corr, &u_hat),
-                || series(&mut corr_joint, &u_joint),
-            );
-            let (full, joint) = (full?, joint?);
-            for (c, ((pc, slip), (pj, _))) in full.into_iter().zip(joint).enumerate() {
+            // The joint part alone (no truncated-mode dynamics) ranks the pairs; without
+            // truncated modes it is the whole correction.
+            let (full, joint) = match (&self.truncation, &excess) {
+                (Some(tr), Some(excess)) => {
+                    let u_hat = &u_joint + &tr.b_psi * excess.subcols(first, cols);
+                    let (full, joint) = rayon::join(
+                        || series(&mut corr, &u_hat),
+                        || series(&mut corr_joint, &u_joint),
+                    );
+                    (Some(full?), joint?)
+                }
+                _ => (None, series(&mut corr_joint, &u_joint)?),
+            };
+            for (c, (pj, slip_j)) in joint.iter().enumerate() {
                 let j = first + c;
+                let (pc, slip) = full.as_ref().map_or((pj, slip_j), |f| (&f[c].0, &f[c].1));
                 let p = &states.p[3 * w * j..3 * w * (j + 1)];
                 if law.friction {
-                    dissipation.push(p, &pc, &states.s[ns * j..ns * (j + 1)], &slip);
+                    dissipation.push(p, pc, &states.s[ns * j..ns * (j + 1)], slip);
                 }
-                let [fc, fr, fc_rom, fr_rom, fcj, frj] = out.add_output(p, &pc, &pj);
+                let [fc, fr, fc_rom, fr_rom, fcj, frj] = out.add_output(p, pc, pj);
                 fc_joint.push(fcj.sqrt());
                 fr_joint.push(frj.sqrt());
                 // x_m* = C f_m − G_m q̈ − Hᵀ p* (the tangential part of p* as in the gaps: the
@@ -1113,7 +1144,11 @@ impl ErrorEstimator<'_> {
         } else {
             None
         };
-        out.truncation = relative_l2(&fc_joint, &fc);
+        out.truncation = self
+            .truncation
+            .is_some()
+            .then(|| relative_l2(&fc_joint, &fc))
+            .flatten();
         out.corrected_joint_norm2 = fc_joint.iter().map(|v| v * v).sum();
         out.corrected_joint_friction_norm2 = fr_joint.iter().map(|v| v * v).sum();
         out.errors = CurveErrors {

@@ -452,6 +452,27 @@ pub fn run_estimated_with(
     checks: Checks,
     observe: impl FnMut(f64, &[f64]),
 ) -> Result<(Run, Result<RunEstimate, Error>), Error> {
+    run_estimated_parts(model, flex, rom, scene, opts, checks, true, observe)
+}
+
+/// [`run_estimated_with`], the reduction part with its truncation part only if `truncation`
+/// ([`JointFlexibility::estimator_with`]; without it no truncation check either). A run whose
+/// estimate only ranks the pairs needs the joint part alone; the truncated modes are then
+/// computed beside the run all the same, for the runs after it.
+///
+/// # Errors
+/// As [`run_estimated`].
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn run_estimated_parts(
+    model: &Model,
+    flex: &JointFlexibility,
+    rom: ReducedSystem,
+    scene: &Scene,
+    opts: &TransientOptions,
+    checks: Checks,
+    truncation: bool,
+    observe: impl FnMut(f64, &[f64]),
+) -> Result<(Run, Result<RunEstimate, Error>), Error> {
     flex.basis_of(&rom)?;
     let opts = TransientOptions {
         record: true,
@@ -471,7 +492,11 @@ pub fn run_estimated_with(
             run
         },
         move || {
-            let estimator = flex.estimator(model, &aside);
+            if !truncation {
+                // A mode set that fails here fails again, named, where it is needed.
+                let _ = flex.truncation_modes(model);
+            }
+            let estimator = flex.estimator_with(model, &aside, truncation);
             // The two re-runs beside each other (a third job when a core is free).
             let rich = match &estimator {
                 Ok(e) if checks.truncation => truncation_check_system(model, e),

@@ -51,7 +51,10 @@
 //! O(1) and its integration error at [`RANKING_LOOSENING`]× looser tolerances is a small
 //! fraction of that — so it runs at those looser tolerances; should it meet TOL, it is re-run at
 //! the user's before it is the result. It is still estimated on every output: a thinned ranking
-//! picks worse pairs on refined meshes.
+//! picks worse pairs on refined meshes. But only its joint part (the correction without the
+//! truncated modes' dynamics): the pairs are ranked by that part, and ν grows only once it is
+//! within its share, so the second correction per output and the truncated modes' setup against
+//! its basis would buy nothing there.
 //!
 //! Pairs that never carry force in either the run or the correction have `e_k = 0` and are never
 //! added: the model keeps only the joint directions the scene uses. The estimate's truncation
@@ -97,7 +100,7 @@ use crate::reduction::{
     Quantity, DEFAULT_DROP_TOL,
 };
 use crate::rom::estimate::{
-    add_checks, beside, drop_truncation, loosened, run_estimated_with, Checks, RunEstimate,
+    add_checks, beside, drop_truncation, loosened, run_estimated_parts, Checks, RunEstimate,
 };
 use crate::rom::statics::{reduced_contact_static_restarting, scaled_load, ReducedStatic};
 use crate::system::{ReducedSystem, Scene};
@@ -188,7 +191,8 @@ pub struct Round {
     pub nu: usize,
     /// Basis size r.
     pub basis_size: usize,
-    /// The estimated relative L2 error of ‖f_c‖(t) (reduction part).
+    /// The estimated relative L2 error of ‖f_c‖(t) (reduction part; of the ranking round its
+    /// joint part alone).
     pub estimate: Option<f64>,
     /// The estimated relative L2 error of ‖f_R‖(t) (reduction part; `None` without friction).
     pub friction_estimate: Option<f64>,
@@ -196,7 +200,8 @@ pub struct Round {
     pub joint: Option<f64>,
     /// The joint part of the ‖f_R‖(t) estimate (what more tangential attachment modes remove).
     pub joint_friction: Option<f64>,
-    /// Its truncation part (what more fixed-interface modes remove).
+    /// Its truncation part (what more fixed-interface modes remove; `None` in the ranking
+    /// round, whose estimate is its joint part alone).
     pub truncation: Option<f64>,
     /// The truncation check's part of the estimate (the re-run with the next fixed-interface
     /// modes, [`super::estimate::truncation_check_run`]): the largest over the controlled
@@ -345,13 +350,15 @@ pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<Toleran
         } else {
             Checks::NONE
         };
-        let (run, estimate) = run_estimated_with(
+        // The ranking round's estimate only ranks the pairs: its joint part alone.
+        let (run, estimate) = run_estimated_parts(
             model,
             &flex,
             rom.clone(),
             &scene,
             &transient,
             checks,
+            !ranking,
             |_, _| {},
         )?;
         let run = run.into_result()?;
