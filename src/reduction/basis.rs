@@ -8,7 +8,7 @@ use super::pod::DEFAULT_THRESHOLD;
 use super::tvd::TvdOptions;
 use crate::error::{Error, ReductionError};
 use crate::linalg::compensated::{split, two_product_sums};
-use crate::linalg::sparse::{sym_mul_vec_into, SymCsc};
+use crate::linalg::sparse::{sym_mul_mat, sym_mul_vec_into, SymCsc};
 use crate::linalg::symmetric_eigen;
 use crate::linalg::LinalgError;
 use crate::model::Model;
@@ -33,10 +33,59 @@ pub fn final_basis(
     m: &SymCsc,
     drop_tol: f64,
 ) -> Result<(Mat<f64>, usize), Error> {
+    orthonormalize(parts, m, drop_tol, None)
+}
+
+/// The columns that [`final_basis`] of `[phi, extra]` appends to an M-orthonormal `phi`
+/// (n × r, `ΦᵀMΦ = I`): `extra` (n × m) M-orthonormalized against Φ and among themselves, with
+/// Φ taken as it is instead of orthonormalized again. Φ's part is removed in blocks —
+/// `W ← W − Φ (MΦ)ᵀ W`, twice ("twice is enough") — and the remainders go through
+/// [`final_basis`]'s modified Gram–Schmidt among themselves, a column dropped when its M-norm
+/// is `≤ drop_tol ·` its M-norm before the projection. Returns `(Ψ, dropped)`.
+///
+/// For columns that are not nearly in Φ's span (smooth, global vectors such as the
+/// fixed-interface modes beyond a basis) the block projection in plain arithmetic is accurate:
+/// its rounding noise, `eps ‖v‖`, is far below the remainder. The compensated updates of
+/// [`final_basis`] are for stiff local vectors nearly in the span of earlier ones.
+pub fn orthonormal_beyond(
+    phi: MatRef<'_, f64>,
+    extra: MatRef<'_, f64>,
+    m: &SymCsc,
+    drop_tol: f64,
+) -> Result<(Mat<f64>, usize), Error> {
+    let n = m.n;
+    if let Some(p) = [phi, extra].iter().find(|p| p.nrows() != n) {
+        return Err(ReductionError::PartRows { rows: p.nrows(), n }.into());
+    }
+    let m_extra = sym_mul_mat(m, extra);
+    let norm0: Vec<f64> = (0..extra.ncols())
+        .map(|j| {
+            let v = extra.col(j).iter().zip(m_extra.col(j).iter());
+            v.map(|(a, b)| a * b).sum::<f64>().max(0.0).sqrt()
+        })
+        .collect();
+    let m_phi = sym_mul_mat(m, phi);
+    let mut w = extra.to_owned();
+    for _ in 0..2 {
+        let c = m_phi.transpose() * &w;
+        w -= phi * &c;
+    }
+    orthonormalize(&[w.as_ref()], m, drop_tol, Some(&norm0))
+}
+
+/// [`final_basis`], each column's M-norm before its orthogonalization taken from `norm0` when
+/// given (one per column of `parts`, in order).
+fn orthonormalize(
+    parts: &[MatRef<'_, f64>],
+    m: &SymCsc,
+    drop_tol: f64,
+    norm0: Option<&[f64]>,
+) -> Result<(Mat<f64>, usize), Error> {
     let n = m.n;
     if let Some(p) = parts.iter().find(|p| p.nrows() != n) {
         return Err(ReductionError::PartRows { rows: p.nrows(), n }.into());
     }
+    let mut column = 0;
     let mut q: Vec<Vec<f64>> = Vec::new();
     let mut mq: Vec<Vec<f64>> = Vec::new();
     // Veltkamp splits of the accepted columns, for the compensated updates.
@@ -51,7 +100,11 @@ pub fn final_basis(
         for c in 0..part.ncols() {
             let mut v: Vec<f64> = part.col(c).iter().copied().collect();
             sym_mul_vec_into(m, &v, &mut mv);
-            let norm0 = dot(&v, &mv).max(0.0).sqrt();
+            let norm0 = match norm0 {
+                Some(given) => given[column],
+                None => dot(&v, &mv).max(0.0).sqrt(),
+            };
+            column += 1;
             if !norm0.is_finite() {
                 return Err(ReductionError::NotFinite {
                     what: "basis column is",

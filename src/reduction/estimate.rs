@@ -156,7 +156,7 @@ use crate::linalg::symmetric_eigen;
 use crate::linalg::LinalgError;
 use crate::linalg::{SubsetLlt, SymCsc};
 use crate::model::{Interface, Model};
-use crate::reduction::final_basis;
+use crate::reduction::basis::orthonormal_beyond;
 use crate::system::{ReducedSystem, SecondOrderSystem};
 
 /// The joint flexibility of a model: one sparse Cholesky of `K`, the static responses to unit
@@ -595,11 +595,9 @@ impl Truncation {
         phi: MatRef<'_, f64>,
         modes: MatRef<'_, f64>,
     ) -> Result<Truncation, Error> {
-        let r = phi.ncols();
-        let (both, _) = final_basis(&[phi, modes], &model.mass, 1e-6)?;
-        let w_cols = both.ncols().saturating_sub(r);
-        let w = both.subcols(r, w_cols).to_owned();
-        let (psi, omega2) = if w_cols > 0 {
+        // Φ is M-orthonormal already: the modes are orthonormalized against it as it is.
+        let (w, _) = orthonormal_beyond(phi, modes, &model.mass, 1e-6)?;
+        let (psi, omega2) = if w.ncols() > 0 {
             let k2 = compensated_gram(&model.stiffness, w.as_ref());
             let evd = symmetric_eigen(k2.as_ref(), "truncation modes' eigenproblem")
                 .map_err(Error::LinearAlgebra)?;
