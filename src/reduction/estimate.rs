@@ -1045,6 +1045,9 @@ impl ErrorEstimator<'_> {
         let mut dissipation = Dissipation::default();
         let mut corr = Corrector::new(self.flex, law);
         let mut corr_joint = Corrector::new(self.flex, law);
+        // D is summed from the full correction's states: the joint part's slip only when the
+        // joint part is the whole correction.
+        corr_joint.want_slip = self.truncation.is_none();
         let at = |j: usize| {
             move |e: Error| match e {
                 Error::LinearAlgebra(source) => Error::LinearAlgebra(LinalgError::EstimateAt {
@@ -1222,8 +1225,11 @@ struct Corrector<'a> {
     /// The run's slip memory at the previous output (2w, mm; empty before the first).
     last_s: Vec<f64>,
     /// The slip memory of the last corrected state (2w, mm; NaN for open pairs; empty
-    /// without friction): [`Corrector::corrected_slip`].
+    /// without friction or without `want_slip`): [`Corrector::corrected_slip`].
     slip: Vec<f64>,
+    /// Whether the corrected slip is wanted (the dissipated energy is summed from this
+    /// correction's states).
+    want_slip: bool,
 }
 
 /// Active-set iterations per output before the projected Gauss–Seidel fallback.
@@ -1265,6 +1271,7 @@ impl<'a> Corrector<'a> {
             cols: vec![None; flex.pairs()],
             last_s: Vec::new(),
             slip: Vec::new(),
+            want_slip: true,
         }
     }
 
@@ -1412,6 +1419,9 @@ impl<'a> Corrector<'a> {
             }
         }
         let stuck = self.stick(u0, s, pc, stick)?;
+        if !self.want_slip {
+            return Ok(());
+        }
         self.corrected_slip(u0, s, pc, &stuck)
     }
 
