@@ -1138,39 +1138,14 @@ impl ErrorEstimator<'_> {
                 }
             }
         }
-        let [fc, fr, uy, fc_rom, fr_rom, uy_rom] = curves;
-        out.joint = relative_l2(&fc_rom, &fc_joint);
-        out.joint_friction = if law.friction {
-            relative_l2(&fr_rom, &fr_joint)
-        } else {
-            None
-        };
-        out.truncation = self
-            .truncation
-            .is_some()
-            .then(|| relative_l2(&fc_joint, &fc))
-            .flatten();
-        out.corrected_joint_norm2 = fc_joint.iter().map(|v| v * v).sum();
-        out.corrected_joint_friction_norm2 = fr_joint.iter().map(|v| v * v).sum();
-        out.errors = CurveErrors {
-            contact_force: relative_l2(&fc_rom, &fc),
-            friction_force: if law.friction {
-                relative_l2(&fr_rom, &fr)
-            } else {
-                None
-            },
-            master_uy: relative_l2(&uy_rom, &uy),
-            dissipated: law
-                .friction
-                .then(|| relative_l2(&dissipation.run, &dissipation.corrected))
-                .flatten(),
-            dissipated_end: law.friction.then(|| dissipation.end_error()).flatten(),
-        };
-        out.corrected_dissipated = dissipation.corrected;
-        out.corrected_contact_force = fc;
-        out.corrected_friction_force = fr;
-        out.corrected_master_uy = uy;
-        Ok(out)
+        Ok(finish_estimate(
+            out,
+            curves,
+            [fc_joint, fr_joint],
+            dissipation,
+            law.friction,
+            self.truncation.is_some(),
+        ))
     }
 
     /// `q̈ = M̃⁻¹ (Φᵀ f(t) − K̃ q − (BΦ)ᵀ p)` at every output (r × outputs).
@@ -1203,6 +1178,47 @@ impl ErrorEstimator<'_> {
         }
         Ok(acc)
     }
+}
+
+/// The estimate's curve errors from its per-output curves (`[‖p_n*‖, ‖p_t*‖, u_y*, ‖p_n‖, ‖p_t‖,
+/// u_y]`, the joint-only correction's `[‖p_n‖, ‖p_t‖]` and the dissipated energies), written into
+/// `out` with the per-pair shares it holds; the truncation part only if the estimate has one.
+fn finish_estimate(
+    mut out: Estimate,
+    curves: [Vec<f64>; 6],
+    [fc_joint, fr_joint]: [Vec<f64>; 2],
+    dissipation: Dissipation,
+    friction: bool,
+    truncation: bool,
+) -> Estimate {
+    let [fc, fr, uy, fc_rom, fr_rom, uy_rom] = curves;
+    out.joint = relative_l2(&fc_rom, &fc_joint);
+    out.joint_friction = if friction {
+        relative_l2(&fr_rom, &fr_joint)
+    } else {
+        None
+    };
+    out.truncation = truncation.then(|| relative_l2(&fc_joint, &fc)).flatten();
+    out.corrected_joint_norm2 = fc_joint.iter().map(|v| v * v).sum();
+    out.corrected_joint_friction_norm2 = fr_joint.iter().map(|v| v * v).sum();
+    out.errors = CurveErrors {
+        contact_force: relative_l2(&fc_rom, &fc),
+        friction_force: if friction {
+            relative_l2(&fr_rom, &fr)
+        } else {
+            None
+        },
+        master_uy: relative_l2(&uy_rom, &uy),
+        dissipated: friction
+            .then(|| relative_l2(&dissipation.run, &dissipation.corrected))
+            .flatten(),
+        dissipated_end: friction.then(|| dissipation.end_error()).flatten(),
+    };
+    out.corrected_dissipated = dissipation.corrected;
+    out.corrected_contact_force = fc;
+    out.corrected_friction_force = fr;
+    out.corrected_master_uy = uy;
+    out
 }
 
 /// The per-output pair-space correction (module docs). Consecutive outputs mostly share their
