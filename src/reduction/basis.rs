@@ -8,7 +8,7 @@ use super::pod::DEFAULT_THRESHOLD;
 use super::tvd::TvdOptions;
 use crate::error::{Error, ReductionError};
 use crate::linalg::compensated::{split, two_product_sums};
-use crate::linalg::sparse::{sym_mul_vec_into, SymCsc};
+use crate::linalg::sparse::{sym_mul_mat, sym_mul_vec_into, SymCsc};
 use crate::linalg::symmetric_eigen;
 use crate::linalg::LinalgError;
 use crate::model::Model;
@@ -33,66 +33,198 @@ pub fn final_basis(
     m: &SymCsc,
     drop_tol: f64,
 ) -> Result<(Mat<f64>, usize), Error> {
+    orthonormalize(parts, m, drop_tol, None)
+}
+
+/// The columns that [`final_basis`] of `[phi, extra]` appends to an M-orthonormal `phi`
+/// (n × r, `ΦᵀMΦ = I`): `extra` (n × m) M-orthonormalized against Φ and among themselves, with
+/// Φ taken as it is instead of orthonormalized again. Φ's part is removed in blocks —
+/// `W ← W − Φ (MΦ)ᵀ W`, twice ("twice is enough") — and the remainders go through
+/// [`final_basis`]'s modified Gram–Schmidt among themselves, a column dropped when its M-norm
+/// is `≤ drop_tol ·` its M-norm before the projection. Returns `(Ψ, dropped)`.
+///
+/// For columns that are not nearly in Φ's span (smooth, global vectors such as the
+/// fixed-interface modes beyond a basis) the block projection in plain arithmetic is accurate:
+/// its rounding noise, `eps ‖v‖`, is far below the remainder. The compensated updates of
+/// [`final_basis`] are for stiff local vectors nearly in the span of earlier ones.
+pub fn orthonormal_beyond(
+    phi: MatRef<'_, f64>,
+    extra: MatRef<'_, f64>,
+    m: &SymCsc,
+    drop_tol: f64,
+) -> Result<(Mat<f64>, usize), Error> {
     let n = m.n;
-    if let Some(p) = parts.iter().find(|p| p.nrows() != n) {
+    if let Some(p) = [phi, extra].iter().find(|p| p.nrows() != n) {
         return Err(ReductionError::PartRows { rows: p.nrows(), n }.into());
     }
-    let mut q: Vec<Vec<f64>> = Vec::new();
-    let mut mq: Vec<Vec<f64>> = Vec::new();
-    // Veltkamp splits of the accepted columns, for the compensated updates.
-    let mut q_hi: Vec<Vec<f64>> = Vec::new();
-    let mut q_lo: Vec<Vec<f64>> = Vec::new();
-    let mut dropped = 0;
-    let mut mv = vec![0.0; n];
-    let mut hi = vec![0.0; n];
-    let mut lo = vec![0.0; n];
-    let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| x * y).sum::<f64>();
+    let m_extra = sym_mul_mat(m, extra);
+    let norm0: Vec<f64> = (0..extra.ncols())
+        .map(|j| {
+            let v = extra.col(j).iter().zip(m_extra.col(j).iter());
+            v.map(|(a, b)| a * b).sum::<f64>().max(0.0).sqrt()
+        })
+        .collect();
+    let m_phi = sym_mul_mat(m, phi);
+    let mut w = extra.to_owned();
+    for _ in 0..2 {
+        let c = m_phi.transpose() * &w;
+        w -= phi * &c;
+    }
+    orthonormalize(&[w.as_ref()], m, drop_tol, Some(&norm0))
+}
+
+/// [`final_basis`], each column's M-norm before its orthogonalization taken from `norm0` when
+/// given (one per column of `parts`, in order).
+fn orthonormalize(
+    parts: &[MatRef<'_, f64>],
+    m: &SymCsc,
+    drop_tol: f64,
+    norm0: Option<&[f64]>,
+) -> Result<(Mat<f64>, usize), Error> {
+    let mut gs = Orthonormalizer::new(m, drop_tol);
+    let mut column = 0;
     for part in parts {
+        if part.nrows() != m.n {
+            return Err(ReductionError::PartRows {
+                rows: part.nrows(),
+                n: m.n,
+            }
+            .into());
+        }
         for c in 0..part.ncols() {
-            let mut v: Vec<f64> = part.col(c).iter().copied().collect();
-            sym_mul_vec_into(m, &v, &mut mv);
-            let norm0 = dot(&v, &mv).max(0.0).sqrt();
-            if !norm0.is_finite() {
-                return Err(ReductionError::NotFinite {
-                    what: "basis column is",
+            let v: Vec<f64> = part.col(c).iter().copied().collect();
+            gs.push_with_norm(v, norm0.map(|given| given[column]))?;
+            column += 1;
+        }
+    }
+    Ok((gs.basis(), gs.dropped()))
+}
+
+/// The modified Gram–Schmidt of [`final_basis`], one column at a time, resumable: the state
+/// after the first k columns does not depend on the ones after, so a caller whose next basis
+/// starts with the same columns as its last one ([`Orthonormalizer::truncate`] to their count)
+/// orthonormalizes only the new ones — the same bits as [`final_basis`] of all of them.
+#[derive(Clone, Debug)]
+pub struct Orthonormalizer<'m> {
+    m: &'m SymCsc,
+    drop_tol: f64,
+    /// The accepted columns, M-orthonormal, their M-products and Veltkamp splits.
+    q: Vec<Vec<f64>>,
+    mq: Vec<Vec<f64>>,
+    q_hi: Vec<Vec<f64>>,
+    q_lo: Vec<Vec<f64>>,
+    /// Per column pushed, the accepted columns after it.
+    accepted_after: Vec<usize>,
+}
+
+impl<'m> Orthonormalizer<'m> {
+    /// No columns yet; `drop_tol` as in [`final_basis`].
+    pub fn new(m: &'m SymCsc, drop_tol: f64) -> Orthonormalizer<'m> {
+        Orthonormalizer {
+            m,
+            drop_tol,
+            q: Vec::new(),
+            mq: Vec::new(),
+            q_hi: Vec::new(),
+            q_lo: Vec::new(),
+            accepted_after: Vec::new(),
+        }
+    }
+
+    /// Columns pushed so far (accepted or dropped).
+    pub fn pushed(&self) -> usize {
+        self.accepted_after.len()
+    }
+
+    /// Columns dropped so far (linearly dependent on earlier ones, or zero).
+    pub fn dropped(&self) -> usize {
+        self.pushed() - self.q.len()
+    }
+
+    /// Forgets every column pushed after the first `pushed`.
+    pub fn truncate(&mut self, pushed: usize) {
+        if pushed >= self.pushed() {
+            return;
+        }
+        self.accepted_after.truncate(pushed);
+        let keep = self.accepted_after.last().copied().unwrap_or(0);
+        for v in [&mut self.q, &mut self.mq, &mut self.q_hi, &mut self.q_lo] {
+            v.truncate(keep);
+        }
+    }
+
+    /// The accepted columns (n × accepted), `Φᵀ M Φ = I`.
+    pub fn basis(&self) -> Mat<f64> {
+        Mat::from_fn(self.m.n, self.q.len(), |r, c| self.q[c][r])
+    }
+
+    /// Orthogonalizes `v` (n values) against the accepted columns and accepts it unless it is
+    /// dependent on them ([`final_basis`]).
+    ///
+    /// # Errors
+    /// [`ReductionError::PartRows`] for a column of the wrong length,
+    /// [`ReductionError::NotFinite`] for one that is not finite.
+    pub fn push(&mut self, v: Vec<f64>) -> Result<(), Error> {
+        self.push_with_norm(v, None)
+    }
+
+    /// [`Orthonormalizer::push`], the column's M-norm before its orthogonalization (the scale
+    /// of the drop test) `norm0` when given.
+    fn push_with_norm(&mut self, mut v: Vec<f64>, norm0: Option<f64>) -> Result<(), Error> {
+        let n = self.m.n;
+        if v.len() != n {
+            return Err(ReductionError::PartRows { rows: v.len(), n }.into());
+        }
+        let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| x * y).sum::<f64>();
+        let mut mv = vec![0.0; n];
+        let norm0 = match norm0 {
+            Some(given) => given,
+            None => {
+                sym_mul_vec_into(self.m, &v, &mut mv);
+                dot(&v, &mv).max(0.0).sqrt()
+            }
+        };
+        if !norm0.is_finite() {
+            return Err(ReductionError::NotFinite {
+                what: "basis column is",
+            }
+            .into());
+        }
+        if norm0 == 0.0 {
+            self.accepted_after.push(self.q.len());
+            return Ok(());
+        }
+        let mut hi = vec![0.0; n];
+        let mut lo = vec![0.0; n];
+        for _ in 0..2 {
+            // v ← v − Σ_k (q_kᵀ M v) q_k, each entry accumulated in double-double (`hi + lo`,
+            // the arithmetic of `Dot2`) and rounded once (see [`final_basis`]).
+            hi.copy_from_slice(&v);
+            lo.fill(0.0);
+            for ((mqk, qh), ql) in self.mq.iter().zip(&self.q_hi).zip(&self.q_lo) {
+                let a = -dot(mqk, &v);
+                let (ah, al) = split(a);
+                two_product_sums(&mut hi, &mut lo, a, ah, al, qh, ql);
+                // Modified Gram–Schmidt: the next coefficient sees this update.
+                for ((x, h), l) in v.iter_mut().zip(&hi).zip(&lo) {
+                    *x = h + l;
                 }
-                .into());
             }
-            if norm0 == 0.0 {
-                dropped += 1;
-                continue;
-            }
-            for _ in 0..2 {
-                // v ← v − Σ_k (q_kᵀ M v) q_k, each entry accumulated in double-double (`hi + lo`,
-                // the arithmetic of `Dot2`) and rounded once (see the doc comment).
-                hi.copy_from_slice(&v);
-                lo.fill(0.0);
-                for ((mqk, qh), ql) in mq.iter().zip(&q_hi).zip(&q_lo) {
-                    let a = -dot(mqk, &v);
-                    let (ah, al) = split(a);
-                    two_product_sums(&mut hi, &mut lo, a, ah, al, qh, ql);
-                    // Modified Gram–Schmidt: the next coefficient sees this update.
-                    for ((x, h), l) in v.iter_mut().zip(&hi).zip(&lo) {
-                        *x = h + l;
-                    }
-                }
-            }
-            sym_mul_vec_into(m, &v, &mut mv);
-            let norm = dot(&v, &mv).max(0.0).sqrt();
-            if norm <= drop_tol * norm0 {
-                dropped += 1;
-                continue;
-            }
+        }
+        sym_mul_vec_into(self.m, &v, &mut mv);
+        let norm = dot(&v, &mv).max(0.0).sqrt();
+        if norm > self.drop_tol * norm0 {
             v.iter_mut().for_each(|x| *x /= norm);
             mv.iter_mut().for_each(|x| *x /= norm);
             let (h, l): (Vec<f64>, Vec<f64>) = v.iter().map(|&x| split(x)).unzip();
-            q_hi.push(h);
-            q_lo.push(l);
-            q.push(v);
-            mq.push(mv.clone());
+            self.q_hi.push(h);
+            self.q_lo.push(l);
+            self.q.push(v);
+            self.mq.push(mv);
         }
+        self.accepted_after.push(self.q.len());
+        Ok(())
     }
-    Ok((Mat::from_fn(n, q.len(), |r, c| q[c][r]), dropped))
 }
 
 /// Which joint DOF the Joint Interface Modes are condensed to.

@@ -156,7 +156,7 @@ use crate::linalg::symmetric_eigen;
 use crate::linalg::LinalgError;
 use crate::linalg::{SubsetLlt, SymCsc};
 use crate::model::{Interface, Model};
-use crate::reduction::final_basis;
+use crate::reduction::basis::orthonormal_beyond;
 use crate::system::{ReducedSystem, SecondOrderSystem};
 
 /// The joint flexibility of a model: one sparse Cholesky of `K`, the static responses to unit
@@ -462,24 +462,43 @@ impl JointFlexibility {
     }
 
     /// The estimator of a reduced model on the basis `phi` (n × r) of `model`: `G = B K⁻¹ M Φ`
-    /// and `G_m = E_mᵀ K⁻¹ M Φ` from r refined solves.
+    /// and `G_m = E_mᵀ K⁻¹ M Φ` from r refined solves, and the truncated modes beyond Φ.
     pub fn estimator<'a>(
         &'a self,
         model: &Model,
         rom: &ReducedSystem,
     ) -> Result<ErrorEstimator<'a>, Error> {
+        self.estimator_with(model, rom, true)
+    }
+
+    /// [`JointFlexibility::estimator`], with the truncation part only if `truncation`: without
+    /// it the estimate is the joint part alone ([`Estimate::truncation`] `None`), one correction
+    /// per output instead of two and no truncated modes set up — for a run whose estimate only
+    /// ranks the pairs (the tolerance model's first round).
+    pub fn estimator_with<'a>(
+        &'a self,
+        model: &Model,
+        rom: &ReducedSystem,
+        truncation: bool,
+    ) -> Result<ErrorEstimator<'a>, Error> {
         let phi = self.basis_of(rom)?;
         let m_phi = sym_mul_mat(&model.mass, phi.as_ref());
         let y = solve_refined_owned(&self.stiffness, &self.chol, m_phi);
+        let truncation = if truncation {
+            let modes = self.truncation_modes(model)?;
+            Some(Truncation::new(
+                model,
+                phi.as_ref(),
+                modes.as_ref().as_ref(),
+            )?)
+        } else {
+            None
+        };
         Ok(ErrorEstimator {
             flex: self,
             g: self.joint.reduce(y.as_ref()),
             g_m: Mat::from_fn(6, y.ncols(), |d, j| y[(self.master[d], j)]),
-            truncation: Truncation::new(
-                model,
-                phi.as_ref(),
-                self.truncation_modes(model)?.as_ref().as_ref(),
-            )?,
+            truncation,
             rom: rom.clone(),
         })
     }
@@ -488,7 +507,7 @@ impl JointFlexibility {
     /// computed on first use: only the transient estimate needs them (not the pair-space
     /// statics), and its first use is on the second core beside a reduced run
     /// ([`crate::rom::estimate::run_estimated`]).
-    fn truncation_modes(&self, model: &Model) -> Result<Arc<Mat<f64>>, Error> {
+    pub(crate) fn truncation_modes(&self, model: &Model) -> Result<Arc<Mat<f64>>, Error> {
         // Not held while computing: the modes' solves may run on rayon's pool, and a worker
         // waiting there can take another estimator's job that wants this lock (the deadlock
         // class of `rom::estimate::beside`). Two estimators may both compute them: the
@@ -549,7 +568,8 @@ pub struct ErrorEstimator<'a> {
     g: Mat<f64>,
     /// `G_m = E_mᵀ K⁻¹ M Φ` (6 × r).
     g_m: Mat<f64>,
-    truncation: Truncation,
+    /// The truncated modes (`None`: the estimate is the joint part alone).
+    truncation: Option<Truncation>,
     rom: ReducedSystem,
 }
 
@@ -575,11 +595,9 @@ impl Truncation {
         phi: MatRef<'_, f64>,
         modes: MatRef<'_, f64>,
     ) -> Result<Truncation, Error> {
-        let r = phi.ncols();
-        let (both, _) = final_basis(&[phi, modes], &model.mass, 1e-6)?;
-        let w_cols = both.ncols().saturating_sub(r);
-        let w = both.subcols(r, w_cols).to_owned();
-        let (psi, omega2) = if w_cols > 0 {
+        // Φ is M-orthonormal already: the modes are orthonormalized against it as it is.
+        let (w, _) = orthonormal_beyond(phi, modes, &model.mass, 1e-6)?;
+        let (psi, omega2) = if w.ncols() > 0 {
             let k2 = compensated_gram(&model.stiffness, w.as_ref());
             let evd = symmetric_eigen(k2.as_ref(), "truncation modes' eigenproblem")
                 .map_err(Error::LinearAlgebra)?;
@@ -623,22 +641,33 @@ impl Truncation {
         let outputs = t.len();
         let rho = self.psi_m.transpose() * load - &self.psi_k_phi * q - self.b_psi.transpose() * p;
         let mut out = Mat::<f64>::zeros(m, outputs);
+        // The outputs are nearly equally spaced: their steps take a few distinct values (in
+        // the last bits), so each mode's rotation is computed once per distinct step.
+        let mut distinct: Vec<f64> = Vec::new();
+        let mut index = std::collections::HashMap::new();
+        let step_of: Vec<usize> = (0..outputs.saturating_sub(1))
+            .map(|j| {
+                let h = t[j + 1] - t[j];
+                *index.entry(h.to_bits()).or_insert_with(|| {
+                    distinct.push(h);
+                    distinct.len() - 1
+                })
+            })
+            .collect();
+        let mut rotation = vec![(0.0, 1.0); distinct.len()];
         for i in 0..m {
             let w2 = self.omega2[i];
             let w = w2.sqrt();
+            for (r, h) in rotation.iter_mut().zip(&distinct) {
+                *r = (w * h).sin_cos();
+            }
             let mut d = -rho[(i, 0)] / w2;
             let mut slope_prev = 0.0;
             let mut rate = 0.0;
-            // The outputs are mostly equally spaced: the rotation of the last step again.
-            let mut step = (f64::NAN, 0.0, 1.0);
             out[(i, 0)] = d;
             for j in 0..outputs.saturating_sub(1) {
                 let h = t[j + 1] - t[j];
-                if h.to_bits() != step.0.to_bits() {
-                    let (sn, cs) = (w * h).sin_cos();
-                    step = (h, sn, cs);
-                }
-                let (sn, cs) = (step.1, step.2);
+                let (sn, cs) = rotation[step_of[j]];
                 let slope = if h > 0.0 {
                     (rho[(i, j + 1)] - rho[(i, j)]) / h
                 } else {
@@ -993,7 +1022,7 @@ impl ErrorEstimator<'_> {
     /// a scene's error need not be the next ones (the lap joint's dissipated energy at ν = 10
     /// is changed little by modes 11–20 and mostly by 21–30).
     pub fn truncation_check_basis(&self) -> Option<Mat<f64>> {
-        let extra = &self.truncation.ordered;
+        let extra = &self.truncation.as_ref()?.ordered;
         let phi = self.rom.phi.as_ref()?;
         (extra.ncols() > 0).then(|| {
             Mat::from_fn(phi.nrows(), phi.ncols() + extra.ncols(), |i, j| {
@@ -1025,8 +1054,12 @@ impl ErrorEstimator<'_> {
         // kinematics for every output at once (small: modes × outputs, 6 × outputs).
         let q_all = MatRef::from_column_major_slice(states.q, r, outputs);
         let p_all = MatRef::from_column_major_slice(states.p, 3 * w, outputs);
-        let excess = self.truncation.excess(states.t, &load, q_all, p_all);
-        let x_hat = &self.flex.c * &load - &self.g_m * &qdd + &self.truncation.psi_m * &excess;
+        let mut x_hat = &self.flex.c * &load - &self.g_m * &qdd;
+        let excess = self.truncation.as_ref().map(|tr| {
+            let excess = tr.excess(states.t, &load, q_all, p_all);
+            x_hat += &tr.psi_m * &excess;
+            excess
+        });
         let mut out = Estimate {
             pair_error: vec![0.0; w],
             ..Default::default()
@@ -1040,6 +1073,9 @@ impl ErrorEstimator<'_> {
         let mut dissipation = Dissipation::default();
         let mut corr = Corrector::new(self.flex, law);
         let mut corr_joint = Corrector::new(self.flex, law);
+        // D is summed from the full correction's states: the joint part's slip only when the
+        // joint part is the whole correction.
+        corr_joint.want_slip = self.truncation.is_none();
         let at = |j: usize| {
             move |e: Error| match e {
                 Error::LinearAlgebra(source) => Error::LinearAlgebra(LinalgError::EstimateAt {
@@ -1063,7 +1099,6 @@ impl ErrorEstimator<'_> {
                     }
                 }
             }
-            let u_hat = &u_joint + &self.truncation.b_psi * excess.subcols(first, cols);
             // The two corrections are independent sequences over the outputs (each warm-starts
             // from its own previous active set): one per core, the same bits as one after the
             // other.
@@ -1086,19 +1121,27 @@ impl ErrorEstimator<'_> {
                     })
                     .collect()
             };
-            // The joint part alone (no truncated-mode dynamics) ranks the pairs.
-            let (full, joint) = rayon::join(
-                || series(&mut corr, &u_hat),
-                || series(&mut corr_joint, &u_joint),
-            );
-            let (full, joint) = (full?, joint?);
-            for (c, ((pc, slip), (pj, _))) in full.into_iter().zip(joint).enumerate() {
+            // The joint part alone (no truncated-mode dynamics) ranks the pairs; without
+            // truncated modes it is the whole correction.
+            let (full, joint) = match (&self.truncation, &excess) {
+                (Some(tr), Some(excess)) => {
+                    let u_hat = &u_joint + &tr.b_psi * excess.subcols(first, cols);
+                    let (full, joint) = rayon::join(
+                        || series(&mut corr, &u_hat),
+                        || series(&mut corr_joint, &u_joint),
+                    );
+                    (Some(full?), joint?)
+                }
+                _ => (None, series(&mut corr_joint, &u_joint)?),
+            };
+            for (c, (pj, slip_j)) in joint.iter().enumerate() {
                 let j = first + c;
+                let (pc, slip) = full.as_ref().map_or((pj, slip_j), |f| (&f[c].0, &f[c].1));
                 let p = &states.p[3 * w * j..3 * w * (j + 1)];
                 if law.friction {
-                    dissipation.push(p, &pc, &states.s[ns * j..ns * (j + 1)], &slip);
+                    dissipation.push(p, pc, &states.s[ns * j..ns * (j + 1)], slip);
                 }
-                let [fc, fr, fc_rom, fr_rom, fcj, frj] = out.add_output(p, &pc, &pj);
+                let [fc, fr, fc_rom, fr_rom, fcj, frj] = out.add_output(p, pc, pj);
                 fc_joint.push(fcj.sqrt());
                 fr_joint.push(frj.sqrt());
                 // x_m* = C f_m − G_m q̈ − Hᵀ p* (the tangential part of p* as in the gaps: the
@@ -1123,42 +1166,14 @@ impl ErrorEstimator<'_> {
                 }
             }
         }
-        let [fc, fr, uy, fc_rom, fr_rom, uy_rom] = curves;
-        out.joint = relative_l2(&fc_rom, &fc_joint);
-        out.joint_friction = if law.friction {
-            relative_l2(&fr_rom, &fr_joint)
-        } else {
-            None
-        };
-        out.truncation = relative_l2(&fc_joint, &fc);
-        out.corrected_joint_norm2 = fc_joint.iter().map(|v| v * v).sum();
-        out.corrected_joint_friction_norm2 = fr_joint.iter().map(|v| v * v).sum();
-        out.errors = CurveErrors {
-            contact_force: relative_l2(&fc_rom, &fc),
-            friction_force: if law.friction {
-                relative_l2(&fr_rom, &fr)
-            } else {
-                None
-            },
-            master_uy: relative_l2(&uy_rom, &uy),
-            dissipated: law
-                .friction
-                .then(|| relative_l2(&dissipation.run, &dissipation.corrected))
-                .flatten(),
-            dissipated_end: law.friction.then(|| dissipation.end_error()).flatten(),
-        };
-        out.pair_dissipation_end = dissipation
-            .pair_run
-            .iter()
-            .zip(&dissipation.pair_corrected)
-            .map(|(a, b)| a - b)
-            .collect();
-        out.pair_dissipation_error = dissipation.pair_error;
-        out.corrected_dissipated = dissipation.corrected;
-        out.corrected_contact_force = fc;
-        out.corrected_friction_force = fr;
-        out.corrected_master_uy = uy;
-        Ok(out)
+        Ok(finish_estimate(
+            out,
+            curves,
+            [fc_joint, fr_joint],
+            dissipation,
+            law.friction,
+            self.truncation.is_some(),
+        ))
     }
 
     /// `q̈ = M̃⁻¹ (Φᵀ f(t) − K̃ q − (BΦ)ᵀ p)` at every output (r × outputs).
@@ -1193,6 +1208,54 @@ impl ErrorEstimator<'_> {
     }
 }
 
+/// The estimate's curve errors from its per-output curves (`[‖p_n*‖, ‖p_t*‖, u_y*, ‖p_n‖, ‖p_t‖,
+/// u_y]`, the joint-only correction's `[‖p_n‖, ‖p_t‖]` and the dissipated energies), written into
+/// `out` with the per-pair shares it holds; the truncation part only if the estimate has one.
+fn finish_estimate(
+    mut out: Estimate,
+    curves: [Vec<f64>; 6],
+    [fc_joint, fr_joint]: [Vec<f64>; 2],
+    dissipation: Dissipation,
+    friction: bool,
+    truncation: bool,
+) -> Estimate {
+    let [fc, fr, uy, fc_rom, fr_rom, uy_rom] = curves;
+    out.joint = relative_l2(&fc_rom, &fc_joint);
+    out.joint_friction = if friction {
+        relative_l2(&fr_rom, &fr_joint)
+    } else {
+        None
+    };
+    out.truncation = truncation.then(|| relative_l2(&fc_joint, &fc)).flatten();
+    out.corrected_joint_norm2 = fc_joint.iter().map(|v| v * v).sum();
+    out.corrected_joint_friction_norm2 = fr_joint.iter().map(|v| v * v).sum();
+    out.errors = CurveErrors {
+        contact_force: relative_l2(&fc_rom, &fc),
+        friction_force: if friction {
+            relative_l2(&fr_rom, &fr)
+        } else {
+            None
+        },
+        master_uy: relative_l2(&uy_rom, &uy),
+        dissipated: friction
+            .then(|| relative_l2(&dissipation.run, &dissipation.corrected))
+            .flatten(),
+        dissipated_end: friction.then(|| dissipation.end_error()).flatten(),
+    };
+    out.pair_dissipation_end = dissipation
+        .pair_run
+        .iter()
+        .zip(&dissipation.pair_corrected)
+        .map(|(a, b)| a - b)
+        .collect();
+    out.pair_dissipation_error = dissipation.pair_error;
+    out.corrected_dissipated = dissipation.corrected;
+    out.corrected_contact_force = fc;
+    out.corrected_friction_force = fr;
+    out.corrected_master_uy = uy;
+    out
+}
+
 /// The per-output pair-space correction (module docs). Consecutive outputs mostly share their
 /// active set, so each solve starts from the previous output's set and reuses its factor of
 /// `I + k_n F_AA` while the set is unchanged.
@@ -1213,8 +1276,11 @@ struct Corrector<'a> {
     /// The run's slip memory at the previous output (2w, mm; empty before the first).
     last_s: Vec<f64>,
     /// The slip memory of the last corrected state (2w, mm; NaN for open pairs; empty
-    /// without friction): [`Corrector::corrected_slip`].
+    /// without friction or without `want_slip`): [`Corrector::corrected_slip`].
     slip: Vec<f64>,
+    /// Whether the corrected slip is wanted (the dissipated energy is summed from this
+    /// correction's states).
+    want_slip: bool,
 }
 
 /// Active-set iterations per output before the projected Gauss–Seidel fallback.
@@ -1256,6 +1322,7 @@ impl<'a> Corrector<'a> {
             cols: vec![None; flex.pairs()],
             last_s: Vec::new(),
             slip: Vec::new(),
+            want_slip: true,
         }
     }
 
@@ -1403,6 +1470,9 @@ impl<'a> Corrector<'a> {
             }
         }
         let stuck = self.stick(u0, s, pc, stick)?;
+        if !self.want_slip {
+            return Ok(());
+        }
         self.corrected_slip(u0, s, pc, &stuck)
     }
 

@@ -56,7 +56,9 @@ pub mod estimate;
 pub mod pod;
 pub mod tvd;
 
-pub use basis::{final_basis, modal_rotation, Basis, BasisOptions, JimSet, DEFAULT_DROP_TOL};
+pub use basis::{
+    final_basis, modal_rotation, Basis, BasisOptions, JimSet, Orthonormalizer, DEFAULT_DROP_TOL,
+};
 pub use build::{build_basis, build_tvd_basis_both_pods, BasisKind};
 pub use competitors::{
     alldof_vectors, jim_dofs, jim_vectors, joint_interface_modes, snapshot_basis, snapshot_pod,

@@ -55,7 +55,10 @@
 //! O(1) and its integration error at [`RANKING_LOOSENING`]× looser tolerances is a small
 //! fraction of that — so it runs at those looser tolerances; should it meet TOL, it is re-run at
 //! the user's before it is the result. It is still estimated on every output: a thinned ranking
-//! picks worse pairs on refined meshes.
+//! picks worse pairs on refined meshes. But only its joint part (the correction without the
+//! truncated modes' dynamics): the pairs are ranked by that part, and ν grows only once it is
+//! within its share, so the second correction per output and the truncated modes' setup against
+//! its basis would buy nothing there.
 //!
 //! Pairs that never carry force in either the run or the correction have `e_k = 0` and are never
 //! added: the model keeps only the joint directions the scene uses. The estimate's truncation
@@ -85,6 +88,7 @@
 //! user's tolerances above TOL — the best model is returned with `met = false` (the CLI warns;
 //! tighter `--rtol/--atol` lower the integration floor).
 
+use std::collections::HashMap;
 use std::time::Instant;
 
 use serde::Serialize;
@@ -97,11 +101,11 @@ use crate::reduction::estimate::TRUNCATION_MODES;
 #[cfg(doc)]
 use crate::reduction::Estimate;
 use crate::reduction::{
-    craig_bampton, final_basis, modal_rotation, CurveErrors, JointFlexibility, Quantities,
+    craig_bampton, modal_rotation, CurveErrors, JointFlexibility, Orthonormalizer, Quantities,
     Quantity, DEFAULT_DROP_TOL,
 };
 use crate::rom::estimate::{
-    add_checks, beside, drop_truncation, loosened, run_estimated_with, Checks, RunEstimate,
+    add_checks, beside, drop_truncation, loosened, run_estimated_parts, Checks, RunEstimate,
 };
 use crate::rom::statics::{reduced_contact_static_restarting, scaled_load, ReducedStatic};
 use crate::system::{ReducedSystem, Scene};
@@ -143,7 +147,7 @@ pub enum IntegrationTolerances {
 /// The factor `s` on the paper's Table 1 rtol and atol (1e-8, 1e-6 mm) at which the tolerance
 /// model of tolerance `tol` starts: `s = clamp(tol / 1e-4, 1, 1e4)` — ten times looser per
 /// decade of tolerance above 1e-4, the paper's tolerances from 1e-4 down. The estimate, whose
-/// integration part is a re-run ten times tighter ([`super::estimate::integration_errors`]),
+/// integration part is a re-run √10 times tighter ([`super::estimate::integration_errors`]),
 /// checks the choice: while its total misses TOL, `s` drops tenfold and the model is re-run,
 /// down to `s = 1`.
 pub fn integration_looseness(tol: f64) -> f64 {
@@ -192,7 +196,8 @@ pub struct Round {
     pub nu: usize,
     /// Basis size r.
     pub basis_size: usize,
-    /// The estimated relative L2 error of ‖f_c‖(t) (reduction part).
+    /// The estimated relative L2 error of ‖f_c‖(t) (reduction part; of the ranking round its
+    /// joint part alone).
     pub estimate: Option<f64>,
     /// The estimated relative L2 error of ‖f_R‖(t) (reduction part; `None` without friction).
     pub friction_estimate: Option<f64>,
@@ -200,7 +205,8 @@ pub struct Round {
     pub joint: Option<f64>,
     /// The joint part of the ‖f_R‖(t) estimate (what more tangential attachment modes remove).
     pub joint_friction: Option<f64>,
-    /// Its truncation part (what more fixed-interface modes remove).
+    /// Its truncation part (what more fixed-interface modes remove; `None` in the ranking
+    /// round, whose estimate is its joint part alone).
     pub truncation: Option<f64>,
     /// The truncation check's part of the estimate (the re-run with the next fixed-interface
     /// modes, [`super::estimate::truncation_check_run`]): the largest over the controlled
@@ -322,6 +328,7 @@ pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<Toleran
     let (flex, mut cb) = (flex?, cb?);
     let setup_s = start.elapsed().as_secs_f64();
     let mut chosen = Chosen::default();
+    let mut bases = BasisCache::new(model);
     let mut rounds = Vec::new();
     // The Craig–Bampton round only ranks the pairs: looser tolerances (module docs).
     let mut ranking = true;
@@ -334,7 +341,7 @@ pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<Toleran
     };
     loop {
         let round_start = Instant::now();
-        let rom = reduced_on(model, &cb, &flex, &chosen)?;
+        let rom = reduced_on(model, &cb, &flex, &chosen, &mut bases)?;
         let basis_s = round_start.elapsed().as_secs_f64();
         let transient = loosened(
             &opts.transient,
@@ -349,13 +356,15 @@ pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<Toleran
         } else {
             Checks::NONE
         };
-        let (run, estimate) = run_estimated_with(
+        // The ranking round's estimate only ranks the pairs: its joint part alone.
+        let (run, estimate) = run_estimated_parts(
             model,
             &flex,
             rom.clone(),
             &scene,
             &transient,
             checks,
+            !ranking,
             |_, _| {},
         )?;
         let run = run.into_result()?;
@@ -744,30 +753,128 @@ pub fn reduced_on_pairs(
         pairs: pairs.to_vec(),
         ..Chosen::default()
     };
-    reduced_on(model, cb, flex, &chosen)
+    reduced_on(model, cb, flex, &chosen, &mut BasisCache::new(model))
+}
+
+/// A column of a tolerance model's basis before its M-orthonormalization.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+enum Column {
+    /// Column `j` of the Craig–Bampton basis with `cols` columns (6 + ν).
+    CraigBampton { cols: usize, j: usize },
+    /// The normal attachment mode of a pair.
+    Normal(usize),
+    /// The tangential attachment mode of a pair in a direction (its bits).
+    Tangential(usize, [u64; 2]),
+}
+
+/// What successive rounds' bases share: their leading columns (Craig–Bampton, and the
+/// attachment modes while only later ones change), orthonormalized once — the modified
+/// Gram–Schmidt's state after a column does not depend on the columns after it — and the
+/// attachment modes solved so far (a column's refined solve has the same bits alone as in a
+/// block). Every basis is the one [`crate::reduction::final_basis`] gives of all its columns,
+/// bit for bit.
+struct BasisCache<'m> {
+    /// The orthonormalization of the last basis's columns `keys`, in order.
+    gs: Orthonormalizer<'m>,
+    keys: Vec<Column>,
+    /// Attachment modes solved so far (n values each).
+    solved: HashMap<Column, Vec<f64>>,
+}
+
+impl<'m> BasisCache<'m> {
+    fn new(model: &'m Model) -> BasisCache<'m> {
+        BasisCache {
+            gs: Orthonormalizer::new(&model.mass, DEFAULT_DROP_TOL),
+            keys: Vec::new(),
+            solved: HashMap::new(),
+        }
+    }
+
+    /// The M-orthonormal basis of the columns `keys` (before the rotation), orthonormalizing
+    /// only those after the prefix it shares with the last basis, and solving only the
+    /// attachment modes not solved before.
+    fn basis(
+        &mut self,
+        cb: &faer::Mat<f64>,
+        flex: &JointFlexibility,
+        keys: Vec<Column>,
+    ) -> Result<faer::Mat<f64>, Error> {
+        let common = self
+            .keys
+            .iter()
+            .zip(&keys)
+            .take_while(|(a, b)| a == b)
+            .count();
+        self.gs.truncate(common);
+        self.keys.truncate(common);
+        let missing = |want: fn(&Column) -> bool| -> Vec<Column> {
+            let mut out: Vec<Column> = keys[common..]
+                .iter()
+                .filter(|c| want(c) && !self.solved.contains_key(c))
+                .copied()
+                .collect();
+            out.dedup();
+            out
+        };
+        let normal = missing(|c| matches!(c, Column::Normal(_)));
+        let tangential = missing(|c| matches!(c, Column::Tangential(..)));
+        let pairs: Vec<usize> = normal
+            .iter()
+            .filter_map(|c| match c {
+                Column::Normal(k) => Some(*k),
+                _ => None,
+            })
+            .collect();
+        let directions: Vec<(usize, [f64; 2])> = tangential
+            .iter()
+            .filter_map(|c| match c {
+                Column::Tangential(k, d) => Some((*k, d.map(f64::from_bits))),
+                _ => None,
+            })
+            .collect();
+        let att = flex.attachment_modes(&pairs);
+        let tan = flex.tangential_attachment_modes(&directions);
+        for (cols, modes) in [(&normal, &att), (&tangential, &tan)] {
+            for (j, c) in cols.iter().enumerate() {
+                self.solved
+                    .insert(*c, modes.col(j).iter().copied().collect());
+            }
+        }
+        for key in &keys[common..] {
+            let v = match key {
+                Column::CraigBampton { j, .. } => cb.col(*j).iter().copied().collect(),
+                other => self.solved[other].clone(),
+            };
+            self.gs.push(v)?;
+            self.keys.push(*key);
+        }
+        Ok(self.gs.basis())
+    }
 }
 
 /// The reduced system on Craig–Bampton plus the normal and tangential attachment modes of
-/// `chosen`.
+/// `chosen` ([`BasisCache`]: the columns it shares with the last basis are not orthonormalized
+/// again).
 fn reduced_on(
     model: &Model,
     cb: &faer::Mat<f64>,
     flex: &JointFlexibility,
     chosen: &Chosen,
+    cache: &mut BasisCache<'_>,
 ) -> Result<ReducedSystem, Error> {
-    let att = flex.attachment_modes(&chosen.pairs);
-    let with_directions: Vec<(usize, [f64; 2])> = chosen
-        .tangential
-        .iter()
-        .copied()
-        .zip(chosen.directions.iter().copied())
+    let cols = cb.ncols();
+    let keys: Vec<Column> = (0..cols)
+        .map(|j| Column::CraigBampton { cols, j })
+        .chain(chosen.pairs.iter().map(|&k| Column::Normal(k)))
+        .chain(
+            chosen
+                .tangential
+                .iter()
+                .zip(&chosen.directions)
+                .map(|(&k, d)| Column::Tangential(k, d.map(f64::to_bits))),
+        )
         .collect();
-    let tangential = flex.tangential_attachment_modes(&with_directions);
-    let (phi, _) = final_basis(
-        &[cb.as_ref(), att.as_ref(), tangential.as_ref()],
-        &model.mass,
-        DEFAULT_DROP_TOL,
-    )?;
+    let phi = cache.basis(cb, flex, keys)?;
     let (phi, _) = modal_rotation(model, phi)?;
     ReducedSystem::new(model, phi)
 }
@@ -844,9 +951,14 @@ pub fn static_tolerance_model(
     let mut ranked: Vec<usize> = (0..exact.len()).filter(|&k| exact[k] != 0.0).collect();
     ranked.sort_by(|&a, &b| exact[a].abs().total_cmp(&exact[b].abs()).reverse());
     let cb = craig_bampton(model, nu)?;
+    let mut bases = BasisCache::new(model);
     let mut m = 0;
     loop {
-        let rom = reduced_on_pairs(model, &cb, &flex, &ranked[..m])?;
+        let chosen = Chosen {
+            pairs: ranked[..m].to_vec(),
+            ..Chosen::default()
+        };
+        let rom = reduced_on(model, &cb, &flex, &chosen, &mut bases)?;
         let (solution, _) =
             reduced_contact_static_restarting(model, &rom, scale, &ContactOptions::default())?;
         let got = solution.state.contact_force_norm;

@@ -9,7 +9,8 @@ use jointrom::integrate::{integrate, TransientOptions};
 use jointrom::joint::statics::ContactOptions;
 use jointrom::model::{contact_static_full, Model};
 use jointrom::reduction::{
-    build_basis, BasisKind, BasisOptions, JointFlexibility, Quantities, Quantity, RunStates,
+    build_basis, craig_bampton, final_basis, BasisKind, BasisOptions, JointFlexibility,
+    Orthonormalizer, Quantities, Quantity, RunStates, DEFAULT_DROP_TOL,
 };
 use jointrom::rom::compare::JointCurves;
 use jointrom::rom::estimate::{
@@ -375,6 +376,82 @@ fn prefetched_columns_leave_the_estimate_unchanged() {
         on_demand.errors.contact_force,
         prefetched.errors.contact_force
     );
+}
+
+/// An estimate without its truncation part (the tolerance model's ranking round) is the joint
+/// part of the full estimate, bit for bit: the same pair shares (which rank the pairs), its
+/// ‖f_c‖ and ‖f_R‖ errors the full estimate's joint parts, no truncation part and no basis for a
+/// truncation check.
+#[test]
+fn estimate_without_truncation_is_the_joint_part() {
+    let m = model("friction_bar");
+    let basis = build_basis(&m, BasisKind::Tvd, &BasisOptions::default()).unwrap();
+    let rom = ReducedSystem::new(&m, basis.phi).unwrap();
+    let opts = TransientOptions {
+        end_time: Some(0.01),
+        record: true,
+        ..Default::default()
+    };
+    let scene = Scene::of(&m);
+    let mut run = integrate(rom.clone(), &scene, &opts, |_, _| {});
+    let tr = run.trajectory.take().unwrap();
+    let states = RunStates {
+        t: &run.curves.t,
+        q: &tr.q,
+        p: &tr.p,
+        s: &tr.s,
+    };
+    let law = pair_law(&scene, &opts.problem);
+    let flex = JointFlexibility::new(&m).unwrap();
+    let full = flex.estimator(&m, &rom).unwrap();
+    let joint_only = flex.estimator_with(&m, &rom, false).unwrap();
+    assert!(full.truncation_check_basis().is_some());
+    assert!(joint_only.truncation_check_basis().is_none());
+    let full = full.estimate(&law, states).unwrap();
+    let joint = joint_only.estimate(&law, states).unwrap();
+    assert!(full.truncation.is_some());
+    assert_eq!(joint.truncation, None);
+    assert_eq!(joint.pair_error, full.pair_error);
+    assert_eq!(joint.pair_tangential_error, full.pair_tangential_error);
+    assert_eq!(joint.pair_tangential_moment, full.pair_tangential_moment);
+    assert_eq!(joint.errors.contact_force, full.joint);
+    assert_eq!(joint.joint, full.joint);
+    assert!(law.friction, "the scene's run has friction");
+    assert_eq!(joint.errors.friction_force, full.joint_friction);
+    assert!(full.joint.unwrap() > 0.0 && full.pair_error.iter().any(|e| *e > 0.0));
+}
+
+/// The tolerance model's bases are orthonormalized in a resumable Gram–Schmidt that keeps the
+/// prefix a basis shares with the last one: truncated after a prefix (a dependent column in it,
+/// dropped) and continued with other columns, it gives the bits `final_basis` gives of the
+/// prefix and those columns at once.
+#[test]
+fn resumed_orthonormalization_equals_final_basis() {
+    let m = model("friction_bar");
+    let cb = craig_bampton(&m, 10).unwrap();
+    let flex = JointFlexibility::new(&m).unwrap();
+    let a = flex.tangential_attachment_modes(&[(3, [1.0, 0.0]), (7, [0.6, 0.8])]);
+    let dup = cb.subcols(0, 1).to_owned();
+    let b = flex.tangential_attachment_modes(&[(12, [0.0, 1.0]), (3, [0.0, 1.0])]);
+    let c = flex.tangential_attachment_modes(&[(20, [0.8, -0.6])]);
+    let push = |gs: &mut Orthonormalizer<'_>, part: &faer::Mat<f64>| {
+        for j in 0..part.ncols() {
+            gs.push(part.col(j).iter().copied().collect()).unwrap();
+        }
+    };
+    let mut gs = Orthonormalizer::new(&m.mass, DEFAULT_DROP_TOL);
+    for part in [&cb, &a, &dup, &c] {
+        push(&mut gs, part);
+    }
+    let prefix = cb.ncols() + a.ncols() + dup.ncols();
+    gs.truncate(prefix);
+    assert_eq!(gs.pushed(), prefix);
+    push(&mut gs, &b);
+    let parts = [cb.as_ref(), a.as_ref(), dup.as_ref(), b.as_ref()];
+    let (want, dropped) = final_basis(&parts, &m.mass, DEFAULT_DROP_TOL).unwrap();
+    assert_eq!(dropped, 1, "the repeated column is dropped");
+    assert_eq!(gs.dropped(), dropped);
+    assert_eq!(gs.basis(), want);
 }
 
 /// The integration check that runs beside its run on a second thread gives the same numbers as

@@ -490,7 +490,7 @@ fn print_summary(a: &TransientArgs, name: &str, model: &Model, o: &ModelRun, tot
                 line("  truncation (vs the next fixed-interface modes)", t);
             }
             if let Some(i) = &e.integration {
-                line("  integration (vs 2x looser tolerances, scaled)", i);
+                line("  integration (vs a re-run at other tolerances, scaled)", i);
             }
         }
         Some(Err(why)) => println!("error estimate unavailable: {why}"),
