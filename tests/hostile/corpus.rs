@@ -181,6 +181,7 @@ pub fn corpus() -> Vec<Hostile> {
     v.extend(decks());
     v.extend(sizes_and_crawls(fx));
     v.extend(per_area(fx));
+    v.extend(sampling(fx));
     v
 }
 
@@ -298,6 +299,17 @@ fn per_area(fx: &Fixture) -> Vec<Hostile> {
             &["--contact-per-area=160,-1"],
             Fails("--contact-per-area"),
         ),
+    ]
+}
+
+/// Contact points inside the joint's faces: the contact block's `sampling`, a map's, the flag.
+fn sampling(fx: &Fixture) -> Vec<Hostile> {
+    let (c, map, k, m) = (&fx.case, &fx.map, &fx.k, &fx.m);
+    use Expect::Fails;
+    let mk = |id, what, map2: String, expect| {
+        map_entry(id, what, fx, map2, k.clone(), m.clone(), expect)
+    };
+    vec![
         info_case(
             "case-sampling-per-pair",
             "contact points inside the faces with per-pair stiffnesses",
