@@ -21,7 +21,10 @@
 //!
 //! where the corners fused in a nugget or held by a support pass their share to the weld or the
 //! support as in the nodal rule, so `Σ_p A_p = Σ_i A_i` (the pairs' tributary areas) on any
-//! mesh. With `"points": "nodes"` the points are the pairs themselves (today's per-area law).
+//! mesh and for any m. Sub-cell centres rather than Gauss points: every point has an area of its
+//! own that adds up exactly, and the points cover the face evenly (a strip is met wherever it
+//! lies). With [`SamplingPoints::Nodes`] the points are the pairs themselves (the node-pair
+//! per-area law, reproduced bit for bit).
 //!
 //! The point's rows in B are the interpolation, on the upper face minus the lower face (each
 //! face's corners ordered like the lower one's), of
@@ -35,7 +38,9 @@
 //! The frame of a point is the shape-weighted mean of its corners' pair normals (`+y` for the
 //! generated sheets). A point is a pair of the per-area law ([`super::per_area`]): its rows are
 //! weighted by `√(A_p/Ā)`, so everything downstream (statics, the TVD's `∂K/∂q`, the joint
-//! flexibility, reduced `BΦ`) sees an operator of the same kind, with more rows.
+//! flexibility, reduced `BΦ`) sees an operator of the same kind, with more rows. A point's
+//! [`PairFrame`] names the node pair of its nearest paired corner (its sheets' thickness, the
+//! joint's node set) and [`Model::point_positions`] where it sits.
 
 use super::Model;
 use crate::case::GapInterpolation;
