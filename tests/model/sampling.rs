@@ -229,3 +229,20 @@ fn sampled_statics_are_the_point_springs() {
     let res = r.iter().map(|v| v.abs()).fold(0.0, f64::max);
     assert!(res <= 1e-8 * scale, "residual {res:e} of {scale}");
 }
+
+/// A matrix map holds node pairs only: exporting a model with contact points is refused by
+/// name, and the same model without them exports.
+#[test]
+fn export_refuses_contact_points() {
+    let dir = std::env::temp_dir().join(format!("jointrom-sampling-export-{}", std::process::id()));
+    let case = per_area(common::builtin_case("friction_bar"), points(2, GAPS[0]));
+    let model = Model::from_case(case).unwrap();
+    let err = jointrom::model::matrices::write(&model, &dir)
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("contact.sampling"), "{err}");
+    assert!(!dir.join("model.json").exists());
+    let plain = Model::from_case(per_area(common::builtin_case("friction_bar"), None)).unwrap();
+    assert!(jointrom::model::matrices::write(&plain, &dir).is_ok());
+    let _ = std::fs::remove_dir_all(&dir);
+}
