@@ -338,6 +338,40 @@ pub struct ContactSpec {
     /// `normal_stiffness_per_area`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub stick_stiffness_per_area: Option<f64>,
+    /// Where the contact is sampled with a law per area (absent: at the node pairs): points
+    /// inside the joint's faces ([`ContactSampling`]). Only with the stiffnesses per area.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sampling: Option<ContactSampling>,
+}
+
+/// Contact points inside the joint's faces (`crate::model::sampling`): each face of the joint
+/// surface split into `points_per_edge`² parametric sub-cells, a contact point at each centre
+/// with the sub-cell's share of the joint area, its gap interpolated by `gap`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ContactSampling {
+    /// Contact points along each edge of a face, m (1 ≤ m ≤ [`MAX_POINTS_PER_EDGE`]); a face
+    /// gets m × m points.
+    pub points_per_edge: usize,
+    /// How the normal gap varies inside a face (default `hermite`).
+    #[serde(default)]
+    pub gap: GapInterpolation,
+}
+
+/// The largest `points_per_edge` of a contact sampling.
+pub const MAX_POINTS_PER_EDGE: usize = 8;
+
+/// The interpolation of the normal gap inside a joint face.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum GapInterpolation {
+    /// The shells' own edge deflections (cubic along each edge from the corners' deflections
+    /// and rotations: the Hermite cubic for thin shells, DKMQ's edge field in general) blended
+    /// over the face.
+    #[default]
+    Hermite,
+    /// Bilinear in the corners' deflections.
+    Bilinear,
 }
 
 /// A per-pair stiffness the file leaves out (it gives the per-area one).
@@ -359,6 +393,7 @@ impl ContactSpec {
             stick_stiffness: k_t,
             normal_stiffness_per_area: None,
             stick_stiffness_per_area: None,
+            sampling: None,
         }
     }
 

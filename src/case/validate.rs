@@ -140,6 +140,26 @@ fn check_stiffnesses(c: &ContactSpec, ctx: &Ctx) -> Result<(), Error> {
             }
         }
     }
+    if let Some(sampling) = &c.sampling {
+        let m = sampling.points_per_edge;
+        if !ways[0] {
+            return Err(ctx.err(
+                "contact.sampling",
+                "contact points inside the faces need the stiffnesses per area \
+                 (`normal_stiffness_per_area`, `stick_stiffness_per_area`, N/mm³): a point's \
+                 spring is κ times its share of the joint area",
+            ));
+        }
+        if !(1..=super::MAX_POINTS_PER_EDGE).contains(&m) {
+            return Err(ctx.err(
+                "contact.sampling.points_per_edge",
+                format!(
+                    "must lie in 1..={} (points per face edge; a face gets m × m), got {m}",
+                    super::MAX_POINTS_PER_EDGE
+                ),
+            ));
+        }
+    }
     if ways[0] != ways[1] {
         return Err(ctx.err(
             "contact.stick_stiffness_per_area",

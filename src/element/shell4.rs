@@ -373,6 +373,85 @@ impl Shell4 {
         ]
     }
 
+    /// The bilinear shape functions `N_a(r, s)` and the area element `det J` (mm² per unit
+    /// `dr ds`) at the parametric point `(r, s)` ∈ [−1, 1]².
+    pub fn shape(&self, r: f64, s: f64) -> ([f64; 4], f64) {
+        let sh = self.shape_at(r, s);
+        (sh.n, sh.det_j)
+    }
+
+    /// The row (24 values over the global DOF `[ux, uy, uz, rx, ry, rz]` of the four nodes) of
+    /// the transverse deflection `w = n·u` (mm, along [`Shell4::normal`]) at the parametric
+    /// point `(r, s)`.
+    ///
+    /// `edges = false`: the bilinear interpolation `Σ N_a w_a` of the nodal deflections.
+    /// `edges = true`: the element's own edge deflections blended over the face (a Coons
+    /// patch). Along edge k (nodes i → j, length L, arc length σ) DKMQ's tangential rotation
+    /// is `β_s(σ) = β_s,i + (β_s,j − β_s,i) σ/L + Δβ_k (4σ/L − 4σ²/L²)` and its shear strain the
+    /// constant `γ_k = −⅔ φ_k Δβ_k`, so `w' = γ_k − β_s` integrates to the cubic
+    ///
+    /// ```text
+    /// w_k(σ) = w_i + (γ_k − β_s,i) σ − (β_s,j − β_s,i) σ²/(2L) − Δβ_k (2σ²/L − 4σ³/(3L²))
+    /// ```
+    ///
+    /// which ends at `w_j` by the definition of `Δβ_k` (thin: the Hermite cubic of the nodal
+    /// deflections and slopes `−β_s`, the DKQ edge). The face gets
+    /// `w = ½(1−s) w_C(r) + ½(1+s) w_A(r) + ½(1−r) w_B(s) + ½(1+r) w_D(s) − Σ N_a w_a`,
+    /// which equals each edge's cubic on that edge (so neighbouring faces agree) and, on a
+    /// rectangle, is the 12-term Adini–Clough–Melosh interpolation of the nodal deflections and
+    /// Kirchhoff slopes.
+    pub fn deflection_row(&self, r: f64, s: f64, edges: bool) -> [f64; 24] {
+        let (n, _, _) = shape_functions(r, s);
+        let mut local = [0.0; 24];
+        for a in 0..4 {
+            local[6 * a + W] = n[a];
+        }
+        if edges {
+            for v in local.iter_mut() {
+                *v = -*v;
+            }
+            let nu = self.material.poisson_ratio;
+            let terms = self.edge_rows();
+            // (edge nodes, edge parameter, blend) of C, A, B, D — the order of `edge_rows`.
+            let blend = [
+                ((0usize, 1usize), r, 0.5 * (1.0 - s)),
+                ((3, 2), r, 0.5 * (1.0 + s)),
+                ((0, 3), s, 0.5 * (1.0 - r)),
+                ((1, 2), s, 0.5 * (1.0 + r)),
+            ];
+            for (((i, j), tau, b), edge) in blend.into_iter().zip(&terms) {
+                let dx = self.local[j][0] - self.local[i][0];
+                let dy = self.local[j][1] - self.local[i][1];
+                let l = (dx * dx + dy * dy).sqrt();
+                let [c, sn] = edge.tangent;
+                let phi = dkmq_phi(self.thickness, l, nu);
+                let sigma = 0.5 * l * (1.0 + tau);
+                // w_k = w_i + σ γ − σ β_i − σ²/(2L) (β_j − β_i) − Δβ (2σ²/L − 4σ³/(3L²)),
+                // γ = −⅔ φ Δβ, β = c θ2 − s θ1.
+                let q = sigma * sigma / (2.0 * l);
+                let dbeta = -(2.0 / 3.0) * phi * sigma
+                    - (2.0 * sigma * sigma / l - 4.0 * sigma.powi(3) / (3.0 * l * l));
+                local[6 * i + W] += b;
+                for (node, coef) in [(i, -sigma + q), (j, -q)] {
+                    local[6 * node + T2] += b * coef * c;
+                    local[6 * node + T1] -= b * coef * sn;
+                }
+                for (d, v) in edge.increment.iter().enumerate() {
+                    local[d] += b * dbeta * v;
+                }
+            }
+        }
+        // Local DOF row → global: a_g[3 blk + c] = Σ_k a_l[3 blk + k] R[k][c].
+        let f = &self.frame;
+        let mut out = [0.0; 24];
+        for blk in 0..8 {
+            for c in 0..3 {
+                out[3 * blk + c] = (0..3).map(|k| local[3 * blk + k] * f[k][c]).sum();
+            }
+        }
+        out
+    }
+
     /// Stiffness in the local frame (24×24, local DOF order per node u, v, w, θ1, θ2, θ3).
     fn local_stiffness(&self) -> Mat24 {
         let mut k = [[0.0; 24]; 24];

@@ -14,6 +14,14 @@ pub enum ModelError {
          follower of the master node; the map cannot express it"
     )]
     ExportDependentDof { node: u64, dof: usize },
+    /// `export-matrices`: the model's contact points lie inside the joint's faces, which a
+    /// map's node pairs cannot express.
+    #[error(
+        "export-matrices: the contact is sampled at points inside the joint's faces \
+         (`contact.sampling`); a matrix map holds node pairs only: export the case without \
+         `sampling`"
+    )]
+    ExportContactPoints,
     /// `export-matrices`: no node owns the six master DOF.
     #[error("export-matrices: no node owns the six master DOF")]
     ExportNoMasterNode,

@@ -99,6 +99,44 @@ impl JointOperator {
         })
     }
 
+    /// Builds B from explicit rows: `rows[3k + d]` lists `(independent DOF, coefficient)` of
+    /// contact point k's row d (normal, t1, t2) over `n` DOF — the kinematics of a contact point
+    /// that is an interpolation of several nodes' DOF rather than a node pair. Entries of one
+    /// DOF are summed, zeros dropped. `rows.len()` must be a multiple of 3 and every column
+    /// below `n` (checked by the caller that built them; a violation panics in debug builds).
+    pub fn from_rows(rows: &[Vec<(usize, f64)>], n: usize) -> JointOperator {
+        debug_assert!(rows.len() % 3 == 0);
+        let mut row_ptr = vec![0];
+        let mut col_idx = Vec::new();
+        let mut values = Vec::new();
+        for row in rows {
+            let mut entries = row.clone();
+            entries.sort_by_key(|e| e.0);
+            let mut merged: Vec<(usize, f64)> = Vec::new();
+            for (i, c) in entries {
+                debug_assert!(i < n);
+                match merged.last_mut() {
+                    Some(last) if last.0 == i => last.1 += c,
+                    _ => merged.push((i, c)),
+                }
+            }
+            for (i, c) in merged {
+                if c != 0.0 {
+                    col_idx.push(i);
+                    values.push(c);
+                }
+            }
+            row_ptr.push(col_idx.len());
+        }
+        JointOperator {
+            pairs: rows.len() / 3,
+            n,
+            row_ptr,
+            col_idx,
+            values,
+        }
+    }
+
     /// Number of joint pairs w.
     pub fn pairs(&self) -> usize {
         self.pairs

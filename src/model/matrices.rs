@@ -367,9 +367,18 @@ pub fn load(map_path: &Path) -> Result<Model, Error> {
         warnings: Vec::new(),
         pair_areas,
         pair_weights: None,
+        point_positions: None,
         contact: map.contact,
         end_time: map.end_time,
     };
+    if model.contact.sampling.is_some() {
+        return Err(field_err(
+            &model.source,
+            "contact.sampling",
+            "contact points inside the joint's faces need the mesh's faces, which a matrix map \
+             does not have: leave `sampling` out (the pairs are the contact points)",
+        ));
+    }
     if let Some(kappa) = per_area {
         if model.pair_areas.is_none() {
             return Err(field_err(
@@ -922,6 +931,9 @@ fn union_pattern(
 /// their frames, cells, load, contact law and end time. Returns the three paths.
 pub fn write(model: &Model, dir: &Path) -> Result<Vec<PathBuf>, Error> {
     crate::files::create_dir(dir)?;
+    if model.point_positions.is_some() {
+        return Err(ModelError::ExportContactPoints.into());
+    }
     let k_path = dir.join("K.mtx");
     let m_path = dir.join("M.mtx");
     let map_path = dir.join("model.json");

@@ -19,6 +19,7 @@ pub mod matrices;
 pub mod mtx;
 pub mod per_area;
 pub mod petsc;
+pub mod sampling;
 
 pub use contact::contact_static_full;
 pub use load::LoadOptions;
@@ -175,6 +176,10 @@ pub struct Model {
     /// `k = κ·Ā` on the weighted kinematics `w_i·(g, u_t)` returns the force `w_i² κ Ā g =
     /// κ A_i g` to the structure (module [`per_area`]).
     pub pair_weights: Option<Vec<f64>>,
+    /// Where each pair sits, mm, for contact points inside the joint's faces
+    /// ([`sampling`]; their [`Model::pairs`] name the nearest node pair). `None`: the pairs are
+    /// node pairs, at their lower nodes.
+    pub point_positions: Option<Vec<[f64; 3]>>,
 }
 
 impl Model {
@@ -213,6 +218,7 @@ impl Model {
             .collect();
         let node_ids = (1..=mesh.nodes.len() as u64).collect();
         let (per_area, overlap) = (case.contact.per_area(), per_area::joints_overlap(&case));
+        let sampling = case.contact.sampling;
         let parts = Parts {
             name: case.name.clone(),
             source: case.source.clone(),
@@ -228,6 +234,14 @@ impl Model {
         model.set_mesh_areas();
         if let Some(kappa) = per_area {
             model.apply_case_per_area(kappa, overlap)?;
+            if let Some(s) = sampling {
+                model.apply_contact_sampling(
+                    kappa,
+                    sampling::SamplingPoints::SubCells(s.points_per_edge),
+                    s.gap,
+                    "contact.sampling",
+                )?;
+            }
         }
         Ok(model)
     }
@@ -336,6 +350,7 @@ impl Model {
             warnings: parts.warnings,
             pair_areas: None,
             pair_weights: None,
+            point_positions: None,
             origin: origin(mesh),
             geometry,
             pairs,
@@ -344,6 +359,13 @@ impl Model {
             mass,
             joint,
         })
+    }
+
+    /// Where pair `i` sits, mm: its contact point, or its lower node.
+    pub fn pair_position(&self, i: usize) -> [f64; 3] {
+        self.point_positions
+            .as_ref()
+            .map_or(self.geometry.nodes[self.pairs[i].lower], |p| p[i])
     }
 
     /// The case, for a model generated from one.

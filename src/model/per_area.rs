@@ -113,6 +113,25 @@ impl Model {
                 ))
             }
         };
+        self.resolve_per_area(kappa, areas, field)
+    }
+
+    /// Resolves `[κ_n, κ_t]` (N/mm³, checked here) on the given areas of the model's pairs
+    /// (mm², one per pair, unweighted rows): weights B's rows and sets the law (module docs).
+    pub(crate) fn resolve_per_area(
+        &mut self,
+        kappa: [f64; 2],
+        areas: Vec<f64>,
+        field: &str,
+    ) -> Result<(), Error> {
+        for (name, k) in ["normal", "stick"].iter().zip(kappa) {
+            if !(k.is_finite() && k > 0.0) {
+                return Err(self.per_area_error(
+                    field,
+                    format!("the {name} stiffness per area must be positive (finite and > 0), got {k} N/mm³"),
+                ));
+            }
+        }
         let mean = areas.iter().sum::<f64>() / areas.len() as f64;
         let weights: Vec<f64> = areas.iter().map(|a| (a / mean).sqrt()).collect();
         self.joint.weight_pairs(&weights);

@@ -114,9 +114,10 @@ pub(crate) fn render_joint_modes(
     let pos: Vec<(f64, f64)> = model
         .pairs
         .iter()
-        .map(|p| {
+        .enumerate()
+        .map(|(i, p)| {
             // In the joint plane: (t1 · x, t2 · x); (x, z) for generated sheets.
-            let x = model.geometry.nodes[p.lower];
+            let x = model.pair_position(i);
             let dot = |t: [f64; 3]| t[0] * x[0] + t[1] * x[1] + t[2] * x[2];
             (dot(p.t1), dot(p.t2))
         })

@@ -462,3 +462,122 @@ fn lanczos_matches_dense_eigensolver() {
         }
     }
 }
+
+/// Global DOF of four nodes from a deflection field `u_y = f(x, z)` with Kirchhoff rotations
+/// `θ_z = ∂f/∂x`, `θ_x = −∂f/∂z` (the sheets' plane y = const).
+fn kirchhoff_dofs(nodes: &[[f64; 3]; 4], f: &dyn Fn(f64, f64) -> [f64; 3]) -> [f64; 24] {
+    let mut u = [0.0; 24];
+    for (a, p) in nodes.iter().enumerate() {
+        let [w, wx, wz] = f(p[0], p[2]);
+        u[6 * a + 1] = w;
+        u[6 * a + 3] = -wz;
+        u[6 * a + 5] = wx;
+    }
+    u
+}
+
+#[test]
+fn edge_deflection_reproduces_the_acm_space_on_a_thin_rectangle() {
+    // Thin (φ ≈ 1e-8): the blended edge cubics are the 12-term ACM interpolation, exact for
+    // every monomial of its space; the bilinear one is not (except for the bilinear ones).
+    let nodes = [
+        [1.0, 2.0, 1.0],
+        [9.0, 2.0, 1.0],
+        [9.0, 2.0, 6.0],
+        [1.0, 2.0, 6.0],
+    ];
+    let sh = Shell4::new(nodes, 1e-3, STEEL).unwrap();
+    let sign = sh.normal()[1];
+    type Field = fn(f64, f64) -> [f64; 3];
+    let fields: [Field; 6] = [
+        |x, _| [x * x * x, 3.0 * x * x, 0.0],
+        |x, z| [x * x * z, 2.0 * x * z, x * x],
+        |x, z| [x * x * x * z, 3.0 * x * x * z, x * x * x],
+        |_, z| [z * z * z, 0.0, 3.0 * z * z],
+        |x, z| [x * z * z * z, z * z * z, 3.0 * x * z * z],
+        |x, z| [0.3 + 0.2 * x - 0.1 * z + x * z, 0.2 + z, -0.1 + x],
+    ];
+    for (k, f) in fields.iter().enumerate() {
+        let u = kirchhoff_dofs(&nodes, f);
+        let mut bilinear_error = 0.0f64;
+        for (r, s) in [(0.3, -0.6), (-0.8, 0.1), (0.0, 0.0), (0.95, 0.7)] {
+            let (n, _) = sh.shape(r, s);
+            let x: f64 = (0..4).map(|a| n[a] * nodes[a][0]).sum();
+            let z: f64 = (0..4).map(|a| n[a] * nodes[a][2]).sum();
+            let exact = sign * f(x, z)[0];
+            let dot = |row: [f64; 24]| (0..24).map(|d| row[d] * u[d]).sum::<f64>();
+            let got = dot(sh.deflection_row(r, s, true));
+            assert!(
+                (got - exact).abs() < 1e-6 * (1.0 + exact.abs()),
+                "field {k} at ({r}, {s}): {got} vs {exact}"
+            );
+            bilinear_error =
+                bilinear_error.max((dot(sh.deflection_row(r, s, false)) - exact).abs());
+        }
+        if k < 5 {
+            assert!(
+                bilinear_error > 1e-2,
+                "field {k}: bilinear error {bilinear_error}"
+            );
+        } else {
+            assert!(
+                bilinear_error < 1e-9,
+                "field {k}: bilinear error {bilinear_error}"
+            );
+        }
+    }
+}
+
+#[test]
+fn edge_deflection_is_the_nodal_deflection_at_the_corners_and_rigid_exact() {
+    // At a corner both interpolations give the node's own w; a rigid motion (translation and
+    // rotation) is reproduced anywhere on a distorted element, thin or thick.
+    for t in [0.5, 5.0] {
+        let nodes = skewed_nodes();
+        let sh = Shell4::new(nodes, t, STEEL).unwrap();
+        let n = sh.normal();
+        for (a, (r, s)) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)]
+            .into_iter()
+            .enumerate()
+        {
+            for edges in [false, true] {
+                let row = sh.deflection_row(r, s, edges);
+                for d in 0..24 {
+                    let want = if d / 6 == a && d % 6 < 3 {
+                        n[d % 6]
+                    } else {
+                        0.0
+                    };
+                    assert!(
+                        (row[d] - want).abs() < 1e-12,
+                        "corner {a} dof {d}: {}",
+                        row[d]
+                    );
+                }
+            }
+        }
+        let (c, theta) = ([0.2, -0.4, 0.7], [0.01, -0.03, 0.02]);
+        let mut u = [0.0; 24];
+        for (a, p) in nodes.iter().enumerate() {
+            let disp = [0, 1, 2].map(|k| c[k]);
+            let rot = cross(theta, *p);
+            for k in 0..3 {
+                u[6 * a + k] = disp[k] + rot[k];
+                u[6 * a + 3 + k] = theta[k];
+            }
+        }
+        for (r, s) in [(0.3, -0.6), (-0.8, 0.1), (0.0, 0.0)] {
+            let (shape, _) = sh.shape(r, s);
+            let x = [0, 1, 2].map(|k| (0..4).map(|a| shape[a] * nodes[a][k]).sum::<f64>());
+            let rot = cross(theta, x);
+            let exact: f64 = (0..3).map(|k| n[k] * (c[k] + rot[k])).sum();
+            let got: f64 = (0..24)
+                .map(|d| sh.deflection_row(r, s, true)[d] * u[d])
+                .sum();
+            assert!(
+                (got - exact).abs() < 1e-12,
+                "t {t} at ({r}, {s}): {got} vs {exact}"
+            );
+        }
+    }
+}

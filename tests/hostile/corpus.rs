@@ -181,6 +181,7 @@ pub fn corpus() -> Vec<Hostile> {
     v.extend(decks());
     v.extend(sizes_and_crawls(fx));
     v.extend(per_area(fx));
+    v.extend(sampling(fx));
     v
 }
 
@@ -298,6 +299,86 @@ fn per_area(fx: &Fixture) -> Vec<Hostile> {
             &["--contact-per-area=160,-1"],
             Fails("--contact-per-area"),
         ),
+    ]
+}
+
+/// Contact points inside the joint's faces: the contact block's `sampling`, a map's, the flag.
+fn sampling(fx: &Fixture) -> Vec<Hostile> {
+    let (c, map, k, m) = (&fx.case, &fx.map, &fx.k, &fx.m);
+    use Expect::Fails;
+    let mk = |id, what, map2: String, expect| {
+        map_entry(id, what, fx, map2, k.clone(), m.clone(), expect)
+    };
+    vec![
+        info_case(
+            "case-sampling-per-pair",
+            "contact points inside the faces with per-pair stiffnesses",
+            edit(c, |v| {
+                v["contact"]["sampling"] = json!({"points_per_edge": 2});
+            }),
+            Fails("contact.sampling"),
+        ),
+        info_case(
+            "case-sampling-zero-points",
+            "zero contact points per face edge",
+            edit(c, |v| {
+                v["contact"] = json!({"normal_stiffness_per_area": 160.0,
+                    "friction_coefficient": 0.25, "stick_stiffness_per_area": 160.0,
+                    "sampling": {"points_per_edge": 0}});
+            }),
+            Fails("contact.sampling.points_per_edge"),
+        ),
+        info_case(
+            "case-sampling-unknown-gap",
+            "an unknown gap interpolation",
+            edit(c, |v| {
+                v["contact"] = json!({"normal_stiffness_per_area": 160.0,
+                    "friction_coefficient": 0.25, "stick_stiffness_per_area": 160.0,
+                    "sampling": {"points_per_edge": 2, "gap": "cubic"}});
+            }),
+            Fails("contact.sampling.gap"),
+        ),
+        mk(
+            "map-sampling",
+            "contact points inside the faces of a matrix map",
+            edit(map, |v| {
+                let n = v["pairs"].as_array().map_or(0, |a| a.len());
+                for i in 0..n {
+                    v["pairs"][i]["area"] = json!(62.5);
+                }
+                v["contact"] = json!({"normal_stiffness_per_area": 160.0,
+                    "friction_coefficient": 0.25, "stick_stiffness_per_area": 160.0,
+                    "sampling": {"points_per_edge": 2}});
+            }),
+            Fails("contact.sampling"),
+        ),
+        flag(
+            "flag-contact-sampling-range",
+            "--contact-sampling with 9 points per edge",
+            &["--contact-per-area", "160,160", "--contact-sampling", "9"],
+            Fails("--contact-sampling"),
+        ),
+        flag(
+            "flag-contact-sampling-per-pair",
+            "--contact-sampling on a case with per-pair stiffnesses",
+            &["--contact-sampling", "2,hermite"],
+            Fails("--contact-sampling"),
+        ),
+        entry(
+            "flag-contact-sampling-deck",
+            "flag",
+            "--contact-sampling on a NASTRAN deck",
+            &[
+                "info",
+                DECK,
+                "--contact-per-area",
+                "160,160",
+                "--contact-sampling",
+                "2",
+            ],
+            Fails("--contact-sampling"),
+        )
+        .file("deck.bdf", deck_text()),
     ]
 }
 

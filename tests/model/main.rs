@@ -10,4 +10,5 @@ mod matrices;
 mod model;
 mod per_area;
 mod petsc;
+mod sampling;
 mod weld_targets;

@@ -122,6 +122,7 @@ fn scene() -> Scene {
             stick_stiffness: K_T,
             normal_stiffness_per_area: None,
             stick_stiffness_per_area: None,
+            sampling: None,
         },
         end_time: 1.0,
     }

@@ -34,6 +34,12 @@ pub struct Cli {
     /// nugget on the deck's own shells) or a shell size in mm.
     #[arg(long, global = true, value_name = "auto|off|SIZE")]
     pub deck_local_mesh: Option<String>,
+    /// Contact points inside a case's joint faces `M[,hermite|bilinear]`: M × M points per face
+    /// (1 ≤ M ≤ 8) with the gap interpolated from the shells' edge deflections (`hermite`,
+    /// default) or bilinearly, in place of the case's `contact.sampling`; needs the contact
+    /// stiffnesses per area (the case's or --contact-per-area).
+    #[arg(long, global = true, value_name = "M[,GAP]")]
+    pub contact_sampling: Option<String>,
 }
 
 impl Cli {
@@ -58,7 +64,35 @@ impl Cli {
         Ok(jointrom::model::LoadOptions {
             contact_per_area: self.contact_per_area()?,
             deck_local_mesh,
+            contact_sampling: self.contact_sampling()?,
         })
+    }
+
+    /// `--contact-sampling M[,GAP]`: M in 1..=8, GAP `hermite` (default) or `bilinear`.
+    pub fn contact_sampling(&self) -> Result<Option<jointrom::case::ContactSampling>, Error> {
+        use jointrom::case::{ContactSampling, GapInterpolation, MAX_POINTS_PER_EDGE};
+        let Some(text) = &self.contact_sampling else {
+            return Ok(None);
+        };
+        let bad = || FlagError::Range {
+            flag: "contact-sampling",
+            need: "`M` or `M,hermite` or `M,bilinear` with M points per face edge in 1..=8",
+            got: format!("`{text}`"),
+        };
+        let mut parts = text.split(',').map(str::trim);
+        let m: usize = parts.next().and_then(|m| m.parse().ok()).ok_or_else(bad)?;
+        let gap = match parts.next() {
+            None | Some("hermite") => GapInterpolation::Hermite,
+            Some("bilinear") => GapInterpolation::Bilinear,
+            Some(_) => return Err(bad().into()),
+        };
+        if parts.next().is_some() || !(1..=MAX_POINTS_PER_EDGE).contains(&m) {
+            return Err(bad().into());
+        }
+        Ok(Some(ContactSampling {
+            points_per_edge: m,
+            gap,
+        }))
     }
 
     /// `--contact-per-area KN,KT`: two positive finite numbers.

@@ -126,7 +126,7 @@ fn contact_json(model: &Model, scale: f64) -> Result<(Value, contact::ContactSta
 
 /// Adds the contact state's `contact_force_norm`, `contact_force_total` (the resultant Σ|p|, N:
 /// unlike the norm, comparable between meshes of one scene), `pairs_in_contact`, `pair_forces`
-/// (`[x, y, z (mm) of the pair's lower node, p (N, compressive negative)]` per pair in contact),
+/// (`[x, y, z (mm) of the pair's lower node or contact point, p (N, compressive negative)]` per pair in contact),
 /// the mesh-independent measures (`contact_resultant` N, `contact_area` mm², `peak_pressure`
 /// N/mm², `max_penetration` mm, `max_penetration_per_thickness`; `crate::model::per_area`) and
 /// the resolved `contact` law to the JSON object `v`.
@@ -137,8 +137,8 @@ fn add_pair_forces(v: &mut Value, model: &Model, st: &contact::ContactState) {
         .zip(&model.pairs)
         .enumerate()
         .filter(|(_, (p, _))| **p != 0.0)
-        .map(|(i, (p, pair))| {
-            let [x, y, z] = model.geometry.nodes[pair.lower];
+        .map(|(i, (p, _))| {
+            let [x, y, z] = model.pair_position(i);
             [x, y, z, model.pair_weight(i) * *p]
         })
         .collect();
