@@ -73,20 +73,7 @@ impl JointOperator {
                         }
                     }
                 }
-                entries.sort_by_key(|e| e.0);
-                let mut merged: Vec<(usize, f64)> = Vec::new();
-                for (i, c) in entries {
-                    match merged.last_mut() {
-                        Some(last) if last.0 == i => last.1 += c,
-                        _ => merged.push((i, c)),
-                    }
-                }
-                for (i, c) in merged {
-                    if c != 0.0 {
-                        col_idx.push(i);
-                        values.push(c);
-                    }
-                }
+                push_row(entries, &mut col_idx, &mut values);
                 row_ptr.push(col_idx.len());
             }
         }
@@ -110,22 +97,8 @@ impl JointOperator {
         let mut col_idx = Vec::new();
         let mut values = Vec::new();
         for row in rows {
-            let mut entries = row.clone();
-            entries.sort_by_key(|e| e.0);
-            let mut merged: Vec<(usize, f64)> = Vec::new();
-            for (i, c) in entries {
-                debug_assert!(i < n);
-                match merged.last_mut() {
-                    Some(last) if last.0 == i => last.1 += c,
-                    _ => merged.push((i, c)),
-                }
-            }
-            for (i, c) in merged {
-                if c != 0.0 {
-                    col_idx.push(i);
-                    values.push(c);
-                }
-            }
+            debug_assert!(row.iter().all(|e| e.0 < n));
+            push_row(row.clone(), &mut col_idx, &mut values);
             row_ptr.push(col_idx.len());
         }
         JointOperator {
@@ -216,5 +189,24 @@ impl JointOperator {
         Mat::from_fn(self.rows(), phi.ncols(), |r, j| {
             self.row(r).map(|(c, v)| v * phi[(c, j)]).sum()
         })
+    }
+}
+
+/// Appends one CSR row from unsorted `(column, coefficient)` entries: sorted by column, the
+/// entries of one column summed in their order, zeros dropped.
+fn push_row(mut entries: Vec<(usize, f64)>, col_idx: &mut Vec<usize>, values: &mut Vec<f64>) {
+    entries.sort_by_key(|e| e.0);
+    let mut merged: Vec<(usize, f64)> = Vec::new();
+    for (i, c) in entries {
+        match merged.last_mut() {
+            Some(last) if last.0 == i => last.1 += c,
+            _ => merged.push((i, c)),
+        }
+    }
+    for (i, c) in merged {
+        if c != 0.0 {
+            col_idx.push(i);
+            values.push(c);
+        }
     }
 }

@@ -688,25 +688,7 @@ fn more_pairs_summed(
     tol: f64,
     cap: usize,
 ) -> Option<(Vec<usize>, bool)> {
-    let mut cand: Vec<(usize, f64)> = shares
-        .iter()
-        .enumerate()
-        .filter(|(k, e)| **e > 0.0 && !held(*k))
-        .map(|(k, e)| (k, *e))
-        .collect();
-    cand.sort_by(|a, b| b.1.total_cmp(&a.1).then(a.0.cmp(&b.0)));
-    let allowed = SELECTION_MARGIN * tol;
-    let mut left: f64 = cand.iter().map(|c| c.1).sum();
-    let mut add = Vec::new();
-    for (k, e) in cand {
-        if left <= allowed || add.len() >= cap {
-            break;
-        }
-        add.push(k);
-        left -= e;
-    }
-    let all = left <= allowed;
-    (!add.is_empty()).then_some((add, all))
+    select_largest(shares, held, SELECTION_MARGIN * tol, cap)
 }
 
 /// What [`Chosen::enrich`] did.
@@ -890,17 +872,26 @@ fn more_pairs(
     tol: f64,
     cap: usize,
 ) -> Option<(Vec<usize>, bool)> {
-    let mut cand: Vec<(usize, f64)> = errors
+    select_largest(errors, held, (SELECTION_MARGIN * tol).powi(2) * norm2, cap)
+}
+
+/// The pairs outside the `held` ones with a positive share, largest first, until the sum of the
+/// shares left is within `allowed` or `cap` are taken, and whether that is all of them (the cap
+/// did not cut); `None` when nothing is taken. The one greedy rule of [`more_pairs`] (squared
+/// shares of a norm) and [`more_pairs_summed`] (shares that add).
+fn select_largest(
+    shares: &[f64],
+    held: impl Fn(usize) -> bool,
+    allowed: f64,
+    cap: usize,
+) -> Option<(Vec<usize>, bool)> {
+    let mut cand: Vec<(usize, f64)> = shares
         .iter()
         .enumerate()
         .filter(|(k, e)| **e > 0.0 && !held(*k))
         .map(|(k, e)| (k, *e))
         .collect();
-    if cand.is_empty() {
-        return None;
-    }
     cand.sort_by(|a, b| b.1.total_cmp(&a.1).then(a.0.cmp(&b.0)));
-    let allowed = (SELECTION_MARGIN * tol).powi(2) * norm2;
     let mut left: f64 = cand.iter().map(|c| c.1).sum();
     let mut add = Vec::new();
     for (k, e) in cand {
