@@ -11,7 +11,10 @@ pub fn info_json(model: &Model) -> Value {
     json!({
         "case": model.name,
         "dofs": model.dofs(),
+        // With contact points inside the faces (`contact.sampling`), the contact entities the
+        // law acts on are the points: `joint_pairs` counts them, `contact_points` says so.
         "joint_pairs": model.pair_count(),
+        "contact_points": model.point_positions.as_ref().map(Vec::len),
         "joint_dofs": model.joint_dofs(),
         "origin": match model.origin {
             crate::model::Origin::Case { .. } => "case",

@@ -136,11 +136,33 @@ fn too_many_modes_is_an_error_not_a_panic() {
     assert!(model.modes(0, Interface::Free).is_err());
 }
 
+/// With contact points inside the faces `info` counts the points, and says they are points:
+/// 2 × 2 per joint face of the friction bar (34 faces).
+#[test]
+fn info_counts_contact_points() {
+    let v = jointrom_json([
+        "info",
+        "friction_bar",
+        "--contact-per-area",
+        "160,160",
+        "--contact-sampling",
+        "2",
+        "--json",
+    ]);
+    assert_eq!(v["contact_points"], v["joint_pairs"]);
+    assert_eq!(v["contact_points"], 136);
+}
+
 #[test]
 fn cli_json_contract() {
     let v = jointrom_json(["info", "friction_bar", "--json"]);
     assert_eq!(v["dofs"], 906);
     assert_eq!(v["joint_pairs"], 52);
+    assert!(
+        v["contact_points"].is_null(),
+        "node pairs: {}",
+        v["contact_points"]
+    );
     assert_eq!(v["joint_dofs"], 624);
     assert_eq!(v["nodes"], 157);
     assert_eq!(v["elements"], 102);

@@ -26,7 +26,13 @@ pub fn run(a: InfoArgs) -> Result<(), Error> {
             jointrom::files::printable(&model.name)
         );
         println!("DOF             {}", model.dofs());
-        println!("joint pairs     {}", model.pair_count());
+        match &model.point_positions {
+            Some(points) => println!(
+                "contact points  {} (inside the joint's faces)",
+                points.len()
+            ),
+            None => println!("joint pairs     {}", model.pair_count()),
+        }
         println!("joint DOF       {}", model.joint_dofs());
         println!("nodes           {}", model.geometry.nodes.len());
         println!(
