@@ -78,10 +78,7 @@ pub fn tributary_areas(
     let mut node_area = vec![0.0; nodes.len()];
     let (mut total, mut excluded_area) = (0.0, 0.0);
     for shell in shells {
-        let corners = shell.nodes;
-        if !corners.iter().all(|&n| coincident(n) || support[n])
-            || !corners.iter().any(|&n| coincident(n))
-        {
+        if !on_joint_surface(shell.nodes, coincident, |n| support[n]) {
             continue;
         }
         let shares = corner_areas(shell.nodes.map(|n| nodes[n]));
@@ -110,6 +107,18 @@ pub fn tributary_areas(
         excluded: excluded_area,
         total,
     })
+}
+
+/// Whether a face with `corners` is on the joint surface (module docs): every corner a joint
+/// node (a pair's or a left-out pair's lower node) or held by a support, and one at least a
+/// joint node. The one rule of the pairs' tributary areas and of the contact points inside the
+/// faces ([`crate::model::sampling`]), so that their areas add up alike.
+pub fn on_joint_surface(
+    corners: [usize; 4],
+    joint: impl Fn(usize) -> bool,
+    held: impl Fn(usize) -> bool,
+) -> bool {
+    corners.iter().all(|&n| joint(n) || held(n)) && corners.iter().any(|&n| joint(n))
 }
 
 /// `∫ N_a dA` of the four corners of a bilinear face (corners in cyclic order), mm²: 2×2 Gauss

@@ -47,6 +47,7 @@ use crate::case::GapInterpolation;
 use crate::element::Shell4;
 use crate::error::{Error, ModelError};
 use crate::joint::{JointOperator, PairFrame};
+use crate::mesh::tributary::on_joint_surface;
 use crate::mesh::Mesh;
 
 /// Where the contact points sit.
@@ -325,9 +326,7 @@ fn joint_faces(mesh: &Mesh) -> Result<Vec<FacePair>, usize> {
     let mut out = Vec::new();
     for (e, shell) in mesh.shells.iter().enumerate() {
         let c = shell.nodes;
-        if !c.iter().all(|&n| !partners[n].is_empty() || support[n])
-            || c.iter().all(|&n| partners[n].is_empty())
-        {
+        if !on_joint_surface(c, |n| !partners[n].is_empty(), |n| support[n]) {
             continue;
         }
         let first = c.iter().position(|&n| !partners[n].is_empty()).unwrap_or(0);
