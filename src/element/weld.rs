@@ -80,6 +80,7 @@ use std::sync::{Arc, Mutex};
 
 use faer::linalg::solvers::Solve;
 use faer::{Mat, Side};
+use rayon::prelude::*;
 
 use super::{Beam2, Material};
 use crate::error::{ElementError, Error, WeldLayerProblem};
@@ -208,16 +209,26 @@ impl Weld {
                 None => todo.push(i),
             }
         }
-        // One at a time: the peak memory is one neighbourhood's.
-        let condensed = todo.iter().map(|&i| {
-            let w = &welds[i];
-            let patch = w
-                .patch
-                .as_ref()
-                .expect("a weld with a key has a neighbourhood");
-            super::weld_patch::condense(w, patch, material, faer::get_global_parallelism())
-                .map(|c| Arc::new((c.stiffness, c.mass)))
-        });
+        // The distinct neighbourhoods side by side, one per core, each condensed sequentially
+        // inside: the same bits as one after the other (a condensation does not depend on what
+        // runs beside it), the wall time divided by the cores where there are several, at the
+        // peak memory of as many neighbourhoods as cores.
+        let condensed: Vec<Result<CondensedMatrices, Error>> = todo
+            .par_iter()
+            .map(|&i| {
+                let w = &welds[i];
+                let patch = w
+                    .patch
+                    .as_ref()
+                    .expect("a weld with a key has a neighbourhood");
+                let par = match todo.len() {
+                    1 => faer::get_global_parallelism(),
+                    _ => faer::Par::Seq,
+                };
+                super::weld_patch::condense(w, patch, material, par)
+                    .map(|c| Arc::new((c.stiffness, c.mass)))
+            })
+            .collect();
         for (&i, c) in todo.iter().zip(condensed) {
             let c = c?;
             let key = key_of(i).expect("a condensed weld has a key");
