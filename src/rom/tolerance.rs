@@ -105,7 +105,8 @@ use crate::reduction::{
     Quantity, DEFAULT_DROP_TOL,
 };
 use crate::rom::estimate::{
-    add_checks, beside, drop_truncation, loosened, run_estimated_parts, Checks, RunEstimate,
+    add_checks, add_combined_check, beside, drop_combined, loosened, run_estimated_parts, Checks,
+    RunEstimate,
 };
 use crate::rom::statics::{reduced_contact_static_restarting, scaled_load, ReducedStatic};
 use crate::system::{ReducedSystem, Scene};
@@ -213,6 +214,11 @@ pub struct Round {
     /// quantities (`None` in the ranking round, which makes no re-runs).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub truncation_check: Option<f64>,
+    /// The combined check's part of the estimate (one re-run both richer and tighter,
+    /// [`super::estimate::add_combined_check`]): the largest over the controlled quantities, as
+    /// made — also when it missed and the two separate checks replaced it.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub combined_check: Option<f64>,
     /// Wall time of the round's run, s.
     pub wall_s: f64,
     /// Wall time of the round's basis and reduced system, s.
@@ -234,11 +240,13 @@ pub enum ReRuns {
     None,
     /// Beside its run: it was expected to be the result.
     BesideRun,
-    /// Beside its run, and the truncation part dropped: its correction missed the tolerance
-    /// (the integration part is kept, should the round still be the result).
+    /// Beside its run, and dropped: its correction missed the tolerance.
     Dropped,
     /// After its correction (which met the tolerance), or as the result.
     AfterCorrection,
+    /// The combined check (beside its run or after its correction) missed the tolerance, and
+    /// the two separate checks were made after it to tell its parts apart.
+    Separated,
 }
 
 /// The tolerance-chosen reduced model and its run.
@@ -352,7 +360,7 @@ pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<Toleran
         let scene = Scene::of(model);
         let speculate = !ranking && expect_result;
         let checks = if speculate {
-            Checks::BOTH
+            Checks::COMBINED
         } else {
             Checks::NONE
         };
@@ -371,7 +379,14 @@ pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<Toleran
         let mut estimate = estimate?;
         let candidate = !ranking && worst(&estimate.reduction, on) <= tol;
         let recheck = (&rom, &run, &scene, &transient);
-        let made = round_checks(model, recheck, &mut estimate, speculate, candidate)?;
+        let (made, combined) = round_checks(
+            model,
+            recheck,
+            &mut estimate,
+            (speculate, candidate),
+            on,
+            tol,
+        )?;
         let eta = worst(&estimate.model_error(), on);
         let d = &estimate.detail;
         rounds.push(Round {
@@ -385,6 +400,7 @@ pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<Toleran
             joint_friction: d.joint_friction,
             truncation: d.truncation,
             truncation_check: estimate.truncation.map(|t| worst(&t, on)),
+            combined_check: combined,
             wall_s: run.wall_s,
             basis_s,
             estimate_s: round_start.elapsed().as_secs_f64() - basis_s - run.wall_s,
@@ -418,7 +434,7 @@ pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<Toleran
             // A ranking run is never the result: the same model again at the user's tolerances.
             continue;
         }
-        if !changed && estimate.integration.is_none() {
+        if !changed && estimate.integration.is_none() && estimate.combined.is_none() {
             // The result, or the same model again if its integration misses: its integration
             // check (when the correction missed, no round made it).
             let (rom, run, scene, opts) = recheck;
@@ -468,29 +484,44 @@ pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<Toleran
 }
 
 /// The re-runs of a round (module docs), given as its system, run, scene and transient options:
-/// a round whose correction meets the tolerance (`candidate`) may be the result, so the
-/// truncation check's re-run decides (the next fixed-interface modes) and its integration check
-/// goes beside it — already made beside the run when `speculate`; a speculative truncation part
-/// of a round that is no candidate is dropped. Returns where the re-runs were made.
+/// a round whose correction meets the tolerance (`candidate`) may be the result, so it gets the
+/// combined check (one re-run both richer and tighter) — already made beside the run when
+/// `speculate`. If the total with it meets `tol` on the quantities `on`, that is the result's
+/// estimate; if not, the two separate checks replace it, and their parts decide between more
+/// fixed-interface modes and tighter integration. A speculative check of a round that is no
+/// candidate is dropped. Returns where the re-runs were made, and the combined part as made.
 fn round_checks(
     model: &Model,
     (rom, run, scene, opts): (&ReducedSystem, &Run, &Scene, &TransientOptions),
     estimate: &mut RunEstimate,
-    speculate: bool,
-    candidate: bool,
-) -> Result<ReRuns, Error> {
-    match (candidate, speculate) {
-        (true, true) => Ok(ReRuns::BesideRun),
-        (true, false) => {
-            add_checks(model, estimate, run, rom.clone(), scene, opts, Checks::BOTH)?;
-            Ok(ReRuns::AfterCorrection)
-        }
-        (false, true) => {
-            drop_truncation(estimate);
-            Ok(ReRuns::Dropped)
-        }
-        (false, false) => Ok(ReRuns::None),
+    (speculate, candidate): (bool, bool),
+    on: Quantities,
+    tol: f64,
+) -> Result<(ReRuns, Option<f64>), Error> {
+    if !candidate {
+        let made = if speculate {
+            drop_combined(estimate);
+            ReRuns::Dropped
+        } else {
+            ReRuns::None
+        };
+        return Ok((made, None));
     }
+    if !speculate {
+        add_combined_check(model, estimate, run, rom.clone(), scene, opts)?;
+    }
+    let combined = estimate.combined.map(|c| worst(&c, on));
+    let made = if speculate {
+        ReRuns::BesideRun
+    } else {
+        ReRuns::AfterCorrection
+    };
+    if combined.is_none() || worst(&estimate.total, on) <= tol {
+        return Ok((made, combined));
+    }
+    drop_combined(estimate);
+    add_checks(model, estimate, run, rom.clone(), scene, opts, Checks::BOTH)?;
+    Ok((ReRuns::Separated, combined))
 }
 
 /// CPU time of the process (every thread), s (NaN where unavailable).
