@@ -398,8 +398,14 @@ pub fn integration_check_run(
 /// [`integration_errors`] from its re-run `check` of `run` (made by [`integration_check_run`]
 /// with the same `opts`).
 pub fn integration_errors_from(check: &Run, run: &Run, opts: &TransientOptions) -> CurveErrors {
-    let scale = 1.0 / (check_factor(opts).powf(integration_order_exponent(opts)) - 1.0).abs();
-    curve_differences(check, run, opts.problem.friction, scale)
+    curve_differences(check, run, opts.problem.friction, integration_scale(opts))
+}
+
+/// The factor `1 / |F^(2/3) − 1|` from the integration check's differences to the run's own
+/// integration error ([`integration_errors`]; `1 / |F − 1|` for a DIRK method). The combined
+/// check ([`combined_check_run`]) reads the truncation error this many times as large.
+pub fn integration_scale(opts: &TransientOptions) -> f64 {
+    1.0 / (check_factor(opts).powf(integration_order_exponent(opts)) - 1.0).abs()
 }
 
 /// The relative L2 differences of `run`'s curves from `check`'s (and of D at the end), times

@@ -105,8 +105,8 @@ use crate::reduction::{
     Quantity, DEFAULT_DROP_TOL,
 };
 use crate::rom::estimate::{
-    add_checks, add_combined_check, beside, drop_combined, loosened, run_estimated_parts, Checks,
-    RunEstimate,
+    add_checks, add_combined_check, beside, drop_combined, drop_truncation, integration_scale,
+    loosened, run_estimated_parts, Checks, RunEstimate,
 };
 use crate::rom::statics::{reduced_contact_static_restarting, scaled_load, ReducedStatic};
 use crate::system::{ReducedSystem, Scene};
@@ -342,6 +342,8 @@ pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<Toleran
     let mut ranking = true;
     // Whether the round is expected to be the result (its checks then go beside its run).
     let mut expect_result = false;
+    // Whether the last estimate says a combined check would miss (combined_may_meet).
+    let mut separate = false;
     // The integration tolerances: the user's, or the paper's times s (integration_looseness).
     let mut looseness = match opts.integration {
         IntegrationTolerances::FromTolerance => integration_looseness_for(tol, on),
@@ -359,7 +361,9 @@ pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<Toleran
         // core); any other round makes them after its correction, only if it may be the result.
         let scene = Scene::of(model);
         let speculate = !ranking && expect_result;
-        let checks = if speculate {
+        let checks = if speculate && separate {
+            Checks::BOTH
+        } else if speculate {
             Checks::COMBINED
         } else {
             Checks::NONE
@@ -387,6 +391,10 @@ pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<Toleran
             on,
             tol,
         )?;
+        // The next round, if expected to be the result, is expected with its reduction part
+        // within its share.
+        let expected = SELECTION_MARGIN * tol;
+        separate = !combined_may_meet(expected, &estimate, tol, &transient);
         let eta = worst(&estimate.model_error(), on);
         let d = &estimate.detail;
         rounds.push(Round {
@@ -488,8 +496,11 @@ pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<Toleran
 /// combined check (one re-run both richer and tighter) — already made beside the run when
 /// `speculate`. If the total with it meets `tol` on the quantities `on`, that is the result's
 /// estimate; if not, the two separate checks replace it, and their parts decide between more
-/// fixed-interface modes and tighter integration. A speculative check of a round that is no
-/// candidate is dropped. Returns where the re-runs were made, and the combined part as made.
+/// fixed-interface modes and tighter integration. A round whose own estimate says the combined
+/// check would miss ([`combined_may_meet`]) makes the two separate checks at once (beside its
+/// run, if the last estimate said so). Checks made beside the run of a round that is no
+/// candidate are dropped, all but the integration part. Returns where the re-runs were made,
+/// and the combined part as made.
 fn round_checks(
     model: &Model,
     (rom, run, scene, opts): (&ReducedSystem, &Run, &Scene, &TransientOptions),
@@ -500,6 +511,7 @@ fn round_checks(
 ) -> Result<(ReRuns, Option<f64>), Error> {
     if !candidate {
         let made = if speculate {
+            drop_truncation(estimate);
             drop_combined(estimate);
             ReRuns::Dropped
         } else {
@@ -508,6 +520,10 @@ fn round_checks(
         return Ok((made, None));
     }
     if !speculate {
+        if !combined_may_meet(worst(&estimate.reduction, on), estimate, tol, opts) {
+            add_checks(model, estimate, run, rom.clone(), scene, opts, Checks::BOTH)?;
+            return Ok((ReRuns::AfterCorrection, None));
+        }
         add_combined_check(model, estimate, run, rom.clone(), scene, opts)?;
     }
     let combined = estimate.combined.map(|c| worst(&c, on));
@@ -522,6 +538,25 @@ fn round_checks(
     drop_combined(estimate);
     add_checks(model, estimate, run, rom.clone(), scene, opts, Checks::BOTH)?;
     Ok((ReRuns::Separated, combined))
+}
+
+/// Whether the combined check may accept a run with the reduction part `reduction` and the
+/// first-order truncation part of `estimate` (its correction's, of ‖f_c‖): the combined check
+/// reads the truncation error [`integration_scale`] times as large as the truncation check does
+/// (1.87 at the tolerance model's √10 tighter re-run), so where the reduction part with the
+/// truncation part read that large already exceeds `tol`, the combined check would miss and the
+/// two separate re-runs would follow it. A choice of cost only: either way the result's
+/// estimate is one of the two rules'. A round's own estimate decides for checks made after its
+/// correction; the last round's, with the reduction part expected within its share, for checks
+/// made beside the run.
+fn combined_may_meet(
+    reduction: f64,
+    estimate: &RunEstimate,
+    tol: f64,
+    opts: &TransientOptions,
+) -> bool {
+    let truncation = estimate.detail.truncation.unwrap_or(0.0) * integration_scale(opts);
+    reduction.hypot(truncation) <= tol
 }
 
 /// CPU time of the process (every thread), s (NaN where unavailable).
