@@ -28,8 +28,8 @@
 //! tighter tolerances. Its difference from the run, scaled like the integration part, estimates
 //! the sum of the run's truncation and integration errors without telling them apart; the total
 //! is then `sqrt(e_reduction² + e_combined²)`. The tolerance model makes it instead of the two
-//! re-runs and makes those only when it misses (docs/theory/error-estimate.md, "The combined
-//! check").
+//! re-runs where its runs are looser than the paper's tolerances and at most 10× them, and
+//! makes those only when it misses (docs/theory/error-estimate.md, "The combined check").
 //!
 //! Each part is a relative L2 error of a curve over the output times ([`super::compare`]):
 //! ‖f_c‖(t), ‖f_R‖(t) with friction, master u_y(t), and with friction the dissipated energy

@@ -81,10 +81,12 @@
 //! check's richer model at the integration check's tighter tolerances, its difference scaled
 //! like the integration part). It estimates the sum of both errors without telling them apart:
 //! if the total with it meets TOL the round is the result; if not, the two separate re-runs
-//! replace it and their parts decide between ν and the integration. It reads the truncation
-//! error 1.87× as large as the truncation check does, so a round whose first-order truncation
-//! part read that large already misses ([`combined_may_meet`]) makes the separate ones at once
-//! (docs/theory/error-estimate.md, "The combined check"). A round makes the checks
+//! replace it and their parts decide between ν and the integration. It is made only for runs
+//! looser than the paper's tolerances and at most [`COMBINED_CHECK_MAX_LOOSENESS`]× them (where
+//! two models' integration errors follow the BDF2 law and the integration check is the tighter
+//! re-run), and it reads the truncation error 1.87× as large as the truncation check does, so a
+//! round whose first-order truncation part read that large already misses makes the separate
+//! ones at once (docs/theory/error-estimate.md, "The combined check"). A round makes the checks
 //! only if it may be the result (its correction meets TOL, or nothing is left to change), the
 //! two beside each other on a second core; a round *expected* to be the result starts them
 //! beside its own run instead: one that repeats the previous model (the ranking round's at the
@@ -601,7 +603,7 @@ fn combined_may_meet(
 }
 
 /// The loosest integration at which the tolerance model makes the combined check: rtol (and
-/// atol) at most this many times the paper's ([`combined_may_meet`]) — with friction, the
+/// atol) at most this many times the paper's (module docs) — with friction, the
 /// tolerances of TOL 1e-2 (and those of TOL 1e-2 to 1e-3 without).
 pub const COMBINED_CHECK_MAX_LOOSENESS: f64 = 10.0;
 
