@@ -23,6 +23,14 @@
 //! The total is `sqrt(e_reduction² + e_truncation² + e_integration²)`: the three re-runs differ
 //! from the run in independent ways (pair directions, fixed-interface modes, tolerances).
 //!
+//! The last two can also come from one re-run, the **combined** check
+//! ([`add_combined_check`]): the truncation check's richer model at the integration check's
+//! tighter tolerances. Its difference from the run, scaled like the integration part, estimates
+//! the sum of the run's truncation and integration errors without telling them apart; the total
+//! is then `sqrt(e_reduction² + e_combined²)`. The tolerance model makes it instead of the two
+//! re-runs where its runs are looser than the paper's tolerances and at most 10× them, and
+//! makes those only when it misses (docs/theory/error-estimate.md, "The combined check").
+//!
 //! Each part is a relative L2 error of a curve over the output times ([`super::compare`]):
 //! ‖f_c‖(t), ‖f_R‖(t) with friction, master u_y(t), and with friction the dissipated energy
 //! D(t) (also its relative error at the end of the run).
@@ -98,6 +106,11 @@ pub struct RunEstimate {
     /// The reduction estimate's details (corrected curves, per-pair errors).
     #[serde(skip)]
     pub detail: Estimate,
+    /// The truncation and integration parts from one re-run ([`add_combined_check`]): the run
+    /// against the truncation check's richer model at the integration check's tolerances,
+    /// scaled like the integration part (`None`: not made, or replaced by the two re-runs).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub combined: Option<CurveErrors>,
     /// The basis of the truncation check ([`ErrorEstimator::truncation_check_basis`]), for a
     /// check made after the run ([`add_truncation_check`]).
     #[serde(skip)]
@@ -111,6 +124,9 @@ pub struct Checks {
     pub integration: bool,
     /// The truncation check ([`truncation_check_run`]).
     pub truncation: bool,
+    /// The combined check instead of the truncation check ([`combined_check_run`]; with no
+    /// mode beyond the basis it is the integration check).
+    pub combined: bool,
 }
 
 impl Checks {
@@ -118,16 +134,25 @@ impl Checks {
     pub const BOTH: Checks = Checks {
         integration: true,
         truncation: true,
+        combined: false,
     };
     /// No re-run.
     pub const NONE: Checks = Checks {
         integration: false,
         truncation: false,
+        combined: false,
     };
     /// The integration check alone.
     pub const INTEGRATION: Checks = Checks {
         integration: true,
         truncation: false,
+        combined: false,
+    };
+    /// The combined check alone.
+    pub const COMBINED: Checks = Checks {
+        integration: false,
+        truncation: false,
+        combined: true,
     };
 }
 
@@ -143,10 +168,11 @@ impl RunEstimate {
 
     /// Sets `total` from the parts.
     fn update_total(&mut self) {
-        self.total = match &self.integration {
-            Some(i) => self.model_error().combine(i),
-            None => self.model_error(),
-        };
+        let mut total = self.model_error();
+        for part in [&self.integration, &self.combined].into_iter().flatten() {
+            total = total.combine(part);
+        }
+        self.total = total;
     }
 }
 
@@ -226,6 +252,69 @@ pub fn add_checks(
 pub fn drop_truncation(estimate: &mut RunEstimate) {
     estimate.truncation = None;
     estimate.update_total();
+}
+
+/// Drops the combined part of an estimate (its re-run missed, and the two separate re-runs are
+/// to tell the parts apart; or a check made beside the run that the caller does not use).
+pub fn drop_combined(estimate: &mut RunEstimate) {
+    estimate.combined = None;
+    estimate.update_total();
+}
+
+/// Adds the combined part to the estimate of `run` (of the reduced system `rom`, at its options
+/// `opts`) made without it: one re-run of the truncation check's richer model at the
+/// integration check's tolerances ([`combined_check_run`]). With no mode beyond the basis that
+/// re-run is the integration check, and its part goes there. Each part is the one a check made
+/// beside the run would give, bit for bit.
+///
+/// # Errors
+/// The richer basis fails, or the re-run does not finish.
+pub fn add_combined_check(
+    model: &Model,
+    estimate: &mut RunEstimate,
+    run: &Run,
+    rom: ReducedSystem,
+    scene: &Scene,
+    opts: &TransientOptions,
+) -> Result<(), Error> {
+    match &estimate.truncation_basis {
+        Some(basis) => {
+            let rich = truncation_check_system_of(model, basis)?;
+            let check = combined_check_run(rich, scene, opts)?;
+            estimate.combined = Some(integration_errors_from(&check, run, opts));
+        }
+        None => {
+            let check = integration_check_run(rom, scene, opts)?;
+            estimate.integration = Some(integration_errors_from(&check, run, opts));
+        }
+    }
+    estimate.update_total();
+    Ok(())
+}
+
+/// The combined check's re-run: the truncation check's richer model
+/// ([`truncation_check_system`]) at the integration check's tolerances ([`check_factor`]×
+/// the run's). Its relative L2 differences `D` from the run, divided by `|F^(2/3) − 1|` like
+/// the integration part's, are the combined part of the estimate.
+///
+/// ## What it measures
+///
+/// With `y*` the richer model integrated exactly, the run's error against it is `E = T + e`,
+/// its truncation error `T` and its integration error `e`; the re-run's is its own integration
+/// error `e_c`, so `D = E − e_c`. Under the BDF2 law `e_c ≈ F^(2/3) e'`, `e'` the richer
+/// model's error at the run's tolerances. Where `e'` follows `e` (the same steps resolve the
+/// same transitions) `D ≈ T + (1 − F^(2/3)) e` and `D / (1 − F^(2/3))` = `T / 0.536 + e`:
+/// the integration part as the integration check reads it, the truncation part 1.87× as large
+/// as the truncation check reads it. Where `e'` is independent of `e`, `D` adds `e_c` in
+/// quadrature and reads higher still. So the combined part is not smaller than
+/// `sqrt(T² + e²)` unless `T` and `e` cancel each other in the run, and a result it accepts is
+/// one the two separate checks accept.
+pub fn combined_check_run(
+    rich: ReducedSystem,
+    scene: &Scene,
+    opts: &TransientOptions,
+) -> Result<Run, Error> {
+    integration_check_run(rich, scene, opts)
 }
 
 /// The integration part of a run's error estimate: the relative L2 differences `D` of its curves
@@ -309,8 +398,14 @@ pub fn integration_check_run(
 /// [`integration_errors`] from its re-run `check` of `run` (made by [`integration_check_run`]
 /// with the same `opts`).
 pub fn integration_errors_from(check: &Run, run: &Run, opts: &TransientOptions) -> CurveErrors {
-    let scale = 1.0 / (check_factor(opts).powf(integration_order_exponent(opts)) - 1.0).abs();
-    curve_differences(check, run, opts.problem.friction, scale)
+    curve_differences(check, run, opts.problem.friction, integration_scale(opts))
+}
+
+/// The factor `1 / |F^(2/3) − 1|` from the integration check's differences to the run's own
+/// integration error ([`integration_errors`]; `1 / |F − 1|` for a DIRK method). The combined
+/// check ([`combined_check_run`]) reads the truncation error this many times as large.
+pub fn integration_scale(opts: &TransientOptions) -> f64 {
+    1.0 / (check_factor(opts).powf(integration_order_exponent(opts)) - 1.0).abs()
 }
 
 /// The relative L2 differences of `run`'s curves from `check`'s (and of D at the end), times
@@ -435,6 +530,7 @@ pub fn run_estimated(
     let checks = Checks {
         integration: checks,
         truncation: checks,
+        combined: false,
     };
     run_estimated_with(model, flex, rom, scene, opts, checks, observe)
 }
@@ -499,16 +595,17 @@ pub(crate) fn run_estimated_parts(
             let estimator = flex.estimator_with(model, &aside, truncation);
             // The two re-runs beside each other (a third job when a core is free).
             let rich = match &estimator {
-                Ok(e) if checks.truncation => truncation_check_system(model, e),
+                Ok(e) if checks.truncation || checks.combined => truncation_check_system(model, e),
                 _ => Ok(None),
             };
+            // With no mode beyond the basis the combined check is the integration check.
+            let integration = checks.integration || (checks.combined && matches!(rich, Ok(None)));
             let check = beside(
-                || {
-                    checks
-                        .integration
-                        .then(|| integration_check_run(aside, scene, opts))
-                },
+                || integration.then(|| integration_check_run(aside, scene, opts)),
                 || match rich {
+                    Ok(Some(rich)) if checks.combined => {
+                        combined_check_run(rich, scene, opts).map(Some)
+                    }
                     Ok(Some(rich)) => truncation_check_run(rich, scene, opts).map(Some),
                     Ok(None) => Ok(None),
                     Err(e) => Err(e),
@@ -544,13 +641,20 @@ pub(crate) fn run_estimated_parts(
             Some(c) => Some(integration_errors_from(&c?, &run, opts)),
             None => None,
         };
-        let truncation =
-            rich?.map(|rich| curve_differences(&rich, &run, opts.problem.friction, 1.0));
+        let (mut truncation, mut combined) = (None, None);
+        if let Some(rich) = rich? {
+            if checks.combined {
+                combined = Some(integration_errors_from(&rich, &run, opts));
+            } else {
+                truncation = Some(curve_differences(&rich, &run, opts.problem.friction, 1.0));
+            }
+        }
         let mut estimate = RunEstimate {
             total: detail.errors,
             reduction: detail.errors,
             truncation,
             integration,
+            combined,
             detail,
             truncation_basis,
         };

@@ -14,9 +14,12 @@ use jointrom::reduction::{
 };
 use jointrom::rom::compare::JointCurves;
 use jointrom::rom::estimate::{
-    add_checks, add_truncation_check, integration_errors, pair_law, run_estimated, Checks,
+    add_checks, add_combined_check, add_truncation_check, drop_combined, integration_errors,
+    pair_law, run_estimated, run_estimated_with, Checks,
 };
-use jointrom::rom::tolerance::{static_tolerance_model, tolerance_model, ReRuns, ToleranceOptions};
+use jointrom::rom::tolerance::{
+    static_tolerance_model, tolerance_model, worst, ReRuns, ToleranceOptions,
+};
 use jointrom::system::{ReducedSystem, Scene};
 
 use crate::common::{jointrom_err, jointrom_json, model, reference_json};
@@ -131,7 +134,7 @@ fn tolerance_model_meets_the_stored_full_reference() {
         );
         assert!(t.pairs.len() < m.pair_count());
         assert!(
-            t.estimate.truncation.is_some(),
+            t.estimate.truncation.is_some() || t.estimate.combined.is_some(),
             "{name}: no truncation check"
         );
         assert!(t.offline_s > 0.0 && t.run.wall_s > 0.0 && t.estimate_s > 0.0);
@@ -153,7 +156,8 @@ fn tolerance_model_meets_the_lap_joint_reference() {
     let reference = JointCurves::read(&path).unwrap();
     let t = tolerance_model(&m, &ToleranceOptions::new(1e-2)).unwrap();
     assert!(t.met, "not met ({:?})", t.estimate.total);
-    assert!(t.estimate.integration.is_some() && t.estimate.truncation.is_some());
+    let separate = t.estimate.integration.is_some() && t.estimate.truncation.is_some();
+    assert!(separate || t.estimate.combined.is_some());
     // Only the result made the re-runs (no round threw an integration check away).
     let (last, earlier) = t.rounds.split_last().unwrap();
     assert_ne!(last.checks, ReRuns::None);
@@ -493,11 +497,97 @@ fn concurrent_integration_check_equals_the_sequential_one() {
     let checks = Checks {
         integration: true,
         truncation: true,
+        combined: false,
     };
     add_checks(&m, &mut both, &run, rom_again, &scene, &opts, checks).unwrap();
     assert_eq!(both.truncation, est.truncation);
     assert_eq!(both.integration, est.integration);
     assert_eq!(both.total, est.total);
+}
+
+/// The combined check (the truncation check's richer model at the integration check's
+/// tolerances) made beside the run equals the one made after it — what the tolerance model
+/// relies on when it moves it — and it is the sum of the two parts it replaces: within a factor
+/// 2 of their root sum of squares on every curve.
+#[test]
+fn combined_check_beside_equals_after_and_reads_both_parts() {
+    let m = model("friction_bar");
+    let flex = JointFlexibility::new(&m).unwrap();
+    let basis = build_basis(&m, BasisKind::Tvd, &BasisOptions::default()).unwrap();
+    let rom = ReducedSystem::new(&m, basis.phi).unwrap();
+    let mut opts = TransientOptions {
+        end_time: Some(0.02),
+        ..Default::default()
+    };
+    // The tolerance model's integration at TOL 1e-2 (the paper's rtol and atol × 10).
+    opts.ode.rtol *= 10.0;
+    opts.ode.atol *= 10.0;
+    let scene = Scene::of(&m);
+    let (run, est) = run_estimated_with(
+        &m,
+        &flex,
+        rom.clone(),
+        &scene,
+        &opts,
+        Checks::COMBINED,
+        |_, _| {},
+    )
+    .unwrap();
+    let run = run.into_result().unwrap();
+    let est = est.unwrap();
+    let combined = est.combined.expect("the combined part");
+    assert!(est.truncation.is_none() && est.integration.is_none());
+    let mut after = est.clone();
+    drop_combined(&mut after);
+    add_combined_check(&m, &mut after, &run, rom.clone(), &scene, &opts).unwrap();
+    assert_eq!(after.combined, Some(combined));
+    assert_eq!(after.total, est.total);
+    let mut separate = est.clone();
+    drop_combined(&mut separate);
+    add_checks(&m, &mut separate, &run, rom, &scene, &opts, Checks::BOTH).unwrap();
+    let (t, i) = (separate.truncation.unwrap(), separate.integration.unwrap());
+    for q in Quantities::ALL.iter() {
+        let c = combined.of(q).unwrap();
+        let parts = t.of(q).unwrap().hypot(i.of(q).unwrap());
+        assert!(
+            (0.5..=2.0).contains(&(c / parts)),
+            "{}: combined {c:e}, separate parts {parts:e}",
+            q.name()
+        );
+    }
+}
+
+/// The friction bar's 1 % model is accepted by its combined check, and the two separate checks
+/// of the same run accept it too: the combined path chooses the model the separate one does.
+#[test]
+fn combined_check_accepts_what_the_separate_checks_accept() {
+    let m = model("friction_bar");
+    let tol = 1e-2;
+    let t = tolerance_model(&m, &ToleranceOptions::new(tol)).unwrap();
+    assert!(t.met);
+    let last = t.rounds.last().unwrap();
+    assert!(matches!(
+        last.checks,
+        ReRuns::BesideRun | ReRuns::AfterCorrection
+    ));
+    assert!(t.estimate.combined.is_some() && t.estimate.truncation.is_none());
+    let on = t.quantities;
+    assert!(worst(&t.estimate.total, on) <= tol);
+    let mut separate = t.estimate.clone();
+    drop_combined(&mut separate);
+    let scene = Scene::of(&m);
+    add_checks(
+        &m,
+        &mut separate,
+        &t.run,
+        t.rom.clone(),
+        &scene,
+        &t.transient,
+        Checks::BOTH,
+    )
+    .unwrap();
+    let total = worst(&separate.total, on);
+    assert!(total <= tol, "the separate checks miss: {total:e}");
 }
 
 /// The estimate of a fixed model (the paper's a-priori TVD, Craig–Bampton alone, g = 0, and the

@@ -492,6 +492,12 @@ fn print_summary(a: &TransientArgs, name: &str, model: &Model, o: &ModelRun, tot
             if let Some(i) = &e.integration {
                 line("  integration (vs a re-run at other tolerances, scaled)", i);
             }
+            if let Some(c) = &e.combined {
+                line(
+                    "  truncation + integration (vs one re-run richer and tighter, scaled)",
+                    c,
+                );
+            }
         }
         Some(Err(why)) => println!("error estimate unavailable: {why}"),
         None => {}
