@@ -52,6 +52,10 @@
 //! eigenvalues below the Gram route's round-off (measured in `docs/validation/static-convergence.md`, section
 //! `reduction::tvd`).
 //!
+//! The product `Z C` itself is needed by nothing downstream of the factors: the POMs are
+//! `Z (C w_i)/σ_i`, formed for the g a basis takes. [`trial_vector_derivatives_factored`]
+//! therefore leaves it unformed — at 10⁶ DOF an n × 512 block (4 GB) that never exists.
+//!
 //! # The secant TVD (opt-in, [`TvdOptions::secant`])
 //! A tangent TVD `K⁻¹ (∂K/∂q_{k,j}) φ_i` weighs pair z by the gap the linear base opens there,
 //! `k_n (B_n φ_i)_z`: the first-order change of φ_i when the penalty of the active set A is
