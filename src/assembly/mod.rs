@@ -57,11 +57,11 @@ pub fn assemble_structure(mesh: &Mesh) -> Result<Structure, Error> {
     let welds = Weld::build_all(&mesh.welds, &mesh.nodes, material)?;
     let dof_map = DofMap::new(mesh);
     // Each weld's parts ([`Weld::parts`]) with the weld they belong to.
-    let weld_parts: Vec<(&[usize], Option<&Mat<f64>>, usize)> = welds
+    let weld_parts = welds
         .iter()
         .enumerate()
         .flat_map(|(i, w)| w.parts().into_iter().map(move |(n, k)| (n, k, i)))
-        .collect();
+        .collect::<Vec<_>>();
     let element_nodes: Vec<&[usize]> = mesh
         .shells
         .iter()
