@@ -56,16 +56,22 @@ pub fn assemble_structure(mesh: &Mesh) -> Result<Structure, Error> {
         .collect::<Result<Vec<_>, _>>()?;
     let welds = Weld::build_all(&mesh.welds, &mesh.nodes, material)?;
     let dof_map = DofMap::new(mesh);
+    // Each weld's parts ([`Weld::parts`]) with the weld they belong to.
+    let weld_parts = welds
+        .iter()
+        .enumerate()
+        .flat_map(|(i, w)| w.parts().into_iter().map(move |(n, k)| (n, k, i)))
+        .collect::<Vec<_>>();
     let element_nodes: Vec<&[usize]> = mesh
         .shells
         .iter()
         .map(|s| &s.nodes[..])
         .chain(mesh.beams.iter().map(|b| &b.nodes[..]))
-        .chain(welds.iter().map(Weld::nodes))
+        .chain(weld_parts.iter().map(|p| p.0))
         .chain(mesh.masses.iter().map(|m| std::slice::from_ref(&m.node)))
         .collect();
     let assembler = Assembler::new(&dof_map, element_nodes);
-    let (ns, nb, nw) = (shells.len(), beams.len(), welds.len());
+    let (ns, nb, nw) = (shells.len(), beams.len(), weld_parts.len());
     // The shells a weld's re-meshed neighbourhood replaces (its condensed matrices stand for them).
     let replaced: std::collections::HashSet<usize> = mesh
         .welds
@@ -77,14 +83,20 @@ pub fn assemble_structure(mesh: &Mesh) -> Result<Structure, Error> {
         e if replaced.contains(&e) => Mat::zeros(24, 24),
         e if e < ns => shells[e].stiffness(),
         e if e < ns + nb => beams[e - ns].stiffness(),
-        e if e < ns + nb + nw => welds[e - ns - nb].stiffness(),
+        e if e < ns + nb + nw => match weld_parts[e - ns - nb] {
+            (_, Some(k), _) => k.clone(),
+            (_, None, i) => welds[i].stiffness(),
+        },
         _ => Mat::zeros(6, 6),
     });
     let mass = assembler.assemble(|e| match e {
         e if replaced.contains(&e) => Mat::zeros(24, 24),
         e if e < ns => shells[e].mass(),
         e if e < ns + nb => beams[e - ns].mass(),
-        e if e < ns + nb + nw => welds[e - ns - nb].mass(),
+        e if e < ns + nb + nw => match weld_parts[e - ns - nb] {
+            (_, Some(k), _) => Mat::zeros(k.nrows(), k.ncols()),
+            (_, None, i) => welds[i].mass(),
+        },
         e => {
             let m = mesh.masses[e - ns - nb - nw].matrix();
             Mat::from_fn(6, 6, |a, b| m[a][b])

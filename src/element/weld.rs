@@ -82,6 +82,7 @@ use faer::linalg::solvers::Solve;
 use faer::{Mat, Side};
 use rayon::prelude::*;
 
+use super::weld_slab::SlabPart;
 use super::{Beam2, Material};
 use crate::error::{ElementError, Error, WeldLayerProblem};
 use crate::mesh::{NuggetLayer, OwnShellNugget, WeldElem, WeldPatch};
@@ -100,6 +101,9 @@ pub struct Weld {
     /// with the bonded slab on the sheets' own shells ([`super::weld_slab`]) its stiffness and
     /// no mass, on the DOF of `nodes` (and no maps or beams of its own).
     condensed: Option<Arc<(Mat<f64>, Mat<f64>)>>,
+    /// The bonded slab on the sheets' own shells ([`super::weld_slab`]): its parts, each on the
+    /// eight nodes of two shells; empty for the other weld models.
+    slab: Vec<SlabPart>,
 }
 
 impl Weld {
@@ -117,16 +121,17 @@ impl Weld {
                 maps: Vec::new(),
                 beams: Vec::new(),
                 condensed: Some(Arc::new((c.stiffness, c.mass))),
+                slab: Vec::new(),
             });
         }
         if weld.own_shells == OwnShellNugget::BondedSlab {
-            let (nodes, k) = super::weld_slab::on_own_shells(weld, coords, material)?;
-            let dofs = k.nrows();
+            let (nodes, slab) = super::weld_slab::on_own_shells(weld, coords, material)?;
             return Ok(Weld {
                 nodes,
                 maps: Vec::new(),
                 beams: Vec::new(),
-                condensed: Some(Arc::new((k, Mat::zeros(dofs, dofs)))),
+                condensed: None,
+                slab,
             });
         }
         let mut touched: Vec<usize> = weld
@@ -161,6 +166,7 @@ impl Weld {
             maps,
             beams,
             condensed: None,
+            slab: Vec::new(),
         })
     }
 
@@ -249,6 +255,7 @@ impl Weld {
                         .iter()
                         .find(|(k, _)| *k == key.as_slice())
                         .map(|(_, c)| c.clone()),
+                    slab: Vec::new(),
                 }),
             })
             .collect()
@@ -267,13 +274,41 @@ impl Weld {
         self.maps.get(layer)
     }
 
-    /// Stiffness on the DOF of [`Weld::nodes`], N/mm, N, N·mm/rad.
+    /// The parts the assembly scatters, each with its nodes (6 DOF each) and, for a part of the
+    /// bonded slab on the sheets' own shells, its stiffness (48 × 48, no mass): one part per
+    /// pair of shells the slab's points join (sparse over the disc). Every other weld is one
+    /// part over [`Weld::nodes`] (`None`: its matrices are [`Weld::stiffness`], [`Weld::mass`]).
+    pub fn parts(&self) -> Vec<(&[usize], Option<&Mat<f64>>)> {
+        if self.slab.is_empty() {
+            return vec![(&self.nodes, None)];
+        }
+        self.slab.iter().map(|(n, k)| (&n[..], Some(k))).collect()
+    }
+
+    /// Stiffness on the DOF of [`Weld::nodes`], N/mm, N, N·mm/rad (dense; the assembly takes
+    /// the bonded slab's [`Weld::parts`] instead).
     pub fn stiffness(&self) -> Mat<f64> {
         if let Some(c) = &self.condensed {
             return c.0.clone();
         }
         let dofs = 6 * self.nodes.len();
         let mut k = Mat::<f64>::zeros(dofs, dofs);
+        for (part, kp) in &self.slab {
+            let at = |n: usize| {
+                self.nodes
+                    .binary_search(&n)
+                    .expect("a slab node is the weld's")
+            };
+            let dof: Vec<usize> = part
+                .iter()
+                .flat_map(|&n| (0..6).map(move |d| 6 * at(n) + d))
+                .collect();
+            for (x, &gx) in dof.iter().enumerate() {
+                for (y, &gy) in dof.iter().enumerate() {
+                    k[(gx, gy)] += kp[(x, y)];
+                }
+            }
+        }
         for (l, beam) in self.beams.iter().enumerate() {
             let mut t = Mat::<f64>::zeros(12, dofs);
             t.as_mut()

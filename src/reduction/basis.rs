@@ -97,7 +97,8 @@ fn orthonormalize(
             column += 1;
         }
     }
-    Ok((gs.basis(), gs.dropped()))
+    let dropped = gs.dropped();
+    Ok((gs.into_basis(), dropped))
 }
 
 /// The modified Gram–Schmidt of [`final_basis`], one column at a time, resumable: the state
@@ -108,8 +109,8 @@ fn orthonormalize(
 pub struct Orthonormalizer<'m> {
     m: &'m SymCsc,
     drop_tol: f64,
-    /// The accepted columns, M-orthonormal, their M-products and Veltkamp splits.
-    q: Vec<Vec<f64>>,
+    /// The accepted columns' M-products and Veltkamp splits (`q = q_hi + q_lo` exactly, so the
+    /// columns themselves are not kept a third time).
     mq: Vec<Vec<f64>>,
     q_hi: Vec<Vec<f64>>,
     q_lo: Vec<Vec<f64>>,
@@ -123,7 +124,6 @@ impl<'m> Orthonormalizer<'m> {
         Orthonormalizer {
             m,
             drop_tol,
-            q: Vec::new(),
             mq: Vec::new(),
             q_hi: Vec::new(),
             q_lo: Vec::new(),
@@ -138,7 +138,7 @@ impl<'m> Orthonormalizer<'m> {
 
     /// Columns dropped so far (linearly dependent on earlier ones, or zero).
     pub fn dropped(&self) -> usize {
-        self.pushed() - self.q.len()
+        self.pushed() - self.q_hi.len()
     }
 
     /// Forgets every column pushed after the first `pushed`.
@@ -148,14 +148,30 @@ impl<'m> Orthonormalizer<'m> {
         }
         self.accepted_after.truncate(pushed);
         let keep = self.accepted_after.last().copied().unwrap_or(0);
-        for v in [&mut self.q, &mut self.mq, &mut self.q_hi, &mut self.q_lo] {
+        for v in [&mut self.mq, &mut self.q_hi, &mut self.q_lo] {
             v.truncate(keep);
         }
     }
 
     /// The accepted columns (n × accepted), `Φᵀ M Φ = I`.
     pub fn basis(&self) -> Mat<f64> {
-        Mat::from_fn(self.m.n, self.q.len(), |r, c| self.q[c][r])
+        Mat::from_fn(self.m.n, self.q_hi.len(), |r, c| {
+            self.q_hi[c][r] + self.q_lo[c][r]
+        })
+    }
+
+    /// [`Orthonormalizer::basis`], releasing each column's working copies as it is placed.
+    pub fn into_basis(mut self) -> Mat<f64> {
+        let mut out = Mat::<f64>::zeros(self.m.n, self.q_hi.len());
+        for c in (0..self.q_hi.len()).rev() {
+            let (h, l) = (self.q_hi.pop(), self.q_lo.pop());
+            self.mq.pop();
+            let (Some(h), Some(l)) = (h, l) else { break };
+            for (r, (a, b)) in h.iter().zip(&l).enumerate() {
+                out[(r, c)] = a + b;
+            }
+        }
+        out
     }
 
     /// Orthogonalizes `v` (n values) against the accepted columns and accepts it unless it is
@@ -191,7 +207,7 @@ impl<'m> Orthonormalizer<'m> {
             .into());
         }
         if norm0 == 0.0 {
-            self.accepted_after.push(self.q.len());
+            self.accepted_after.push(self.q_hi.len());
             return Ok(());
         }
         let mut hi = vec![0.0; n];
@@ -219,10 +235,9 @@ impl<'m> Orthonormalizer<'m> {
             let (h, l): (Vec<f64>, Vec<f64>) = v.iter().map(|&x| split(x)).unzip();
             self.q_hi.push(h);
             self.q_lo.push(l);
-            self.q.push(v);
             self.mq.push(mv);
         }
-        self.accepted_after.push(self.q.len());
+        self.accepted_after.push(self.q_hi.len());
         Ok(())
     }
 }

@@ -7,8 +7,8 @@ use faer::Mat;
 use super::basis::{final_basis, modal_rotation, Basis, BasisOptions};
 use super::competitors::{alldof_vectors, jim_vectors};
 use super::craig_bampton::craig_bampton;
-use super::pod::{pod_tvd, pod_tvd_ratios};
-use super::tvd::{trial_vector_derivatives, TvdOptions};
+use super::pod::{pod_tvd_leading, pod_tvd_ratios, Pod};
+use super::tvd::{trial_vector_derivatives_factored, TvdOptions};
 use crate::error::{Error, ReductionError};
 use crate::model::Model;
 
@@ -134,27 +134,31 @@ fn build(
             secant: opts.tvd.secant || kind == BasisKind::TvdSecant,
             ..opts.tvd
         };
-        let tvd = trial_vector_derivatives(model, cb.as_ref(), &tvd_opts)?;
-        let p = pod_tvd(model, &tvd, kind != BasisKind::TvdPlain)?;
+        // The TVD in factor form and only the g POMs the basis takes: no n × p block but the
+        // flexibility Z, which is dropped before the basis is orthonormalized.
+        let tvd = trial_vector_derivatives_factored(model, cb.as_ref(), &tvd_opts)?;
         if other_pod {
             other_w = Some(pod_tvd_ratios(model, &tvd, kind == BasisKind::TvdPlain)?);
         }
         // One rule for every command: a g beyond the POD's modes is an error, never clamped.
-        let available = p.lambda.len();
-        let g = match opts.g {
-            Some(g) if g > available => {
-                return Err(ReductionError::PodModes {
+        let choose = |p: &Pod| -> Result<usize, Error> {
+            let available = p.lambda.len();
+            match opts.g {
+                Some(g) if g > available => Err(ReductionError::PodModes {
                     g,
                     available,
                     model: crate::files::printable(&model.name).to_string(),
                 }
-                .into())
+                .into()),
+                Some(g) => Ok(g),
+                None => Ok(p.choose_g(opts.threshold).min(available)),
             }
-            Some(g) => g,
-            None => p.choose_g(opts.threshold).min(available),
         };
-        let jm = p.leading(g).to_owned();
-        (p.w, g, tvd.total, tvd.nonzero(), jm)
+        let p = pod_tvd_leading(model, &tvd, kind != BasisKind::TvdPlain, &choose)?;
+        let (total, nonzero) = (tvd.total, tvd.nonzero());
+        drop(tvd);
+        let g = p.poms.ncols();
+        (p.w, g, total, nonzero, p.poms)
     } else {
         (
             Vec::new(),
@@ -206,4 +210,85 @@ fn build(
         eigenvalues,
     };
     Ok((basis, other_w))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::reduction::{pod_tvd, trial_vector_derivatives};
+
+    /// The basis from the TVD's factor form and the leading POMs alone
+    /// ([`trial_vector_derivatives_factored`], [`pod_tvd_leading`]) is the basis from the formed
+    /// TVD `Z C` and all POMs (the route before): the same w(g) and g bit for bit, the POMs and
+    /// the final basis to 1e-10, uncompressed (ν = 10) and compressed (multilayer, Φ_S alone),
+    /// both PODs.
+    #[test]
+    fn factor_form_gives_the_basis_of_the_formed_tvd() {
+        for (name, nu) in [
+            ("friction_bar", 10),
+            ("multilayer_sheet", 10),
+            ("multilayer_sheet", 0),
+        ] {
+            let model = Model::from_case_name(name).unwrap();
+            let cb = craig_bampton(&model, nu).unwrap();
+            let opts = TvdOptions::default();
+            let formed = trial_vector_derivatives(&model, cb.as_ref(), &opts).unwrap();
+            let factored = trial_vector_derivatives_factored(&model, cb.as_ref(), &opts).unwrap();
+            assert_eq!(factored.vectors.ncols(), 0, "{name}: Z C is not formed");
+            assert_eq!(factored.nonzero(), formed.nonzero());
+            let y = factored.formed_vectors();
+            assert!(
+                y.as_ref() == formed.vectors.as_ref(),
+                "{name}: Z C formed on demand"
+            );
+            for kind in [BasisKind::Tvd, BasisKind::TvdPlain] {
+                let weighted = kind == BasisKind::Tvd;
+                let all = pod_tvd(&model, &formed, weighted).unwrap();
+                let g = all.choose_g(0.999);
+                let lead = pod_tvd_leading(&model, &factored, weighted, &|_| Ok(g)).unwrap();
+                assert_eq!(lead.poms.ncols(), g);
+                let bits = |w: &[f64]| w.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+                assert_eq!(bits(&lead.w), bits(&all.w), "{name} {kind:?}");
+                let dev = max_dev(all.leading(g), lead.poms.as_ref());
+                assert!(dev <= 1e-10, "{name} ν = {nu} {kind:?}: POMs {dev:e}");
+                // The whole basis, against the one from the formed TVD and all POMs.
+                let opts = BasisOptions {
+                    nu,
+                    ..BasisOptions::default()
+                };
+                let basis = build_basis(&model, kind, &opts).unwrap();
+                assert_eq!(basis.g, g);
+                let (want, _) =
+                    final_basis(&[cb.as_ref(), all.leading(g)], &model.mass, opts.drop_tol)
+                        .unwrap();
+                let (want, _) = modal_rotation(&model, want).unwrap();
+                let dev = max_dev(want.as_ref(), basis.phi.as_ref());
+                assert!(dev <= 1e-10, "{name} ν = {nu} {kind:?}: basis {dev:e}");
+            }
+        }
+    }
+
+    /// The largest difference of two matrices' columns relative to the column's largest entry,
+    /// up to each column's sign.
+    fn max_dev(a: faer::MatRef<'_, f64>, b: faer::MatRef<'_, f64>) -> f64 {
+        assert_eq!(a.shape(), b.shape());
+        (0..a.ncols())
+            .map(|c| {
+                let scale = a.col(c).iter().fold(0.0f64, |m, v| m.max(v.abs()));
+                let dot: f64 = a
+                    .col(c)
+                    .iter()
+                    .zip(b.col(c).iter())
+                    .map(|(x, y)| x * y)
+                    .sum();
+                let s = dot.signum();
+                let dev = a
+                    .col(c)
+                    .iter()
+                    .zip(b.col(c).iter())
+                    .fold(0.0f64, |m, (x, y)| m.max((x - s * y).abs()));
+                dev / scale
+            })
+            .fold(0.0, f64::max)
+    }
 }

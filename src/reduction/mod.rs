@@ -68,8 +68,11 @@ pub use craig_bampton::craig_bampton;
 pub use estimate::{
     CurveErrors, ErrorEstimator, Estimate, JointFlexibility, Quantities, Quantity, RunStates,
 };
-pub use pod::{pod, pod_tvd, pod_tvd_ratios, sigma_zero, Pod, DEFAULT_THRESHOLD, ZERO_EIGENVALUE};
+pub use pod::{
+    pod, pod_tvd, pod_tvd_leading, pod_tvd_ratios, sigma_zero, Pod, DEFAULT_THRESHOLD,
+    ZERO_EIGENVALUE,
+};
 pub use tvd::{
-    active_pairs, displacement_scales, static_right_hand_sides, trial_vector_derivatives, Tvd,
-    TvdFactor, TvdIndex, TvdOptions,
+    active_pairs, displacement_scales, static_right_hand_sides, trial_vector_derivatives,
+    trial_vector_derivatives_factored, Tvd, TvdFactor, TvdIndex, TvdOptions,
 };

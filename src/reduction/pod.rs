@@ -31,7 +31,8 @@ pub const ZERO_EIGENVALUE: f64 = 1e-12;
 pub struct Pod {
     /// Kept eigenvalues λ of `Yᵀ A Y` (eq. 25; `A = I` for eq. 22), descending.
     pub lambda: Vec<f64>,
-    /// Proper orthogonal modes `u_i = Y û_i / sqrt(λ_i)` (eq. 23), n × lambda.len(), A-orthonormal.
+    /// Proper orthogonal modes `u_i = Y û_i / sqrt(λ_i)` (eq. 23), n × lambda.len(), A-orthonormal;
+    /// the leading ones only from [`pod_tvd_leading`], none from [`pod_tvd_ratios`].
     pub poms: Mat<f64>,
     /// Energy ratio `w[g − 1] = w(g)` (eq. 26) for g = 1..p; 1 from the last kept λ on.
     pub w: Vec<f64>,
@@ -288,36 +289,65 @@ pub fn sigma_zero(m: usize, p: usize) -> f64 {
 /// Without a factor form (the eq. (15) inertia variant, [`TvdOptions::inertia`]) this falls back
 /// to [`pod`] on `tvd.vectors` (weight `model.stiffness` when `weighted`).
 pub fn pod_tvd(model: &Model, tvd: &Tvd, weighted: bool) -> Result<Pod, Error> {
-    pod_tvd_with(model, tvd, weighted, true)
+    pod_tvd_with(
+        model,
+        tvd,
+        weighted,
+        Some(&|pod: &Pod| Ok(pod.lambda.len())),
+    )
 }
 
 /// The energy ratios w(g) of [`pod_tvd`] alone (the same numbers), without forming the POMs:
 /// for the plain POD this skips the orthonormal factor Q of `Z = Q R_Z` and its product with
 /// the singular vectors (two n × p × p products; `jointrom basis` prints both PODs' curves).
 pub fn pod_tvd_ratios(model: &Model, tvd: &Tvd, weighted: bool) -> Result<Vec<f64>, Error> {
-    Ok(pod_tvd_with(model, tvd, weighted, false)?.w)
+    Ok(pod_tvd_with(model, tvd, weighted, None)?.w)
 }
 
-/// [`pod_tvd`]; with `want_poms` false the returned POMs are empty (n × 0).
-fn pod_tvd_with(model: &Model, tvd: &Tvd, weighted: bool, want_poms: bool) -> Result<Pod, Error> {
+/// [`pod_tvd`] forming only the POMs a basis takes: `leading` gets the POD without POMs
+/// (λ, w(g)) and returns their count g; [`Pod::poms`] is then n × g (g capped at the kept
+/// count), the same columns as the first g of [`pod_tvd`]'s, to round-off. The POMs of the
+/// factor form are `Z (C w_i)/σ_i`, formed once from the flexibility Z: neither the TVD `Z C`
+/// ([`super::trial_vector_derivatives_factored`]) nor the POMs beyond g ever exist as n-sized
+/// blocks. Without a factor form the POD is [`pod`]'s, its POMs cut to g.
+pub fn pod_tvd_leading(
+    model: &Model,
+    tvd: &Tvd,
+    weighted: bool,
+    leading: &dyn Fn(&Pod) -> Result<usize, Error>,
+) -> Result<Pod, Error> {
+    pod_tvd_with(model, tvd, weighted, Some(leading))
+}
+
+/// The first `leading(pod without POMs)` POMs of the POD to be formed; none without `leading`.
+type Leading<'a> = Option<&'a dyn Fn(&Pod) -> Result<usize, Error>>;
+
+/// [`pod_tvd`], forming the first `leading(pod without POMs)` POMs only (none without it).
+fn pod_tvd_with(model: &Model, tvd: &Tvd, weighted: bool, leading: Leading) -> Result<Pod, Error> {
     let weight = weighted.then_some(&model.stiffness);
     let Some(f) = &tvd.factor else {
-        return pod(tvd.vectors.as_ref(), weight);
+        return pod_cut(tvd.vectors.as_ref(), weight, leading);
     };
-    let n = tvd.vectors.nrows();
+    let n = model.dofs();
     let (m, p) = (f.coefficients.nrows(), f.coefficients.ncols());
-    if f.flexibility.nrows() != n || f.flexibility.ncols() != m || p != tvd.vectors.ncols() {
+    let formed = tvd.vectors.ncols();
+    if f.flexibility.nrows() != n
+        || f.flexibility.ncols() != m
+        || p != tvd.nonzero()
+        || tvd.vectors.nrows() != n
+        || (formed != p && formed != 0)
+    {
         return Err(ReductionError::TvdFactorForm {
             flexibility: (f.flexibility.nrows(), f.flexibility.ncols()),
             m,
             p,
             n,
-            columns: tvd.vectors.ncols(),
+            columns: tvd.nonzero(),
         }
         .into());
     }
     if p == 0 || m == 0 {
-        return pod(tvd.vectors.as_ref(), weight);
+        return pod_cut(tvd.formed_vectors().as_ref(), weight, leading);
     }
     if f.coefficients
         .col_iter()
@@ -340,12 +370,11 @@ fn pod_tvd_with(model: &Model, tvd: &Tvd, weighted: bool, want_poms: bool) -> Re
         let a = Mat::from_fn(m, p, |r, c| d[r].max(0.0).sqrt() * vt_c[(r, c)]);
         (a, PomMap::Flexibility)
     } else {
-        let (r, q) = if want_poms {
+        // The plain POMs need Q of the same `Z = Q R_Z`; w(g) alone takes R_Z from the blocked
+        // QR (no n × m copy).
+        let (r, q) = if leading.is_some() {
             let qr = f.flexibility.qr();
-            (
-                qr.thin_R().to_owned(),
-                PomMap::Orthonormal(qr.compute_thin_Q()),
-            )
+            (qr.thin_R().to_owned(), PomMap::Orthonormal(qr))
         } else {
             (tall_r_factor(f.flexibility.as_ref()), PomMap::Skip)
         };
@@ -373,25 +402,47 @@ fn pod_tvd_with(model: &Model, tvd: &Tvd, weighted: bool, want_poms: bool) -> Re
     let kept: Vec<usize> = order.into_iter().filter(|&i| s[i] > cut).collect();
     let dropped = p - kept.len();
     let lambda: Vec<f64> = kept.iter().map(|&i| s[i] * s[i]).collect();
+    let mut out = finish(lambda, Mat::zeros(n, 0), dropped, p, weighted);
+    let g = match leading {
+        Some(count) => count(&out)?.min(kept.len()),
+        None => 0,
+    };
+    if g == 0 {
+        return Ok(out);
+    }
+    let kept = &kept[..g];
     let mut poms = match q {
-        PomMap::Skip => Mat::zeros(n, 0),
-        PomMap::Flexibility if !want_poms => Mat::zeros(n, 0),
         // u_i = Z (C w_i) / σ_i.
         PomMap::Flexibility => {
             let w = svd.V();
-            let cw = Mat::from_fn(p, kept.len(), |r, c| w[(r, kept[c])] / s[kept[c]]);
+            let cw = Mat::from_fn(p, g, |r, c| w[(r, kept[c])] / s[kept[c]]);
             let ccw = &f.coefficients * &cw;
             &f.flexibility * &ccw
         }
-        // u_i = Q u_i.
-        PomMap::Orthonormal(q) => {
+        // u_i = Q u_i, Q of `Z = Q R_Z` (Householder, thin).
+        PomMap::Orthonormal(qr) => {
             let u = svd.U();
-            let uk = Mat::from_fn(m, kept.len(), |r, c| u[(r, kept[c])]);
-            &q * &uk
+            let uk = Mat::from_fn(m, g, |r, c| u[(r, kept[c])]);
+            &qr.compute_thin_Q() * &uk
         }
+        PomMap::Skip => Mat::zeros(n, 0),
     };
     fix_signs(&mut poms);
-    Ok(finish(lambda, poms, dropped, p, weighted))
+    out.poms = poms;
+    Ok(out)
+}
+
+/// [`pod`] with its POMs cut to `leading(pod)` columns.
+fn pod_cut(y: MatRef<'_, f64>, weight: Option<&SymCsc>, leading: Leading) -> Result<Pod, Error> {
+    let mut out = pod(y, weight)?;
+    let g = match leading {
+        Some(count) => count(&out)?.min(out.poms.ncols()),
+        None => out.poms.ncols(),
+    };
+    if g < out.poms.ncols() {
+        out.poms = out.poms.subcols(0, g).to_owned();
+    }
+    Ok(out)
 }
 
 /// How [`pod_tvd`] maps the SVD of its small matrix to the POMs.
@@ -428,7 +479,7 @@ enum PomMap {
     /// K-weighted: `u_i = Z (C w_i) / σ_i` with the right singular vectors.
     Flexibility,
     /// Plain: `u_i = Q u_i` with the left singular vectors, Q of `Z = Q R_Z`.
-    Orthonormal(Mat<f64>),
+    Orthonormal(faer::linalg::solvers::Qr<f64>),
     /// No POMs wanted ([`pod_tvd_ratios`]).
     Skip,
 }

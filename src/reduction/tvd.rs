@@ -52,6 +52,10 @@
 //! eigenvalues below the Gram route's round-off (measured in `docs/validation/static-convergence.md`, section
 //! `reduction::tvd`).
 //!
+//! The product `Z C` itself is needed by nothing downstream of the factors: the POMs are
+//! `Z (C w_i)/σ_i`, formed for the g a basis takes. [`trial_vector_derivatives_factored`]
+//! therefore leaves it unformed — at 10⁶ DOF an n × 512 block (4 GB) that never exists.
+//!
 //! # The secant TVD (opt-in, [`TvdOptions::secant`])
 //! A tangent TVD `K⁻¹ (∂K/∂q_{k,j}) φ_i` weighs pair z by the gap the linear base opens there,
 //! `k_n (B_n φ_i)_z`: the first-order change of φ_i when the penalty of the active set A is
@@ -151,7 +155,8 @@ pub struct TvdIndex {
 /// The trial vector derivatives of a base.
 #[derive(Clone, Debug)]
 pub struct Tvd {
-    /// K-normalized TVD (n × p), `φᵀ K φ = 1` for each column.
+    /// K-normalized TVD (n × p), `φᵀ K φ = 1` for each column; n × 0 when only the factor
+    /// form is kept ([`trial_vector_derivatives_factored`], [`Tvd::formed_vectors`]).
     pub vectors: Mat<f64>,
     /// Which `(i, k, j)` each column is.
     pub index: Vec<TvdIndex>,
@@ -202,7 +207,16 @@ pub struct TvdFactor {
 impl Tvd {
     /// Number of kept (nonzero) columns p.
     pub fn nonzero(&self) -> usize {
-        self.vectors.ncols()
+        self.index.len()
+    }
+
+    /// The K-normalized TVD (n × p): [`Tvd::vectors`] where formed, else the product
+    /// `Z C` of the factor form ([`trial_vector_derivatives_factored`]).
+    pub fn formed_vectors(&self) -> Mat<f64> {
+        match &self.factor {
+            Some(f) if self.vectors.ncols() != self.nonzero() => &f.flexibility * &f.coefficients,
+            _ => self.vectors.clone(),
+        }
     }
 }
 
@@ -280,6 +294,32 @@ pub fn trial_vector_derivatives(
     base: MatRef<'_, f64>,
     opts: &TvdOptions,
 ) -> Result<Tvd, Error> {
+    derivatives(model, base, opts, true)
+}
+
+/// [`trial_vector_derivatives`] that keeps the static TVD in their factor form only: where
+/// [`Tvd::factor`] is set, [`Tvd::vectors`] is left empty (n × 0) instead of the n × p product
+/// `Z C` — one dense n × p block less (4 GB for the 509 TVD of a 10⁶-DOF model). Everything
+/// [`super::build_basis`] needs — the POD, its POMs `Z (C w_i)/σ_i`, w(g) — comes from the
+/// factors ([`super::pod_tvd`]); [`Tvd::formed_vectors`] forms the product when wanted. With
+/// eq. (15) columns ([`TvdOptions::inertia`]) there is no factor form and the vectors are formed
+/// as by [`trial_vector_derivatives`].
+pub fn trial_vector_derivatives_factored(
+    model: &Model,
+    base: MatRef<'_, f64>,
+    opts: &TvdOptions,
+) -> Result<Tvd, Error> {
+    derivatives(model, base, opts, false)
+}
+
+/// [`trial_vector_derivatives`]; with `form_static` false the static columns' product `Z C`
+/// is not formed when the factor form stands for all columns.
+fn derivatives(
+    model: &Model,
+    base: MatRef<'_, f64>,
+    opts: &TvdOptions,
+    form_static: bool,
+) -> Result<Tvd, Error> {
     let n = model.dofs();
     if base.nrows() != n {
         return Err(ReductionError::Rows {
@@ -321,8 +361,14 @@ pub fn trial_vector_derivatives(
         .filter(|&c| omega2[cand.index[c].i] == 0.0)
         .collect();
     if !static_cols.is_empty() {
-        let (xs, static_factor) = run.static_columns(&cand, &static_cols, &mut k_norms)?;
-        if static_cols.len() == cols {
+        let all_static = static_cols.len() == cols;
+        let (xs, static_factor) = run.static_columns(
+            &cand,
+            &static_cols,
+            &mut k_norms,
+            form_static || !all_static,
+        )?;
+        if all_static {
             // All columns static (the default): the product is the whole TVD matrix.
             x = xs;
             factor = Some(static_factor);
@@ -545,26 +591,33 @@ impl<'a> TvdRun<'a> {
     }
 
     /// The static columns `static_cols` (eqs. 16/18) through one Cholesky of K: their
-    /// K-normalized vectors `Z C` (n × static_cols.len()) and the factor form Z, G, C; the
-    /// K-norms go to `k_norms`. With fewer columns p than joint rows m, the flexibility is
-    /// solved on the range of C only (module docs, "Compressed flexibility").
+    /// K-normalized vectors `Z C` (n × static_cols.len(); n × 0 unless `form`) and the factor
+    /// form Z, G, C; the K-norms go to `k_norms`. With fewer columns p than joint rows m, the
+    /// flexibility is solved on the range of C only (module docs, "Compressed flexibility").
+    /// The factorization is dropped before the product is formed.
     fn static_columns(
         &self,
         cand: &Candidates,
         static_cols: &[usize],
         k_norms: &mut [f64],
+        form: bool,
     ) -> Result<(Mat<f64>, TvdFactor), Error> {
         let (model, used) = (self.model, &self.used);
         let (q, coef, bt) = self.static_rhs(cand, static_cols);
         let chol = SparseCholesky::new(&model.stiffness)?;
         let z = solve_refined_steps_owned(&model.stiffness, &chol, bt, 1);
+        drop(chol);
         let bz = rows_times(&model.joint, used, z.as_ref());
         let g = symmetric(&match &q {
             Some(q) => q.transpose() * &bz,
             None => bz,
         });
         let scaled = normalize(&g, coef, static_cols, &cand.index, k_norms)?;
-        let xs = &z * &scaled;
+        let xs = if form {
+            &z * &scaled
+        } else {
+            Mat::zeros(model.dofs(), 0)
+        };
         let factor = TvdFactor {
             flexibility: z,
             joint_flexibility: g,

@@ -531,3 +531,59 @@ fn bonded_slab_checks(case: &Case) {
     assert!(weld.reference_map(0).is_none());
     symmetric_and_free_of_rigid_work(&mesh, &weld);
 }
+
+#[test]
+fn bonded_slab_is_assembled_as_parts_of_two_shells() {
+    // The slab on the sheets' own shells enters K as one part per pair of shells its points
+    // join: the same stiffness as its dense matrix over all its nodes, scattered sparsely.
+    let case = plates_with(48, [31.25, 28.75], "area", json!("auto"));
+    let mesh = Mesh::from_case(&case).unwrap();
+    assert_eq!(mesh.welds[0].own_shells, OwnShellNugget::BondedSlab);
+    let weld = Weld::new(&mesh.welds[0], &mesh.nodes, Material::STEEL).unwrap();
+    let parts = weld.parts();
+    assert!(parts.len() > 1);
+    for (nodes, k) in &parts {
+        let k = k.expect("a slab part carries its stiffness");
+        assert_eq!((nodes.len(), k.nrows(), k.ncols()), (8, 48, 48));
+        assert!(nodes.iter().all(|n| weld.nodes().binary_search(n).is_ok()));
+    }
+    let with = assemble_structure(&mesh).unwrap();
+    let mut bare = mesh.clone();
+    bare.welds.clear();
+    let without = assemble_structure(&bare).unwrap();
+    assert_eq!(with.stiffness.n, without.stiffness.n);
+    // Sparse: far fewer new entries than the dense block's (6N)².
+    let grown = with.stiffness.values.len() - without.stiffness.values.len();
+    let dense = (6 * weld.nodes().len()).pow(2);
+    assert!(
+        grown * 4 < dense,
+        "{grown} new entries, dense block {dense}"
+    );
+    let k_weld = weld.stiffness();
+    for seed in [1.0, 2.5] {
+        let n = with.stiffness.n;
+        let q: Vec<f64> = (0..n).map(|i| (seed * i as f64 * 0.37).sin()).collect();
+        let energy = |k: &jointrom::linalg::SymCsc| {
+            let mut kq = vec![0.0; n];
+            k.mul_vec(&q, &mut kq);
+            q.iter().zip(&kq).map(|(a, b)| a * b).sum::<f64>()
+        };
+        let u = with.dof_map.expand(&q);
+        let uw: Vec<f64> = weld
+            .nodes()
+            .iter()
+            .flat_map(|&node| (0..6).map(move |d| 6 * node + d))
+            .map(|i| u[i])
+            .collect();
+        let want: f64 = uw.iter().zip(apply(&k_weld, &uw)).map(|(a, b)| a * b).sum();
+        let (total, got) = (
+            energy(&with.stiffness),
+            energy(&with.stiffness) - energy(&without.stiffness),
+        );
+        assert!(want > 1e-3 * total, "slab energy {want} of {total}");
+        assert!(
+            (got - want).abs() <= 1e-11 * total,
+            "slab energy {got} vs {want}"
+        );
+    }
+}
