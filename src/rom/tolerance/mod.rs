@@ -110,6 +110,9 @@ use crate::rom::estimate::{
 use crate::rom::statics::{reduced_contact_static_restarting, scaled_load, ReducedStatic};
 use crate::system::{ReducedSystem, Scene};
 
+mod compress;
+pub use compress::{Compression, CompressionAttempt, COMPRESSION_TIGHTENING};
+
 /// θ of the pair selection (module docs): the pairs left out may carry at most this fraction of
 /// the tolerance.
 pub const SELECTION_MARGIN: f64 = 0.5;
@@ -131,6 +134,10 @@ pub struct ToleranceOptions {
     /// The quantities the tolerance holds for (`None`: all the run produces,
     /// [`controlled_quantities`]).
     pub quantities: Option<Quantities>,
+    /// Whether the per-pair model that meets the tolerance is then compressed (its joint
+    /// columns replaced by their POD, [`compress`]; kept only if it meets the tolerance with a
+    /// smaller basis).
+    pub compress: bool,
 }
 
 /// Where the tolerance model's rtol and atol come from.
@@ -181,6 +188,7 @@ impl ToleranceOptions {
             max_rounds: 8,
             integration: IntegrationTolerances::FromTolerance,
             quantities: None,
+            compress: false,
         }
     }
 }
@@ -277,6 +285,8 @@ pub struct ToleranceModel {
     /// CPU time of the process over the whole tolerance model (setup, rounds, the result's
     /// run and estimate; every thread, including other work the process does meanwhile), s.
     pub cpu_s: f64,
+    /// What the compression of the joint columns did (`None`: not tried).
+    pub compression: Option<Compression>,
 }
 
 /// What the tolerance model chose, as the outputs report it (`"tolerance"` in a run's JSON).
@@ -308,6 +318,10 @@ pub struct ToleranceChoice {
     pub rtol: f64,
     /// See `rtol`.
     pub atol: f64,
+    /// What the compression of the joint columns did (absent: not tried): how many compressed
+    /// columns replaced how many per-pair ones, and whether that model is the result.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub compression: Option<Compression>,
 }
 
 /// Builds the smallest Craig–Bampton + pair-attachment-mode model whose estimated errors of the
@@ -445,8 +459,36 @@ pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<Toleran
             continue;
         }
         if !changed {
-            let offline_s = (round_start - start).as_secs_f64() + basis_s;
-            let estimate_s = rounds.last().map_or(0.0, |r| r.estimate_s);
+            let mut offline_s = (round_start - start).as_secs_f64() + basis_s;
+            let mut estimate_s = rounds.last().map_or(0.0, |r| r.estimate_s);
+            let (mut rom, mut run, mut estimate) = (rom, run, estimate);
+            let mut compression = None;
+            let joint_columns = chosen.pairs.len() + chosen.tangential.len();
+            if opts.compress && total <= tol && joint_columns > 0 {
+                let compress_start = Instant::now();
+                let per_pair = compress::PerPair {
+                    chosen: &chosen,
+                    cache: &bases,
+                    cb: &cb,
+                    estimate: &estimate,
+                    run: &run,
+                    basis_size: rom.dim(),
+                };
+                let (better, report) =
+                    compress::compress(model, &flex, per_pair, on, tol, &transient)?;
+                if let Some(c) = better {
+                    // The per-pair model's run and estimate and everything before the
+                    // compressed run are offline work now; the compressed model's run and
+                    // estimate are the result.
+                    let last = report.attempts.last().map_or(0.0, |a| a.wall_s);
+                    let before = compress_start.elapsed().as_secs_f64() - last + c.basis_s;
+                    offline_s += run.wall_s + estimate_s + before;
+                    estimate_s = last - c.basis_s - c.run.wall_s;
+                    (rom, run, estimate) = (c.rom, c.run, c.estimate);
+                }
+                compression = Some(report);
+            }
+            let total = worst(&estimate.total, on);
             return Ok(ToleranceModel {
                 pairs: chosen.pairs,
                 tangential: chosen.tangential,
@@ -462,6 +504,7 @@ pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<Toleran
                 estimate_s,
                 transient,
                 cpu_s: process_cpu_s() - cpu_start,
+                compression,
             });
         }
     }
