@@ -887,7 +887,7 @@ pub struct Estimate {
     pub pair_dissipation_end: Vec<f64>,
     /// The corrected pair forces of every output, sparse: per output the pairs with a nonzero
     /// corrected force and their `[p_n*, p_t1*, p_t2*]`, N (the snapshots of the joint's
-    /// deformation patterns, [`crate::reduction::joint_pod`]).
+    /// deformation patterns, [`crate::reduction::joint_pod()`]).
     pub corrected_pair_forces: Vec<Vec<(usize, [f64; 3])>>,
 }
 

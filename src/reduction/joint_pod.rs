@@ -6,7 +6,7 @@
 //! `x_J(t) = Z_S p_S(t)` (`Z_S = K⁻¹ B_Sᵀ`, n × c, and `p_S` the forces of the chosen pairs): the
 //! snapshots `X = Z_S P` (P: c × m, one column per output). Their K-weighted POD — the modes that
 //! hold the most strain energy of the snapshots, as the TVD's POD ranks its vectors
-//! ([`super::pod`], eq. 25) — needs no n-size work, because every product it needs is in the pair
+//! ([`super::pod()`], eq. 25) — needs no n-size work, because every product it needs is in the pair
 //! space:
 //!
 //! ```text

@@ -1,5 +1,5 @@
 //! Compressed joint columns: the tolerance model's attachment modes replaced by the POD of the
-//! deformation the joint forces actually cause ([`crate::reduction::joint_pod`]).
+//! deformation the joint forces actually cause ([`crate::reduction::joint_pod()`]).
 //!
 //! The per-pair model holds one normal attachment mode `z_k = K⁻¹ b_kᵀ` per chosen pair (and
 //! tangential ones), so its size grows with the pairs the joint needs. The joint's deformation
@@ -10,7 +10,7 @@
 //! Once the per-pair model meets the tolerance, its estimate's corrected pair forces
 //! ([`crate::reduction::Estimate::corrected_pair_forces`], the forces the full model would carry
 //! under the run's motion) are the snapshots `P` (kept pairs × outputs), and the POD of `Z_S P`
-//! in the strain-energy norm beyond the Craig–Bampton part ([`crate::reduction::joint_pod`],
+//! in the strain-energy norm beyond the Craig–Bampton part ([`crate::reduction::joint_pod()`],
 //! Gram `G_SS − (B_S Φ_CB) K̃_CB⁻¹ (B_S Φ_CB)ᵀ` with `G_SS = B_S K⁻¹ B_Sᵀ`) gives the compressed
 //! normal columns `Z_S c_j`; the tangential columns likewise, with the corrected tangential
 //! forces along each column's direction.
@@ -45,7 +45,9 @@ use faer::prelude::Solve;
 use faer::{Mat, Side};
 use serde::Serialize;
 
-use super::{worst, BasisCache, Chosen, Column, SELECTION_MARGIN};
+use super::{
+    worst, BasisCache, Chosen, Column, ToleranceModel, ToleranceOptions, SELECTION_MARGIN,
+};
 use crate::error::Error;
 use crate::integrate::{Run, TransientOptions};
 use crate::joint::{JointOperator, NORMAL, T1, T2};
@@ -105,6 +107,51 @@ pub struct Compression {
     pub accepted: bool,
     /// The compressed models tried, in order.
     pub attempts: Vec<CompressionAttempt>,
+}
+
+/// With [`ToleranceOptions::compress`], compresses the joint columns of the per-pair `result`
+/// if it met the tolerance (module docs), given the per-pair model's joint part, basis cache and
+/// Craig–Bampton basis: if a compressed model meets the tolerance with a smaller basis, it becomes the result (its system, run and
+/// estimate; the per-pair run, its estimate and the compression before the compressed run count
+/// as offline time). `result.compression` says what was tried.
+///
+/// # Errors
+/// A failing eigenproblem, basis or run.
+pub(super) fn compress_result(
+    model: &Model,
+    flex: &JointFlexibility,
+    (chosen, cache, cb): (&Chosen, &BasisCache<'_>, &Mat<f64>),
+    opts: &ToleranceOptions,
+    result: &mut ToleranceModel,
+) -> Result<(), Error> {
+    let columns = chosen.pairs.len() + chosen.tangential.len();
+    if !opts.compress || !result.met || columns == 0 {
+        return Ok(());
+    }
+    let tol = opts.tolerance;
+    let start = std::time::Instant::now();
+    let per_pair = PerPair {
+        chosen,
+        cache,
+        cb,
+        estimate: &result.estimate,
+        run: &result.run,
+        basis_size: result.rom.dim(),
+    };
+    let on = result.quantities;
+    let (better, report) = compress(model, flex, per_pair, on, tol, &result.transient)?;
+    if let Some(c) = better {
+        let last = report.attempts.last().map_or(0.0, |a| a.wall_s);
+        let before = start.elapsed().as_secs_f64() - last + c.basis_s;
+        result.offline_s += result.run.wall_s + result.estimate_s + before;
+        result.estimate_s = last - c.basis_s - c.run.wall_s;
+        result.rom = c.rom;
+        result.run = c.run;
+        result.estimate = c.estimate;
+        result.met = worst(&result.estimate.total, on) <= tol;
+    }
+    result.compression = Some(report);
+    Ok(())
 }
 
 /// A compressed model that met the tolerance: its system, run, estimate.

@@ -135,7 +135,7 @@ pub struct ToleranceOptions {
     /// [`controlled_quantities`]).
     pub quantities: Option<Quantities>,
     /// Whether the per-pair model that meets the tolerance is then compressed (its joint
-    /// columns replaced by their POD, [`compress`]; kept only if it meets the tolerance with a
+    /// columns replaced by their POD, `compress.rs`; kept only if it meets the tolerance with a
     /// smaller basis).
     pub compress: bool,
 }
@@ -406,8 +406,7 @@ pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<Toleran
             checks: made,
         });
         let mut changed = false;
-        // The next round repeats this model (tighter) or changes it where the estimate
-        // asked for no more than the round adds: expected to be the result.
+        // The next round repeats this model or adds all the estimate asked for: the result?
         expect_result = true;
         if eta > tol && rounds.len() < opts.max_rounds {
             let enriched = chosen.enrich(&estimate, on, tol, cb.ncols());
@@ -459,39 +458,9 @@ pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<Toleran
             continue;
         }
         if !changed {
-            let mut offline_s = (round_start - start).as_secs_f64() + basis_s;
-            let mut estimate_s = rounds.last().map_or(0.0, |r| r.estimate_s);
-            let (mut rom, mut run, mut estimate) = (rom, run, estimate);
-            let mut compression = None;
-            let joint_columns = chosen.pairs.len() + chosen.tangential.len();
-            if opts.compress && total <= tol && joint_columns > 0 {
-                let compress_start = Instant::now();
-                let per_pair = compress::PerPair {
-                    chosen: &chosen,
-                    cache: &bases,
-                    cb: &cb,
-                    estimate: &estimate,
-                    run: &run,
-                    basis_size: rom.dim(),
-                };
-                let (better, report) =
-                    compress::compress(model, &flex, per_pair, on, tol, &transient)?;
-                if let Some(c) = better {
-                    // The per-pair model's run and estimate and everything before the
-                    // compressed run are offline work now; the compressed model's run and
-                    // estimate are the result.
-                    let last = report.attempts.last().map_or(0.0, |a| a.wall_s);
-                    let before = compress_start.elapsed().as_secs_f64() - last + c.basis_s;
-                    offline_s += run.wall_s + estimate_s + before;
-                    estimate_s = last - c.basis_s - c.run.wall_s;
-                    (rom, run, estimate) = (c.rom, c.run, c.estimate);
-                }
-                compression = Some(report);
-            }
-            let total = worst(&estimate.total, on);
-            return Ok(ToleranceModel {
-                pairs: chosen.pairs,
-                tangential: chosen.tangential,
+            let mut result = ToleranceModel {
+                pairs: chosen.pairs.clone(),
+                tangential: chosen.tangential.clone(),
                 quantities: on,
                 nu,
                 setup_s,
@@ -499,13 +468,16 @@ pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<Toleran
                 run,
                 met: total <= tol,
                 estimate,
+                estimate_s: rounds.last().map_or(0.0, |r| r.estimate_s),
                 rounds,
-                offline_s,
-                estimate_s,
+                offline_s: (round_start - start).as_secs_f64() + basis_s,
                 transient,
-                cpu_s: process_cpu_s() - cpu_start,
-                compression,
-            });
+                cpu_s: f64::NAN,
+                compression: None,
+            };
+            compress::compress_result(model, &flex, (&chosen, &bases, &cb), opts, &mut result)?;
+            result.cpu_s = process_cpu_s() - cpu_start;
+            return Ok(result);
         }
     }
 }
