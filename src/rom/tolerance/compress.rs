@@ -38,8 +38,9 @@
 //! in K rather than the closed-spring norm, so the estimate decides: the compressed model is
 //! run and estimated like any round (reduction, truncation and integration parts), and it is
 //! the result only if every controlled quantity's total estimate meets TOL with a smaller basis.
-//! If it misses, the fractions are tightened by [`COMPRESSION_TIGHTENING`] once; if that misses
-//! too (or would not be smaller), the per-pair model stays the result.
+//! If it misses, the fractions are tightened by [`COMPRESSION_TIGHTENING`] (√10), at most
+//! [`COMPRESSION_ATTEMPTS`] models in all (down to a tenth of the first fraction); if the last
+//! misses too (or would not be smaller), the per-pair model stays the result.
 
 use faer::prelude::Solve;
 use faer::{Mat, Side};
@@ -60,8 +61,12 @@ use crate::reduction::{
 use crate::rom::estimate::{run_estimated_parts, Checks, RunEstimate};
 use crate::system::{ReducedSystem, Scene};
 
-/// The POD fraction is divided by this when the first compressed model misses the tolerance.
-pub const COMPRESSION_TIGHTENING: f64 = 10.0;
+/// The POD fractions are divided by this when a compressed model misses the tolerance (√10:
+/// half a decade per attempt).
+pub const COMPRESSION_TIGHTENING: f64 = 3.162_277_660_168_379_5;
+
+/// Compressed models tried at most (the last at a tenth of the first fraction).
+pub const COMPRESSION_ATTEMPTS: usize = 3;
 
 /// One compressed model tried (`"compression"."attempts"` of the tolerance JSON).
 #[derive(Clone, Debug, Serialize)]
@@ -210,7 +215,7 @@ pub(super) fn compress(
     let pod_t = columns_pod(model, &per_pair, &tangential, forces, stiffness[1])?;
     report.kappa = [pod_n.kappa, pod_t.kappa];
     let mut fraction = [pod_n.kappa, pod_t.kappa].map(|k| SELECTION_MARGIN * tol / k);
-    for _ in 0..2 {
+    for _ in 0..COMPRESSION_ATTEMPTS {
         let (rn, rt) = (
             pod_n.pod.rank_for(fraction[0]),
             pod_t.pod.rank_for(fraction[1]),

@@ -111,7 +111,7 @@ use crate::rom::statics::{reduced_contact_static_restarting, scaled_load, Reduce
 use crate::system::{ReducedSystem, Scene};
 
 mod compress;
-pub use compress::{Compression, CompressionAttempt, COMPRESSION_TIGHTENING};
+pub use compress::{Compression, CompressionAttempt, COMPRESSION_ATTEMPTS, COMPRESSION_TIGHTENING};
 
 /// θ of the pair selection (module docs): the pairs left out may carry at most this fraction of
 /// the tolerance.
