@@ -885,6 +885,10 @@ pub struct Estimate {
     pub pair_dissipation_error: Vec<f64>,
     /// Per pair, `D_k(T) − D_k*(T)` at the last output (N·mm; empty without friction).
     pub pair_dissipation_end: Vec<f64>,
+    /// The corrected pair forces of every output, sparse: per output the pairs with a nonzero
+    /// corrected force and their `[p_n*, p_t1*, p_t2*]`, N (the snapshots of the joint's
+    /// deformation patterns, [`crate::reduction::joint_pod()`]).
+    pub corrected_pair_forces: Vec<Vec<(usize, [f64; 3])>>,
 }
 
 impl Estimate {
@@ -899,6 +903,13 @@ impl Estimate {
                 v[3 * k + T1].powi(2) + v[3 * k + T2].powi(2),
             ]
         };
+        let forces = (0..self.pair_error.len())
+            .filter_map(|k| {
+                let f = [pc[3 * k + NORMAL], pc[3 * k + T1], pc[3 * k + T2]];
+                (f != [0.0; 3]).then_some((k, f))
+            })
+            .collect();
+        self.corrected_pair_forces.push(forces);
         for k in 0..self.pair_error.len() {
             let (a1, a2) = (pj[3 * k + T1], pj[3 * k + T2]);
             self.pair_tangential_error[k] +=

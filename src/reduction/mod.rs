@@ -53,6 +53,7 @@ pub mod competitors;
 pub mod craig_bampton;
 pub mod distributed;
 pub mod estimate;
+pub mod joint_pod;
 pub mod pod;
 pub mod tvd;
 
@@ -68,6 +69,7 @@ pub use craig_bampton::craig_bampton;
 pub use estimate::{
     CurveErrors, ErrorEstimator, Estimate, JointFlexibility, Quantities, Quantity, RunStates,
 };
+pub use joint_pod::{joint_pod, JointPod};
 pub use pod::{
     pod, pod_tvd, pod_tvd_leading, pod_tvd_ratios, sigma_zero, Pod, DEFAULT_THRESHOLD,
     ZERO_EIGENVALUE,

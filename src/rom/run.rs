@@ -31,6 +31,9 @@ pub struct RunSettings {
     pub low_rank: Option<usize>,
     /// Where the tolerance model's rtol and atol come from (the user's `--rtol/--atol` win).
     pub integration: IntegrationTolerances,
+    /// Whether the tolerance model compresses its joint columns
+    /// ([`ToleranceOptions::compress`]).
+    pub compress_joint: bool,
 }
 
 /// A finished run of a spec's model.
@@ -151,6 +154,7 @@ fn run_tolerance(
     topts.quantities = on;
     topts.transient = opts.clone();
     topts.integration = settings.integration;
+    topts.compress = settings.compress_joint;
     let ToleranceModel {
         pairs,
         tangential,
@@ -166,6 +170,7 @@ fn run_tolerance(
         estimate_s,
         transient,
         cpu_s,
+        compression,
     } = tolerance_model(model, &topts)?;
     let frames = match (every, &rom.phi) {
         (Some(every), Some(phi)) => {
@@ -196,6 +201,7 @@ fn run_tolerance(
             rounds,
             rtol: transient.ode.rtol,
             atol: transient.ode.atol,
+            compression,
         }),
     })
 }

@@ -185,6 +185,51 @@ fn tolerance_model_meets_the_lap_joint_reference() {
     }
 }
 
+/// Compressed joint columns (`ToleranceOptions::compress`) on the friction bar at TOL 1e-2:
+/// the POD of the per-pair model's attachment modes under its corrected pair forces gives a
+/// smaller basis that still meets the tolerance against the stored full run, every quantity's
+/// estimate honest (0.5–10× of its true error), and the report says what replaced what.
+#[test]
+fn compressed_joint_columns_meet_the_stored_full_reference() {
+    let m = model("friction_bar");
+    let (path, _) = reference_json("friction_bar_full_friction_on");
+    let reference = JointCurves::read(&path).unwrap();
+    let mut opts = ToleranceOptions::new(1e-2);
+    opts.compress = true;
+    let t = tolerance_model(&m, &opts).unwrap();
+    let c = t.compression.as_ref().expect("compression tried");
+    assert!(t.met && c.accepted, "{c:?}");
+    let last = c.attempts.last().unwrap();
+    assert_eq!(last.basis_size, t.rom.dim());
+    assert!(t.rom.dim() < c.pair_basis_size, "{c:?}");
+    assert!(last.columns < c.pair_columns, "{c:?}");
+    assert!(
+        last.tangential_columns <= c.tangential_pair_columns,
+        "{c:?}"
+    );
+    assert!(c.kappa.iter().all(|k| *k >= 1.0), "{c:?}");
+    let truth = reference.errors(&t.run.curves);
+    let est = &t.estimate.total;
+    for (what, truth, est) in [
+        ("fc", truth.contact_force, est.contact_force),
+        ("fr", truth.friction_force, est.friction_force),
+        ("uy", truth.master_uy, est.master_uy),
+        ("D", truth.dissipated, est.dissipated),
+        ("D(T)", truth.dissipated_end, est.dissipated_end),
+    ] {
+        let (truth, est) = (truth.unwrap(), est.unwrap());
+        assert!(
+            truth <= 1e-2 && est <= 1e-2,
+            "{what}: true {truth}, estimated {est}"
+        );
+        let eff = est / truth;
+        assert!(
+            (0.5..=10.0).contains(&eff),
+            "{what} effectivity {eff} ({est} / {truth})"
+        );
+    }
+}
+
 /// `--tolerance-on fc` controls ‖f_c‖ alone: on the friction bar it keeps no tangential
 /// attachment modes, and its ‖f_R‖ is then the 3 % the normal-only model has — the estimate
 /// reports it within 0.5–10× (the stick correction of the tangential forces).

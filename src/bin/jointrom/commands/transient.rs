@@ -33,6 +33,12 @@ pub struct TransientArgs {
     /// does not meet the tolerance. Without it a miss is a warning.
     #[arg(long, requires = "tolerance")]
     strict: bool,
+    /// With --tolerance: the joint columns of the model that meets it, per pair (off) or
+    /// compressed to the POD of the deformation the corrected pair forces cause (on; kept only
+    /// if the compressed model meets the tolerance with a smaller basis). JSON
+    /// `"tolerance"."compression"`. Default off
+    #[arg(long, value_enum, requires = "tolerance")]
+    compress_joint: Option<OnOff>,
     /// `--model pod`: end of the full-FE training run, s (default: the run's end time).
     #[arg(long)]
     train_end: Option<f64>,
@@ -160,6 +166,7 @@ pub fn run(a: TransientArgs) -> Result<(), Error> {
             } else {
                 IntegrationTolerances::FromTolerance
             },
+            compress_joint: a.compress_joint == Some(OnOff::On),
         },
     )?;
     // The largest estimated error of the quantities the tolerance holds for.

@@ -121,6 +121,9 @@ use crate::rom::estimate::{
 use crate::rom::statics::{reduced_contact_static_restarting, scaled_load, ReducedStatic};
 use crate::system::{ReducedSystem, Scene};
 
+mod compress;
+pub use compress::{Compression, CompressionAttempt, COMPRESSION_ATTEMPTS, COMPRESSION_TIGHTENING};
+
 /// θ of the pair selection (module docs): the pairs left out may carry at most this fraction of
 /// the tolerance.
 pub const SELECTION_MARGIN: f64 = 0.5;
@@ -142,6 +145,10 @@ pub struct ToleranceOptions {
     /// The quantities the tolerance holds for (`None`: all the run produces,
     /// [`controlled_quantities`]).
     pub quantities: Option<Quantities>,
+    /// Whether the per-pair model that meets the tolerance is then compressed (its joint
+    /// columns replaced by their POD, `compress.rs`; kept only if it meets the tolerance with a
+    /// smaller basis).
+    pub compress: bool,
 }
 
 /// Where the tolerance model's rtol and atol come from.
@@ -192,6 +199,7 @@ impl ToleranceOptions {
             max_rounds: 8,
             integration: IntegrationTolerances::FromTolerance,
             quantities: None,
+            compress: false,
         }
     }
 }
@@ -329,6 +337,8 @@ pub struct ToleranceModel {
     /// CPU time of the process over the whole tolerance model (setup, rounds, the result's
     /// run and estimate; every thread, including other work the process does meanwhile), s.
     pub cpu_s: f64,
+    /// What the compression of the joint columns did (`None`: not tried).
+    pub compression: Option<Compression>,
 }
 
 /// What the tolerance model chose, as the outputs report it (`"tolerance"` in a run's JSON).
@@ -360,6 +370,10 @@ pub struct ToleranceChoice {
     pub rtol: f64,
     /// See `rtol`.
     pub atol: f64,
+    /// What the compression of the joint columns did (absent: not tried): how many compressed
+    /// columns replaced how many per-pair ones, and whether that model is the result.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub compression: Option<Compression>,
 }
 
 /// Builds the smallest Craig–Bampton + pair-attachment-mode model whose estimated errors of the
@@ -449,8 +463,7 @@ pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<Toleran
             (run.wall_s, basis_s, estimate_s),
         ));
         let mut changed = false;
-        // The next round repeats this model (tighter) or changes it where the estimate
-        // asked for no more than the round adds: expected to be the result.
+        // The next round repeats this model or adds all the estimate asked for: the result?
         expect_result = true;
         if eta > tol && rounds.len() < opts.max_rounds {
             let enriched = chosen.enrich(&estimate, on, tol, cb.ncols());
@@ -495,11 +508,9 @@ pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<Toleran
             continue;
         }
         if !changed {
-            let offline_s = (round_start - start).as_secs_f64() + basis_s;
-            let estimate_s = rounds.last().map_or(0.0, |r| r.estimate_s);
-            return Ok(ToleranceModel {
-                pairs: chosen.pairs,
-                tangential: chosen.tangential,
+            let mut result = ToleranceModel {
+                pairs: chosen.pairs.clone(),
+                tangential: chosen.tangential.clone(),
                 quantities: on,
                 nu,
                 setup_s,
@@ -507,12 +518,16 @@ pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<Toleran
                 run,
                 met: total <= tol,
                 estimate,
+                estimate_s: rounds.last().map_or(0.0, |r| r.estimate_s),
                 rounds,
-                offline_s,
-                estimate_s,
+                offline_s: (round_start - start).as_secs_f64() + basis_s,
                 transient,
-                cpu_s: process_cpu_s() - cpu_start,
-            });
+                cpu_s: f64::NAN,
+                compression: None,
+            };
+            compress::compress_result(model, &flex, (&chosen, &bases, &cb), opts, &mut result)?;
+            result.cpu_s = process_cpu_s() - cpu_start;
+            return Ok(result);
         }
     }
 }
