@@ -9,10 +9,10 @@ use jointrom::integrate::{integrate, TransientOptions};
 use jointrom::joint::statics::ContactOptions;
 use jointrom::model::{contact_static_full, Model};
 use jointrom::reduction::{
-    build_basis, craig_bampton, final_basis, BasisKind, BasisOptions, JointFlexibility,
-    Orthonormalizer, Quantities, Quantity, RunStates, DEFAULT_DROP_TOL,
+    build_basis, craig_bampton, final_basis, BasisKind, BasisOptions, CurveErrors,
+    JointFlexibility, Orthonormalizer, Quantities, Quantity, RunStates, DEFAULT_DROP_TOL,
 };
-use jointrom::rom::compare::JointCurves;
+use jointrom::rom::compare::{JointCurves, ReferenceErrors};
 use jointrom::rom::estimate::{
     add_checks, add_combined_check, add_truncation_check, drop_combined, integration_errors,
     pair_law, run_estimated, run_estimated_with, Checks,
@@ -38,6 +38,18 @@ fn curve(reference: &Value, key: &str) -> Vec<f64> {
 fn rel_err(a: &[f64], b: &[f64]) -> f64 {
     let n = a.len().min(b.len());
     crate::common::rel_l2(a, b, n)
+}
+
+/// Each quantity's true error (against a stored full run) and estimate, by name.
+fn contract(truth: &ReferenceErrors, est: &CurveErrors) -> [(&'static str, f64, f64); 5] {
+    [
+        ("fc", truth.contact_force, est.contact_force),
+        ("fr", truth.friction_force, est.friction_force),
+        ("uy", truth.master_uy, est.master_uy),
+        ("D", truth.dissipated, est.dissipated),
+        ("D(T)", truth.dissipated_end, est.dissipated_end),
+    ]
+    .map(|(what, t, e)| (what, t.expect("a true error"), e.expect("an estimate")))
 }
 
 /// The pair-space contact statics (one factorization of K, the joint flexibility) reproduce the
@@ -107,15 +119,7 @@ fn tolerance_model_meets_the_stored_full_reference() {
         let truth = reference.errors(&t.run.curves);
         let est = &t.estimate.total;
         assert!(t.met, "{name}: tolerance reported not met ({est:?})");
-        let pairs = [
-            ("fc", truth.contact_force, est.contact_force),
-            ("fr", truth.friction_force, est.friction_force),
-            ("uy", truth.master_uy, est.master_uy),
-            ("D", truth.dissipated, est.dissipated),
-            ("D(T)", truth.dissipated_end, est.dissipated_end),
-        ];
-        for (what, truth, est) in pairs {
-            let (truth, est) = (truth.unwrap(), est.unwrap());
+        for (what, truth, est) in contract(&truth, est) {
             assert!(truth <= 1e-2, "{name}: true {what} error {truth}");
             assert!(est <= 1e-2, "{name}: estimated {what} error {est}");
             let eff = est / truth;
@@ -168,14 +172,7 @@ fn tolerance_model_meets_the_lap_joint_reference() {
     );
     let truth = reference.errors(&t.run.curves);
     let est = &t.estimate.total;
-    for (what, truth, est) in [
-        ("fc", truth.contact_force, est.contact_force),
-        ("fr", truth.friction_force, est.friction_force),
-        ("uy", truth.master_uy, est.master_uy),
-        ("D", truth.dissipated, est.dissipated),
-        ("D(T)", truth.dissipated_end, est.dissipated_end),
-    ] {
-        let (truth, est) = (truth.unwrap(), est.unwrap());
+    for (what, truth, est) in contract(&truth, est) {
         assert!(truth <= 1e-2, "true {what} error {truth}");
         let eff = est / truth;
         assert!(
@@ -210,14 +207,7 @@ fn compressed_joint_columns_meet_the_stored_full_reference() {
     assert!(c.kappa.iter().all(|k| *k >= 1.0), "{c:?}");
     let truth = reference.errors(&t.run.curves);
     let est = &t.estimate.total;
-    for (what, truth, est) in [
-        ("fc", truth.contact_force, est.contact_force),
-        ("fr", truth.friction_force, est.friction_force),
-        ("uy", truth.master_uy, est.master_uy),
-        ("D", truth.dissipated, est.dissipated),
-        ("D(T)", truth.dissipated_end, est.dissipated_end),
-    ] {
-        let (truth, est) = (truth.unwrap(), est.unwrap());
+    for (what, truth, est) in contract(&truth, est) {
         assert!(
             truth <= 1e-2 && est <= 1e-2,
             "{what}: true {truth}, estimated {est}"
