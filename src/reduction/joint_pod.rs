@@ -165,14 +165,21 @@ mod tests {
         (order.iter().map(|&j| evd.values[j]).collect(), modes)
     }
 
-    #[test]
-    fn pair_space_pod_equals_the_direct_k_weighted_pod() {
-        let (n, c, m) = (40, 9, 25);
-        let (k, b, p) = problem(n, c, m);
+    /// The test problem's K, `Z = K⁻¹ Bᵀ`, the snapshots `X = Z P` and their pair-space POD
+    /// (`c` columns, 40 DOF, 25 outputs).
+    fn fixture(c: usize) -> (Mat<f64>, Mat<f64>, Mat<f64>, JointPod) {
+        let (k, b, p) = problem(40, c, 25);
         let z = k.llt(faer::Side::Lower).unwrap().solve(b.transpose());
         let x = &z * &p;
         let gram = b.as_ref() * &z;
         let pod = joint_pod(gram.as_ref(), p.as_ref()).unwrap();
+        (k, z, x, pod)
+    }
+
+    #[test]
+    fn pair_space_pod_equals_the_direct_k_weighted_pod() {
+        let c = 9;
+        let (k, z, x, pod) = fixture(c);
         let (energies, direct) = direct_pod(&k, &x);
         // Energies: every one the direct POD resolves, to round-off of the largest.
         let top = energies[0];
@@ -202,12 +209,8 @@ mod tests {
 
     #[test]
     fn kept_modes_span_the_snapshots_to_the_energy_rule() {
-        let (n, c, m) = (40, 9, 25);
-        let (k, b, p) = problem(n, c, m);
-        let z = k.llt(faer::Side::Lower).unwrap().solve(b.transpose());
-        let x = &z * &p;
-        let gram = b.as_ref() * &z;
-        let pod = joint_pod(gram.as_ref(), p.as_ref()).unwrap();
+        let c = 9;
+        let (k, z, x, pod) = fixture(c);
         for fraction in [1e-1, 1e-2, 1e-4] {
             let rank = pod.rank_for(fraction);
             assert!(rank < c, "fraction {fraction}: rank {rank} of {c}");
