@@ -14,7 +14,8 @@ use crate::rom::estimate::{run_estimated, RunEstimate};
 use crate::rom::file::RomFile;
 use crate::rom::spec::ModelSpec;
 use crate::rom::tolerance::{
-    tolerance_model, IntegrationTolerances, ToleranceChoice, ToleranceModel, ToleranceOptions,
+    tolerance_model, CompressJoint, IntegrationTolerances, ToleranceChoice, ToleranceModel,
+    ToleranceOptions,
 };
 use crate::rom::training::{train_snapshot_basis, Training};
 use crate::system::{FullSystem, ReducedSystem, Scene, SecondOrderSystem};
@@ -31,9 +32,9 @@ pub struct RunSettings {
     pub low_rank: Option<usize>,
     /// Where the tolerance model's rtol and atol come from (the user's `--rtol/--atol` win).
     pub integration: IntegrationTolerances,
-    /// Whether the tolerance model compresses its joint columns
-    /// ([`ToleranceOptions::compress`]).
-    pub compress_joint: bool,
+    /// When the tolerance model compresses its joint columns
+    /// ([`ToleranceOptions::compress`]; default [`CompressJoint::Auto`]).
+    pub compress_joint: CompressJoint,
 }
 
 /// A finished run of a spec's model.

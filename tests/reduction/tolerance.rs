@@ -142,6 +142,34 @@ fn tolerance_model_meets_the_stored_full_reference() {
             "{name}: no truncation check"
         );
         assert!(t.offline_s > 0.0 && t.run.wall_s > 0.0 && t.estimate_s > 0.0);
+        auto_compression_keeps_its_rule(name, &t);
+    }
+}
+
+/// The default `auto` compression runs a compressed model only at most
+/// [`AUTO_COMPRESSION_SHRINK`] of the per-pair basis; where it runs none, the per-pair model
+/// is the result.
+fn auto_compression_keeps_its_rule(name: &str, t: &jointrom::rom::ToleranceModel) {
+    use jointrom::rom::tolerance::AUTO_COMPRESSION_SHRINK;
+    let c = t
+        .compression
+        .as_ref()
+        .expect("auto reports the compression");
+    assert_eq!(c.mode, jointrom::rom::CompressJoint::Auto);
+    let limit = AUTO_COMPRESSION_SHRINK * c.pair_basis_size as f64;
+    assert!(
+        c.attempts.iter().all(|a| a.basis_size as f64 <= limit),
+        "{name}: {c:?}"
+    );
+    assert_eq!(c.tried, !c.attempts.is_empty(), "{name}: {c:?}");
+    if !c.accepted {
+        assert_eq!(t.rom.dim(), c.pair_basis_size, "{name}: {c:?}");
+    }
+    if !c.tried {
+        assert!(
+            c.first_basis_size as f64 > limit || c.first_basis_size >= c.pair_basis_size,
+            "{name}: {c:?}"
+        );
     }
 }
 
@@ -192,7 +220,7 @@ fn compressed_joint_columns_meet_the_stored_full_reference() {
     let (path, _) = reference_json("friction_bar_full_friction_on");
     let reference = JointCurves::read(&path).unwrap();
     let mut opts = ToleranceOptions::new(1e-2);
-    opts.compress = true;
+    opts.compress = jointrom::rom::CompressJoint::On;
     let t = tolerance_model(&m, &opts).unwrap();
     let c = t.compression.as_ref().expect("compression tried");
     assert!(t.met && c.accepted, "{c:?}");

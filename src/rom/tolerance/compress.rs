@@ -41,13 +41,29 @@
 //! If it misses, the fractions are tightened by [`COMPRESSION_TIGHTENING`] (√10), at most
 //! [`COMPRESSION_ATTEMPTS`] models in all (down to a tenth of the first fraction); if the last
 //! misses too (or would not be smaller), the per-pair model stays the result.
+//!
+//! ## When to compress
+//!
+//! A compressed model costs one more run and estimate, so the command's own time grows by
+//! roughly a round; what it buys is a smaller model for this run and for every later use of it
+//! (an exported model, a sweep, a backbone, an FMU). The reduced step's dense work grows like
+//! r² to r³ (the Newton matrix's products and refactorizations), so a basis three quarters the
+//! size steps at 0.42–0.56 of the cost, which repays the extra run and estimate within a few reuses; a
+//! basis 10–15 % smaller does not. [`CompressJoint::Auto`] (the default) therefore runs a
+//! compressed model only where the POD's rank — known before its run, from the per-pair
+//! model's estimate — gives a basis at most [`AUTO_COMPRESSION_SHRINK`] of the per-pair one: a
+//! scene whose joint forces do not compress costs nothing but the POD, and a miss is followed
+//! by a richer attempt only while that one is still small enough.
+//! [`CompressJoint::On`] tries every attempt that is smaller at all, [`CompressJoint::Off`]
+//! never.
 
 use faer::prelude::Solve;
 use faer::{Mat, Side};
 use serde::Serialize;
 
 use super::{
-    worst, BasisCache, Chosen, Column, ToleranceModel, ToleranceOptions, SELECTION_MARGIN,
+    worst, BasisCache, Chosen, Column, CompressJoint, ToleranceModel, ToleranceOptions,
+    SELECTION_MARGIN,
 };
 use crate::error::Error;
 use crate::integrate::{Run, TransientOptions};
@@ -67,6 +83,10 @@ pub const COMPRESSION_TIGHTENING: f64 = 3.162_277_660_168_379_5;
 
 /// Compressed models tried at most (the last at a tenth of the first fraction).
 pub const COMPRESSION_ATTEMPTS: usize = 3;
+
+/// [`CompressJoint::Auto`] runs a compressed model only if its basis is at most this fraction
+/// of the per-pair basis (module docs, "When to compress").
+pub const AUTO_COMPRESSION_SHRINK: f64 = 0.75;
 
 /// One compressed model tried (`"compression"."attempts"` of the tolerance JSON).
 #[derive(Clone, Debug, Serialize)]
@@ -95,6 +115,13 @@ pub struct CompressionAttempt {
 /// What the compression of the joint columns did (`"compression"` of the tolerance JSON).
 #[derive(Clone, Debug, Serialize)]
 pub struct Compression {
+    /// When to compress: `"on"` (always tried) or `"auto"` ([`CompressJoint`]).
+    pub mode: CompressJoint,
+    /// The basis size r of the first compressed model the POD's rank gives (before any run).
+    pub first_basis_size: usize,
+    /// Whether compressed models were run (`false`: the POD gave no smaller basis, or — with
+    /// `"auto"` — none small enough to pay for its run and estimate).
+    pub tried: bool,
     /// Normal attachment modes (one per pair) of the per-pair model.
     pub pair_columns: usize,
     /// Tangential attachment modes of the per-pair model.
@@ -130,7 +157,7 @@ pub(super) fn compress_result(
     result: &mut ToleranceModel,
 ) -> Result<(), Error> {
     let columns = chosen.pairs.len() + chosen.tangential.len();
-    if !opts.compress || !result.met || columns == 0 {
+    if opts.compress == CompressJoint::Off || !result.met || columns == 0 {
         return Ok(());
     }
     let tol = opts.tolerance;
@@ -144,7 +171,13 @@ pub(super) fn compress_result(
         basis_size: result.rom.dim(),
     };
     let on = result.quantities;
-    let (better, report) = compress(model, flex, per_pair, on, tol, &result.transient)?;
+    let (better, report) = compress(
+        model,
+        flex,
+        per_pair,
+        (on, tol, opts.compress),
+        &result.transient,
+    )?;
     if let Some(c) = better {
         let last = report.attempts.last().map_or(0.0, |a| a.wall_s);
         let before = start.elapsed().as_secs_f64() - last + c.basis_s;
@@ -178,9 +211,11 @@ pub(super) struct PerPair<'a> {
     pub basis_size: usize,
 }
 
-/// Tries compressed joint columns for the per-pair model `per_pair` that met `tol` (module
-/// docs), at the result's transient options; returns the compressed model if one met `tol` with
-/// a smaller basis, and what was tried.
+/// Tries compressed joint columns for the per-pair model `per_pair` that met `tol` on the
+/// quantities `on` (module docs), at the result's transient options — with `mode`
+/// [`CompressJoint::Auto`] only if the first compressed basis is at most
+/// [`AUTO_COMPRESSION_SHRINK`] of the per-pair one; returns the compressed model if one met
+/// `tol` with a smaller basis, and what was tried.
 ///
 /// # Errors
 /// A failing eigenproblem, basis or run.
@@ -188,12 +223,14 @@ pub(super) fn compress(
     model: &Model,
     flex: &JointFlexibility,
     per_pair: PerPair<'_>,
-    on: Quantities,
-    tol: f64,
+    (on, tol, mode): (Quantities, f64, CompressJoint),
     transient: &TransientOptions,
 ) -> Result<(Option<Compressed>, Compression), Error> {
     let chosen = per_pair.chosen;
     let mut report = Compression {
+        mode,
+        first_basis_size: per_pair.basis_size,
+        tried: false,
         pair_columns: chosen.pairs.len(),
         tangential_pair_columns: chosen.tangential.len(),
         pair_basis_size: per_pair.basis_size,
@@ -215,14 +252,22 @@ pub(super) fn compress(
     let pod_t = columns_pod(model, &per_pair, &tangential, forces, stiffness[1])?;
     report.kappa = [pod_n.kappa, pod_t.kappa];
     let mut fraction = [pod_n.kappa, pod_t.kappa].map(|k| SELECTION_MARGIN * tol / k);
-    for _ in 0..COMPRESSION_ATTEMPTS {
+    for attempt in 0..COMPRESSION_ATTEMPTS {
         let (rn, rt) = (
             pod_n.pod.rank_for(fraction[0]),
             pod_t.pod.rank_for(fraction[1]),
         );
-        if per_pair.cb.ncols() + rn + rt >= per_pair.basis_size {
+        let size = per_pair.cb.ncols() + rn + rt;
+        if attempt == 0 {
+            report.first_basis_size = size;
+        }
+        let shrink = size as f64 / per_pair.basis_size as f64;
+        if size >= per_pair.basis_size
+            || (mode == CompressJoint::Auto && shrink > AUTO_COMPRESSION_SHRINK)
+        {
             break;
         }
+        report.tried = true;
         let start = std::time::Instant::now();
         let rom = compressed_system(
             model,

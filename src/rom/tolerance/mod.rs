@@ -122,7 +122,10 @@ use crate::rom::statics::{reduced_contact_static_restarting, scaled_load, Reduce
 use crate::system::{ReducedSystem, Scene};
 
 mod compress;
-pub use compress::{Compression, CompressionAttempt, COMPRESSION_ATTEMPTS, COMPRESSION_TIGHTENING};
+pub use compress::{
+    Compression, CompressionAttempt, AUTO_COMPRESSION_SHRINK, COMPRESSION_ATTEMPTS,
+    COMPRESSION_TIGHTENING,
+};
 
 /// θ of the pair selection (module docs): the pairs left out may carry at most this fraction of
 /// the tolerance.
@@ -147,8 +150,23 @@ pub struct ToleranceOptions {
     pub quantities: Option<Quantities>,
     /// Whether the per-pair model that meets the tolerance is then compressed (its joint
     /// columns replaced by their POD, `compress.rs`; kept only if it meets the tolerance with a
-    /// smaller basis).
-    pub compress: bool,
+    /// smaller basis): always, never, or where the POD promises a basis small enough to pay for
+    /// the compressed model's run and estimate ([`CompressJoint::Auto`]).
+    pub compress: CompressJoint,
+}
+
+/// When the tolerance model compresses its joint columns ([`ToleranceOptions::compress`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum CompressJoint {
+    /// Never: the per-pair model is the result.
+    Off,
+    /// Always try (up to [`COMPRESSION_ATTEMPTS`] compressed models).
+    On,
+    /// Try only where the first compressed basis is at most [`AUTO_COMPRESSION_SHRINK`] of the
+    /// per-pair basis.
+    #[default]
+    Auto,
 }
 
 /// Where the tolerance model's rtol and atol come from.
@@ -199,7 +217,7 @@ impl ToleranceOptions {
             max_rounds: 8,
             integration: IntegrationTolerances::FromTolerance,
             quantities: None,
-            compress: false,
+            compress: CompressJoint::Auto,
         }
     }
 }

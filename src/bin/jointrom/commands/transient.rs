@@ -19,7 +19,7 @@ use jointrom::{Error, Model};
 
 use jointrom::studies::stability::IterKind;
 
-use crate::args::{MethodKind, OnOff};
+use crate::args::{CompressArg, MethodKind, OnOff};
 use crate::common::{create_dir, positive, print_json, write_file};
 
 #[derive(Args)]
@@ -35,10 +35,11 @@ pub struct TransientArgs {
     strict: bool,
     /// With --tolerance: the joint columns of the model that meets it, per pair (off) or
     /// compressed to the POD of the deformation the corrected pair forces cause (on; kept only
-    /// if the compressed model meets the tolerance with a smaller basis). JSON
-    /// `"tolerance"."compression"`. Default off
-    #[arg(long, value_enum, requires = "tolerance")]
-    compress_joint: Option<OnOff>,
+    /// if the compressed model meets the tolerance with a smaller basis); auto runs a compressed
+    /// model only where its basis is at most three quarters of the per-pair one. JSON
+    /// `"tolerance"."compression"`.
+    #[arg(long, value_enum, default_value = "auto", requires = "tolerance")]
+    compress_joint: CompressArg,
     /// `--model pod`: end of the full-FE training run, s (default: the run's end time).
     #[arg(long)]
     train_end: Option<f64>,
@@ -166,7 +167,7 @@ pub fn run(a: TransientArgs) -> Result<(), Error> {
             } else {
                 IntegrationTolerances::FromTolerance
             },
-            compress_joint: a.compress_joint == Some(OnOff::On),
+            compress_joint: a.compress_joint.mode(),
         },
     )?;
     // The largest estimated error of the quantities the tolerance holds for.
