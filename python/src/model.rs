@@ -335,8 +335,10 @@ impl PyModel {
         RunResult::new(py, model.name.clone(), "full".into(), run, &opts)
     }
 
-    /// A reduced model: `tolerance=TOL` builds the smallest one whose estimated error of ‖f_c‖
-    /// is at most TOL (its rounds are transient runs with the given options); `basis=KIND`
+    /// A reduced model: `tolerance=TOL` builds the smallest one whose estimated errors of ‖f_c‖,
+    /// ‖f_R‖, u_y and D (with friction) are at most TOL (its rounds are transient runs with the
+    /// given options; its joint columns compressed where that pays, as the CLI's default
+    /// `--compress-joint auto`); `basis=KIND`
     /// (tvd, tvd-plain, modes, jim, alldof) with `g` vectors (default: the a-priori rule) and
     /// `nu` fixed-interface modes builds that basis. Default: tvd.
     #[allow(clippy::too_many_arguments)]
