@@ -74,9 +74,11 @@ impl SymCsc {
 
     /// The leading principal submatrix of size `m` (e.g. the Craig–Bampton interior).
     pub fn leading(&self, m: usize) -> SymCsc {
-        let mut col_ptr = vec![0];
-        let mut row_idx = Vec::new();
-        let mut values = Vec::new();
+        let mut col_ptr = Vec::with_capacity(m + 1);
+        col_ptr.push(0);
+        let stored = self.col_ptr[m.min(self.n)];
+        let mut row_idx = Vec::with_capacity(stored);
+        let mut values = Vec::with_capacity(stored);
         for j in 0..m {
             for p in self.col_ptr[j]..self.col_ptr[j + 1] {
                 if self.row_idx[p] < m {
@@ -160,14 +162,20 @@ pub(crate) fn sym_mul_mat(a: &SymCsc, y: MatRef<'_, f64>) -> Mat<f64> {
     let p = y.ncols();
     let mut out = Mat::<f64>::zeros(n, p);
     if p == 1 {
-        let x = y.col(0);
-        for (j, o) in out.col_mut(0).iter_mut().enumerate() {
-            let mut acc = 0.0f64;
-            for p in a.col_ptr[j]..a.col_ptr[j + 1] {
-                acc += a.values[p] * x[a.row_idx[p]];
+        let copy: Vec<f64>;
+        let x = match y.col(0).try_as_col_major() {
+            Some(c) => c.as_slice(),
+            None => {
+                copy = y.col(0).iter().copied().collect();
+                &copy
             }
-            *o = acc;
-        }
+        };
+        let out_col = out.col_mut(0).try_as_col_major_mut();
+        sym_mul_col(
+            a,
+            x,
+            out_col.expect("a new matrix is contiguous").as_slice_mut(),
+        );
         return out;
     }
     let mut block = vec![[0.0f64; BLOCK]; n];
@@ -197,4 +205,41 @@ pub(crate) fn sym_mul_mat(a: &SymCsc, y: MatRef<'_, f64>) -> Mat<f64> {
         }
     }
     out
+}
+
+/// `out = A x` for one column, each entry summed from 0.0 over its stored entries in order:
+/// four rows at a time, interleaved, so that the four independent sums overlap instead of
+/// each waiting on its own chain of additions (the same operations per entry, so the same bits).
+fn sym_mul_col(a: &SymCsc, x: &[f64], out: &mut [f64]) {
+    let row = |j: usize| a.col_ptr[j]..a.col_ptr[j + 1];
+    let single = |j: usize| -> f64 {
+        let mut acc = 0.0f64;
+        for p in row(j) {
+            acc += a.values[p] * x[a.row_idx[p]];
+        }
+        acc
+    };
+    let mut j = 0;
+    while j + 4 <= a.n {
+        let starts = [0, 1, 2, 3].map(|d| a.col_ptr[j + d]);
+        let lens = [0, 1, 2, 3].map(|d| a.col_ptr[j + d + 1] - starts[d]);
+        let common = lens.into_iter().min().unwrap_or(0);
+        let mut acc = [0.0f64; 4];
+        for i in 0..common {
+            for d in 0..4 {
+                let p = starts[d] + i;
+                acc[d] += a.values[p] * x[a.row_idx[p]];
+            }
+        }
+        for d in 0..4 {
+            for p in starts[d] + common..starts[d] + lens[d] {
+                acc[d] += a.values[p] * x[a.row_idx[p]];
+            }
+            out[j + d] = acc[d];
+        }
+        j += 4;
+    }
+    for (jj, o) in out.iter_mut().enumerate().take(a.n).skip(j) {
+        *o = single(jj);
+    }
 }

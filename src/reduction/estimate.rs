@@ -157,6 +157,7 @@ use crate::linalg::LinalgError;
 use crate::linalg::{SubsetLlt, SymCsc};
 use crate::model::{Interface, Model};
 use crate::reduction::basis::orthonormal_beyond;
+use crate::reduction::craig_bampton::FixedInterface;
 use crate::system::{ReducedSystem, SecondOrderSystem};
 
 /// The joint flexibility of a model: one sparse Cholesky of `K`, the static responses to unit
@@ -180,6 +181,10 @@ pub struct JointFlexibility {
     /// the master), for the truncation part of the estimate: computed on first use
     /// ([`JointFlexibility::truncation_modes`]).
     modes: Mutex<Option<Arc<Mat<f64>>>>,
+    /// The model's fixed-interface problem with its factorization, if shared
+    /// ([`JointFlexibility::share_fixed_interface`]): the truncated modes are then solved with
+    /// it instead of a factorization of their own.
+    fixed: std::sync::OnceLock<Arc<FixedInterface>>,
     /// Per joint row r (3w: normal, t1, t2 of each pair), once solved: the normal rows of its
     /// flexibility column `B_n K⁻¹ b_rᵀ` (w values, mm/N). Shared by every estimate of the
     /// model (sweeps run in parallel), so behind a lock.
@@ -236,6 +241,7 @@ impl JointFlexibility {
             c,
             k_n: model.contact.normal_stiffness,
             modes: Mutex::new(None),
+            fixed: std::sync::OnceLock::new(),
             columns: Mutex::new(vec![None; model.joint.rows()]),
             tangential: Mutex::new(vec![None; model.joint.rows()]),
         })
@@ -503,6 +509,13 @@ impl JointFlexibility {
         })
     }
 
+    /// Shares the model's fixed-interface problem (e.g. the one Craig–Bampton factored) for the
+    /// truncated modes ([`JointFlexibility::truncation_modes`]): the same modes, bit for bit,
+    /// without factoring `K_ii` again. A second call keeps the first.
+    pub fn share_fixed_interface(&self, fixed: Arc<FixedInterface>) {
+        let _ = self.fixed.set(fixed);
+    }
+
     /// The [`TRUNCATION_MODES`] lowest fixed-interface modes (n × m, zero at the master DOF),
     /// computed on first use: only the transient estimate needs them (not the pair-space
     /// statics), and its first use is on the second core beside a reduced run
@@ -523,7 +536,10 @@ impl JointFlexibility {
         let n = self.stiffness.n;
         let count = TRUNCATION_MODES.min(n.saturating_sub(6) / 2);
         let modes = if count > 0 {
-            let fixed = model.modes(count, Interface::Fixed)?;
+            let fixed = match self.fixed.get() {
+                Some(shared) if shared.dofs() + 6 == n => shared.modes(count)?,
+                _ => model.modes(count, Interface::Fixed)?,
+            };
             let m = n - 6;
             Mat::from_fn(n, fixed.shapes.ncols(), |i, j| {
                 if i < m {
