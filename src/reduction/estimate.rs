@@ -1024,12 +1024,22 @@ impl Dissipation {
         }
         self.run.push(d);
         self.corrected.push(dc);
-        self.last = Some(OutputState {
-            p: p.to_vec(),
-            pc: pc.to_vec(),
-            s: s.to_vec(),
-            slip: slip.to_vec(),
+        // The last state's buffers are reused: four copies per output, no allocation.
+        let last = self.last.get_or_insert_with(|| OutputState {
+            p: Vec::new(),
+            pc: Vec::new(),
+            s: Vec::new(),
+            slip: Vec::new(),
         });
+        for (to, from) in [
+            (&mut last.p, p),
+            (&mut last.pc, pc),
+            (&mut last.s, s),
+            (&mut last.slip, slip),
+        ] {
+            to.clear();
+            to.extend_from_slice(from);
+        }
     }
 
     /// `|D(T) − D*(T)| / |D*(T)|` (`None` when nothing is dissipated).
@@ -1300,6 +1310,11 @@ struct Corrector<'a> {
     stick_factor: SubsetLlt,
     /// The flexibility columns of the pairs met so far (w entries, `None` before).
     cols: Vec<Option<Arc<[f64]>>>,
+    /// The tangential flexibility columns met so far, per joint row (3w entries, `None` before
+    /// and for normal rows): the column's normal rows and tangential rows
+    /// ([`JointFlexibility::tangential_columns`]), fetched once per correction sequence instead
+    /// of from the shared cache (its lock) at every output.
+    tcols: Vec<Option<(Arc<[f64]>, Arc<[f64]>)>>,
     /// The run's slip memory at the previous output (2w, mm; empty before the first).
     last_s: Vec<f64>,
     /// The slip memory of the last corrected state (2w, mm; NaN for open pairs; empty
@@ -1347,6 +1362,7 @@ impl<'a> Corrector<'a> {
             factor: SubsetLlt::new(),
             stick_factor: SubsetLlt::new(),
             cols: vec![None; flex.pairs()],
+            tcols: vec![None; 3 * flex.pairs()],
             last_s: Vec::new(),
             slip: Vec::new(),
             want_slip: true,
@@ -1361,8 +1377,15 @@ impl<'a> Corrector<'a> {
         if set.is_empty() {
             return Ok(());
         }
-        for (&k, c) in set.iter().zip(self.flex.normal_columns(set)?) {
-            self.cols[k] = Some(c);
+        let missing: Vec<usize> = set
+            .iter()
+            .copied()
+            .filter(|&k| self.cols[k].is_none())
+            .collect();
+        if !missing.is_empty() {
+            for (&k, c) in missing.iter().zip(self.flex.normal_columns(&missing)?) {
+                self.cols[k] = Some(c);
+            }
         }
         let cols = &self.cols;
         let col = |k: usize| cols[k].as_deref().expect("fetched above");
@@ -1384,6 +1407,22 @@ impl<'a> Corrector<'a> {
             let s = k_n * ga;
             for (gk, fk) in gaps.iter_mut().zip(col(k).iter()) {
                 *gk -= s * fk;
+            }
+        }
+        Ok(())
+    }
+
+    /// Fetches the tangential flexibility columns of the joint rows `rows` not met yet into
+    /// `tcols`.
+    fn fetch_tangential(&mut self, rows: &[usize]) -> Result<(), Error> {
+        let missing: Vec<usize> = rows
+            .iter()
+            .copied()
+            .filter(|&r| self.tcols[r].is_none())
+            .collect();
+        if !missing.is_empty() {
+            for (&r, c) in missing.iter().zip(self.flex.tangential_columns(&missing)?) {
+                self.tcols[r] = Some(c);
             }
         }
         Ok(())
@@ -1530,21 +1569,21 @@ impl<'a> Corrector<'a> {
             let loaded: Vec<usize> = (0..3 * w)
                 .filter(|&r| r % 3 != NORMAL && pc[r] != 0.0)
                 .collect();
-            let cols = self.flex.tangential_columns(&rows)?;
-            let loads = self.flex.tangential_columns(&loaded)?;
+            self.fetch_tangential(&rows)?;
+            self.fetch_tangential(&loaded)?;
+            let tcols = &self.tcols;
+            let col = |r: usize| tcols[r].as_ref().expect("fetched above");
             // Tangential row r of pair k sits at 2k (t1) or 2k + 1 (t2) of a column's
             // tangential rows and of the slip memory.
             let t_at = |r: usize| 2 * (r / 3) + (r % 3 - 1);
+            // The pairs with a normal force, ascending: the others would add only zeros.
+            let closed: Vec<usize> = (0..w).filter(|&k| pc[nrm(k)] != 0.0).collect();
             let mut rhs: Vec<f64> = rows
                 .iter()
-                .zip(&cols)
-                .map(|(&r, (normal, _))| {
-                    let from_normal: f64 = (0..w).map(|k| normal[k] * pc[nrm(k)]).sum();
-                    let from_sliding: f64 = loaded
-                        .iter()
-                        .zip(&loads)
-                        .map(|(&l, (_, t))| t[t_at(r)] * pc[l])
-                        .sum();
+                .map(|&r| {
+                    let normal = &col(r).0;
+                    let from_normal: f64 = closed.iter().map(|&k| normal[k] * pc[nrm(k)]).sum();
+                    let from_sliding: f64 = loaded.iter().map(|&l| col(l).1[t_at(r)] * pc[l]).sum();
                     k_t * (u0[r] - from_normal - from_sliding - s[t_at(r)])
                 })
                 .collect();
@@ -1557,7 +1596,7 @@ impl<'a> Corrector<'a> {
             self.stick_factor
                 .update(&index, |i, j| {
                     let d = if i == j { 1.0 } else { 0.0 };
-                    d + k_t * 0.5 * (cols[col_of[j]].1[i] + cols[col_of[i]].1[j])
+                    d + k_t * 0.5 * (col(rows[col_of[j]]).1[i] + col(rows[col_of[i]]).1[j])
                 })
                 .map_err(|e| {
                     Error::LinearAlgebra(LinalgError::ContactMatrix {
@@ -1621,10 +1660,13 @@ impl<'a> Corrector<'a> {
         if moving.is_empty() {
             return Ok(());
         }
-        let cols = self.flex.tangential_columns(&moving)?;
-        for (&r, (normal, tangential)) in moving.iter().zip(&cols) {
+        self.fetch_tangential(&moving)?;
+        // The pairs with a normal force, ascending: the others would add only zeros.
+        let closed: Vec<usize> = (0..w).filter(|&k| pc[nrm(k)] != 0.0).collect();
+        for &r in &moving {
+            let (normal, tangential) = self.tcols[r].as_ref().expect("fetched above");
             // F is symmetric: row r of F is column r.
-            let from_normal: f64 = (0..w).map(|k| normal[k] * pc[nrm(k)]).sum();
+            let from_normal: f64 = closed.iter().map(|&k| normal[k] * pc[nrm(k)]).sum();
             let from_tangential: f64 = rows.iter().map(|&l| tangential[t_at(l)] * pc[l]).sum();
             let u = u0[r] - from_normal - from_tangential;
             self.slip[t_at(r)] = if k_t > 0.0 { u - pc[r] / k_t } else { u };
