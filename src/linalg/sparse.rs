@@ -136,14 +136,8 @@ impl SymCsc {
 /// its column j, so `y_j = Σ_p a_p x_{row(p)}` over column j — sequential reads, one write per
 /// row, no scattered updates. The same products as [`SymCsc::mul_vec`], summed in column order.
 pub(crate) fn sym_mul_vec_into(a: &SymCsc, x: &[f64], y: &mut [f64]) {
-    for (j, yj) in y.iter_mut().enumerate().take(a.n) {
-        let range = a.col_ptr[j]..a.col_ptr[j + 1];
-        *yj = a.values[range.clone()]
-            .iter()
-            .zip(&a.row_idx[range])
-            .map(|(v, &r)| v * x[r])
-            .sum();
-    }
+    // From −0.0, as `Iterator::sum`: the same bits as the sum per entry.
+    sym_mul_col(a, x, &mut y[..a.n], -0.0);
 }
 
 /// Columns handled together by [`sym_mul_mat`].
@@ -175,6 +169,7 @@ pub(crate) fn sym_mul_mat(a: &SymCsc, y: MatRef<'_, f64>) -> Mat<f64> {
             a,
             x,
             out_col.expect("a new matrix is contiguous").as_slice_mut(),
+            0.0,
         );
         return out;
     }
@@ -207,13 +202,14 @@ pub(crate) fn sym_mul_mat(a: &SymCsc, y: MatRef<'_, f64>) -> Mat<f64> {
     out
 }
 
-/// `out = A x` for one column, each entry summed from 0.0 over its stored entries in order:
-/// four rows at a time, interleaved, so that the four independent sums overlap instead of
-/// each waiting on its own chain of additions (the same operations per entry, so the same bits).
-fn sym_mul_col(a: &SymCsc, x: &[f64], out: &mut [f64]) {
+/// `out = A x` for one column, each entry summed from `start` (0.0 or −0.0) over its stored
+/// entries in order: four rows at a time, interleaved, so that the four independent sums
+/// overlap instead of each waiting on its own chain of additions (the same operations per
+/// entry, so the same bits).
+fn sym_mul_col(a: &SymCsc, x: &[f64], out: &mut [f64], start: f64) {
     let row = |j: usize| a.col_ptr[j]..a.col_ptr[j + 1];
     let single = |j: usize| -> f64 {
-        let mut acc = 0.0f64;
+        let mut acc = start;
         for p in row(j) {
             acc += a.values[p] * x[a.row_idx[p]];
         }
@@ -224,7 +220,7 @@ fn sym_mul_col(a: &SymCsc, x: &[f64], out: &mut [f64]) {
         let starts = [0, 1, 2, 3].map(|d| a.col_ptr[j + d]);
         let lens = [0, 1, 2, 3].map(|d| a.col_ptr[j + d + 1] - starts[d]);
         let common = lens.into_iter().min().unwrap_or(0);
-        let mut acc = [0.0f64; 4];
+        let mut acc = [start; 4];
         for i in 0..common {
             for d in 0..4 {
                 let p = starts[d] + i;
