@@ -127,51 +127,18 @@ fn sym_mul_compensated_block(
     }
 }
 
-/// `hi[c] + lo[c] += a · (bh[c] + bl[c])` for every c: the error-free product (`a = ah + al` and
-/// `b = bh + bl` are Veltkamp splits) and Knuth's TwoSum, the error terms summed into `lo` — the
-/// inner loop of [`sym_mul_compensated`]. Compiled for AVX-512 / AVX2 as well as the baseline
-/// and dispatched at run time (`multiversion`).
+/// `hi[c] + lo[c] += a · b[c]` for every c: the error-free product and Knuth's TwoSum, the
+/// error terms summed into `lo` — the inner loop of [`sym_mul_compensated`],
+/// [`compensated_gram`] and the M-orthonormalization. Compiled for AVX-512 / AVX2 as well as
+/// the baseline and dispatched at run time (`multiversion`).
 ///
 /// The product's rounding error `a·b − fl(a·b)` is exactly representable, and both ways of
-/// computing it here are exact: Dekker's TwoProduct from the splits (every partial product and
-/// sum exact) and, where the CPU has FMA, `fma(a, b, −fl(a·b))` (one rounding of the exact
-/// value). So the two paths give the same bits — barring products within 2⁵³ of the underflow
-/// threshold, far below any entry of K, M or a basis here — and the FMA path does one operation
-/// in place of seven. No other operation is contracted (Rust does not fuse `a * b + c`).
-#[multiversion::multiversion(targets(
-    "x86_64+avx512f+avx512vl+fma",
-    "x86_64+avx2+fma",
-    "x86_64+avx2"
-))]
-pub(crate) fn two_product_sums(
-    hi: &mut [f64],
-    lo: &mut [f64],
-    a: f64,
-    ah: f64,
-    al: f64,
-    bh: &[f64],
-    bl: &[f64],
-) {
-    let fma = multiversion::target::target_cfg_f!(target_feature = "fma");
-    for ((h, l), (&bh, &bl)) in hi.iter_mut().zip(lo.iter_mut()).zip(bh.iter().zip(bl)) {
-        let b = bh + bl;
-        let prod = a * b;
-        let p_err = if fma {
-            a.mul_add(b, -prod)
-        } else {
-            ((ah * bh - prod) + ah * bl + al * bh) + al * bl
-        };
-        let sum = *h + prod;
-        let z = sum - *h;
-        let s_err = (*h - (sum - z)) + (prod - z);
-        *h = sum;
-        *l += s_err + p_err;
-    }
-}
-
-/// [`two_product_sums`] with `b` whole: `hi[c] + lo[c] += a · b[c]`, the splits (where the CPU
-/// has no FMA) made here — the same operations on the same values, so the same bits, without
-/// the caller storing the halves of `b` (half the memory the inner loop reads).
+/// computing it here are exact: Dekker's TwoProduct from Veltkamp splits of `a` and `b`
+/// (every partial product and sum exact) and, where the CPU has FMA, `fma(a, b, −fl(a·b))`
+/// (one rounding of the exact value). So the two paths give the same bits — barring products
+/// within 2⁵³ of the underflow threshold, far below any entry of K, M or a basis here — and
+/// the FMA path does one operation in place of the splits and seven. No other operation is
+/// contracted (Rust does not fuse `a * b + c`).
 #[multiversion::multiversion(targets(
     "x86_64+avx512f+avx512vl+fma",
     "x86_64+avx2+fma",
