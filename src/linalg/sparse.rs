@@ -239,3 +239,60 @@ fn sym_mul_col(a: &SymCsc, x: &[f64], out: &mut [f64], start: f64) {
         *o = single(jj);
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A symmetric pattern with columns of every length from 0 (an empty one) up, n not a
+    /// multiple of the interleaving's four.
+    fn uneven(n: usize) -> SymCsc {
+        let (mut col_ptr, mut row_idx, mut values) = (vec![0], Vec::new(), Vec::new());
+        for j in 0..n {
+            for i in 0..n {
+                let linked = i == j || (i + j) % 3 == 0 || i.abs_diff(j) == 1;
+                if j != 5 && i != 5 && linked {
+                    row_idx.push(i);
+                    values.push(1.0 / (1.0 + (3 * i + 7 * j) as f64 % 11.0) - 0.3);
+                }
+            }
+            col_ptr.push(row_idx.len());
+        }
+        SymCsc {
+            n,
+            col_ptr,
+            row_idx,
+            values,
+        }
+    }
+
+    #[test]
+    fn interleaved_products_are_the_sums_per_entry() {
+        for n in [1, 4, 11, 23] {
+            let a = uneven(n);
+            let x: Vec<f64> = (0..n).map(|i| (i as f64 * 0.37).sin() * 1e3).collect();
+            let per_entry = |j: usize, start: f64| {
+                (a.col_ptr[j]..a.col_ptr[j + 1])
+                    .fold(start, |s, p| s + a.values[p] * x[a.row_idx[p]])
+            };
+            let mut y = vec![f64::NAN; n];
+            sym_mul_vec_into(&a, &x, &mut y);
+            let one = sym_mul_mat(&a, MatRef::from_column_major_slice(&x, n, 1));
+            let two: Vec<f64> = x.iter().chain(&x).copied().collect();
+            let block = sym_mul_mat(&a, MatRef::from_column_major_slice(&two, n, 2));
+            for j in 0..n {
+                assert_eq!(
+                    y[j].to_bits(),
+                    per_entry(j, -0.0).to_bits(),
+                    "n {n}, row {j}"
+                );
+                assert_eq!(
+                    one[(j, 0)].to_bits(),
+                    per_entry(j, 0.0).to_bits(),
+                    "n {n}, {j}"
+                );
+                assert_eq!(one[(j, 0)].to_bits(), block[(j, 1)].to_bits(), "n {n}, {j}");
+            }
+        }
+    }
+}
