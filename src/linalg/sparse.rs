@@ -136,8 +136,14 @@ impl SymCsc {
 /// its column j, so `y_j = Σ_p a_p x_{row(p)}` over column j — sequential reads, one write per
 /// row, no scattered updates. The same products as [`SymCsc::mul_vec`], summed in column order.
 pub(crate) fn sym_mul_vec_into(a: &SymCsc, x: &[f64], y: &mut [f64]) {
-    // From −0.0, as `Iterator::sum`: the same bits as the sum per entry.
-    sym_mul_col(a, x, &mut y[..a.n], -0.0);
+    for (j, yj) in y.iter_mut().enumerate().take(a.n) {
+        let range = a.col_ptr[j]..a.col_ptr[j + 1];
+        *yj = a.values[range.clone()]
+            .iter()
+            .zip(&a.row_idx[range])
+            .map(|(v, &r)| v * x[r])
+            .sum();
+    }
 }
 
 /// Columns handled together by [`sym_mul_mat`].
@@ -156,21 +162,14 @@ pub(crate) fn sym_mul_mat(a: &SymCsc, y: MatRef<'_, f64>) -> Mat<f64> {
     let p = y.ncols();
     let mut out = Mat::<f64>::zeros(n, p);
     if p == 1 {
-        let copy: Vec<f64>;
-        let x = match y.col(0).try_as_col_major() {
-            Some(c) => c.as_slice(),
-            None => {
-                copy = y.col(0).iter().copied().collect();
-                &copy
+        let x = y.col(0);
+        for (j, o) in out.col_mut(0).iter_mut().enumerate() {
+            let mut acc = 0.0f64;
+            for p in a.col_ptr[j]..a.col_ptr[j + 1] {
+                acc += a.values[p] * x[a.row_idx[p]];
             }
-        };
-        let out_col = out.col_mut(0).try_as_col_major_mut();
-        sym_mul_col(
-            a,
-            x,
-            out_col.expect("a new matrix is contiguous").as_slice_mut(),
-            0.0,
-        );
+            *o = acc;
+        }
         return out;
     }
     let mut block = vec![[0.0f64; BLOCK]; n];
@@ -200,99 +199,4 @@ pub(crate) fn sym_mul_mat(a: &SymCsc, y: MatRef<'_, f64>) -> Mat<f64> {
         }
     }
     out
-}
-
-/// `out = A x` for one column, each entry summed from `start` (0.0 or −0.0) over its stored
-/// entries in order: four rows at a time, interleaved, so that the four independent sums
-/// overlap instead of each waiting on its own chain of additions (the same operations per
-/// entry, so the same bits).
-fn sym_mul_col(a: &SymCsc, x: &[f64], out: &mut [f64], start: f64) {
-    let row = |j: usize| a.col_ptr[j]..a.col_ptr[j + 1];
-    let single = |j: usize| -> f64 {
-        let mut acc = start;
-        for p in row(j) {
-            acc += a.values[p] * x[a.row_idx[p]];
-        }
-        acc
-    };
-    let mut j = 0;
-    while j + 4 <= a.n {
-        let starts = [0, 1, 2, 3].map(|d| a.col_ptr[j + d]);
-        let lens = [0, 1, 2, 3].map(|d| a.col_ptr[j + d + 1] - starts[d]);
-        let common = lens.into_iter().min().unwrap_or(0);
-        let mut acc = [start; 4];
-        for i in 0..common {
-            for d in 0..4 {
-                let p = starts[d] + i;
-                acc[d] += a.values[p] * x[a.row_idx[p]];
-            }
-        }
-        for d in 0..4 {
-            for p in starts[d] + common..starts[d] + lens[d] {
-                acc[d] += a.values[p] * x[a.row_idx[p]];
-            }
-            out[j + d] = acc[d];
-        }
-        j += 4;
-    }
-    for (jj, o) in out.iter_mut().enumerate().take(a.n).skip(j) {
-        *o = single(jj);
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// A symmetric pattern with columns of every length from 0 (an empty one) up, n not a
-    /// multiple of the interleaving's four.
-    fn uneven(n: usize) -> SymCsc {
-        let (mut col_ptr, mut row_idx, mut values) = (vec![0], Vec::new(), Vec::new());
-        for j in 0..n {
-            for i in 0..n {
-                let linked = i == j || (i + j) % 3 == 0 || i.abs_diff(j) == 1;
-                if j != 5 && i != 5 && linked {
-                    row_idx.push(i);
-                    values.push(1.0 / (1.0 + (3 * i + 7 * j) as f64 % 11.0) - 0.3);
-                }
-            }
-            col_ptr.push(row_idx.len());
-        }
-        SymCsc {
-            n,
-            col_ptr,
-            row_idx,
-            values,
-        }
-    }
-
-    #[test]
-    fn interleaved_products_are_the_sums_per_entry() {
-        for n in [1, 4, 11, 23] {
-            let a = uneven(n);
-            let x: Vec<f64> = (0..n).map(|i| (i as f64 * 0.37).sin() * 1e3).collect();
-            let per_entry = |j: usize, start: f64| {
-                (a.col_ptr[j]..a.col_ptr[j + 1])
-                    .fold(start, |s, p| s + a.values[p] * x[a.row_idx[p]])
-            };
-            let mut y = vec![f64::NAN; n];
-            sym_mul_vec_into(&a, &x, &mut y);
-            let one = sym_mul_mat(&a, MatRef::from_column_major_slice(&x, n, 1));
-            let two: Vec<f64> = x.iter().chain(&x).copied().collect();
-            let block = sym_mul_mat(&a, MatRef::from_column_major_slice(&two, n, 2));
-            for j in 0..n {
-                assert_eq!(
-                    y[j].to_bits(),
-                    per_entry(j, -0.0).to_bits(),
-                    "n {n}, row {j}"
-                );
-                assert_eq!(
-                    one[(j, 0)].to_bits(),
-                    per_entry(j, 0.0).to_bits(),
-                    "n {n}, {j}"
-                );
-                assert_eq!(one[(j, 0)].to_bits(), block[(j, 1)].to_bits(), "n {n}, {j}");
-            }
-        }
-    }
 }

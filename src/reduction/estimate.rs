@@ -1315,6 +1315,8 @@ struct Corrector<'a> {
     /// ([`JointFlexibility::tangential_columns`]), fetched once per correction sequence instead
     /// of from the shared cache (its lock) at every output.
     tcols: Vec<Option<(Arc<[f64]>, Arc<[f64]>)>>,
+    /// Working arrays of one output, kept between outputs (no allocation per output).
+    scratch: Scratch,
     /// The run's slip memory at the previous output (2w, mm; empty before the first).
     last_s: Vec<f64>,
     /// The slip memory of the last corrected state (2w, mm; NaN for open pairs; empty
@@ -1323,6 +1325,22 @@ struct Corrector<'a> {
     /// Whether the corrected slip is wanted (the dissipated energy is summed from this
     /// correction's states).
     want_slip: bool,
+}
+
+/// The working arrays of [`Corrector::correct`] (their contents do not outlive one output).
+#[derive(Default)]
+struct Scratch {
+    /// ĝ (w), the gaps (w), the active set as a list and the next active set (w).
+    g_hat: Vec<f64>,
+    gaps: Vec<f64>,
+    set: Vec<usize>,
+    next: Vec<bool>,
+    /// The stuck pairs (w), the tangential rows of the closed pairs, those of them that move
+    /// and the closed pairs.
+    is_stuck: Vec<bool>,
+    rows: Vec<usize>,
+    moving: Vec<usize>,
+    closed: Vec<usize>,
 }
 
 /// Active-set iterations per output before the projected Gauss–Seidel fallback.
@@ -1340,16 +1358,25 @@ const JOIN_FRACTION: f64 = 0.5;
 /// the deepest few open most of the others. The fixed point is the same (no pair outside with
 /// `g < 0`, none inside with `g ≥ 0`), so the solution is; it takes a few more, cheap, iterations.
 fn next_active_set(active: &[bool], gaps: &[f64]) -> Vec<bool> {
+    let mut next = Vec::with_capacity(active.len());
+    next_active_set_into(active, gaps, &mut next);
+    next
+}
+
+/// [`next_active_set`] written into `next`.
+fn next_active_set_into(active: &[bool], gaps: &[f64], next: &mut Vec<bool>) {
     let deepest = gaps
         .iter()
         .zip(active)
         .filter(|(_, &a)| !a)
         .map(|(&g, _)| g)
         .fold(0.0f64, f64::min);
-    gaps.iter()
-        .zip(active)
-        .map(|(&g, &a)| g < 0.0 && (a || g <= JOIN_FRACTION * deepest))
-        .collect()
+    next.clear();
+    next.extend(
+        gaps.iter()
+            .zip(active)
+            .map(|(&g, &a)| g < 0.0 && (a || g <= JOIN_FRACTION * deepest)),
+    );
 }
 
 impl<'a> Corrector<'a> {
@@ -1363,6 +1390,7 @@ impl<'a> Corrector<'a> {
             stick_factor: SubsetLlt::new(),
             cols: vec![None; flex.pairs()],
             tcols: vec![None; 3 * flex.pairs()],
+            scratch: Scratch::default(),
             last_s: Vec::new(),
             slip: Vec::new(),
             want_slip: true,
@@ -1433,14 +1461,20 @@ impl<'a> Corrector<'a> {
     fn correct(&mut self, u0: &[f64], p: &[f64], s: &[f64]) -> Result<Vec<f64>, Error> {
         let w = self.w;
         let k_n = self.law.k_n;
-        let g_hat: Vec<f64> = (0..w).map(|k| u0[3 * k + NORMAL]).collect();
+        let mut g_hat = std::mem::take(&mut self.scratch.g_hat);
+        g_hat.clear();
+        g_hat.extend((0..w).map(|k| u0[3 * k + NORMAL]));
         let nrm = |k: usize| 3 * k + NORMAL;
         // Semismooth Newton on the active set (see `crate::joint::statics`), warm-started.
         let mut active = std::mem::take(&mut self.active);
-        let mut gaps = vec![0.0; w];
+        let mut gaps = std::mem::take(&mut self.scratch.gaps);
+        gaps.resize(w, 0.0);
+        let mut set = std::mem::take(&mut self.scratch.set);
+        let mut next = std::mem::take(&mut self.scratch.next);
         let mut converged = false;
         for _ in 0..MAX_ACTIVE_SET_ITERATIONS {
-            let set: Vec<usize> = (0..w).filter(|&k| active[k]).collect();
+            set.clear();
+            set.extend((0..w).filter(|&k| active[k]));
             self.gaps(&set, &g_hat, &mut gaps)?;
             if let Some(k) = gaps.iter().position(|g| !g.is_finite()) {
                 return Err(Error::LinearAlgebra(LinalgError::GapNotFinite {
@@ -1449,12 +1483,12 @@ impl<'a> Corrector<'a> {
                     value: None,
                 }));
             }
-            let next = next_active_set(&active, &gaps);
+            next_active_set_into(&active, &gaps, &mut next);
             if next == active {
                 converged = true;
                 break;
             }
-            active = next;
+            std::mem::swap(&mut active, &mut next);
         }
         let forces: Vec<f64> = if converged {
             gaps.iter()
@@ -1469,6 +1503,10 @@ impl<'a> Corrector<'a> {
             forces
         };
         self.active = active;
+        self.scratch.g_hat = g_hat;
+        self.scratch.gaps = gaps;
+        self.scratch.set = set;
+        self.scratch.next = next;
         let mut pc = vec![0.0; 3 * w];
         for (k, &pk) in forces.iter().enumerate() {
             pc[nrm(k)] = pk;
@@ -1646,23 +1684,37 @@ impl<'a> Corrector<'a> {
         let t_at = |r: usize| 2 * (r / 3) + (r % 3 - 1);
         self.slip.clear();
         self.slip.resize(2 * w, f64::NAN);
-        let mut is_stuck = vec![false; w];
+        let Scratch {
+            is_stuck,
+            rows,
+            moving,
+            closed,
+            ..
+        } = &mut self.scratch;
+        is_stuck.clear();
+        is_stuck.resize(w, false);
         for &k in stuck {
             is_stuck[k] = true;
             self.slip[2 * k] = s[2 * k];
             self.slip[2 * k + 1] = s[2 * k + 1];
         }
-        let rows: Vec<usize> = (0..w)
-            .filter(|&k| pc[nrm(k)] != 0.0)
-            .flat_map(|k| [3 * k + T1, 3 * k + T2])
-            .collect();
-        let moving: Vec<usize> = rows.iter().copied().filter(|&r| !is_stuck[r / 3]).collect();
+        // The pairs with a normal force, ascending (the others would add only zeros), and
+        // their tangential rows.
+        closed.clear();
+        closed.extend((0..w).filter(|&k| pc[nrm(k)] != 0.0));
+        rows.clear();
+        rows.extend(closed.iter().flat_map(|&k| [3 * k + T1, 3 * k + T2]));
+        moving.clear();
+        moving.extend(rows.iter().copied().filter(|&r| !is_stuck[r / 3]));
         if moving.is_empty() {
             return Ok(());
         }
+        let (rows, moving, closed) = (
+            std::mem::take(rows),
+            std::mem::take(moving),
+            std::mem::take(closed),
+        );
         self.fetch_tangential(&moving)?;
-        // The pairs with a normal force, ascending: the others would add only zeros.
-        let closed: Vec<usize> = (0..w).filter(|&k| pc[nrm(k)] != 0.0).collect();
         for &r in &moving {
             let (normal, tangential) = self.tcols[r].as_ref().expect("fetched above");
             // F is symmetric: row r of F is column r.
@@ -1671,6 +1723,7 @@ impl<'a> Corrector<'a> {
             let u = u0[r] - from_normal - from_tangential;
             self.slip[t_at(r)] = if k_t > 0.0 { u - pc[r] / k_t } else { u };
         }
+        (self.scratch.rows, self.scratch.moving, self.scratch.closed) = (rows, moving, closed);
         Ok(())
     }
 }
