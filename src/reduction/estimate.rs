@@ -1314,7 +1314,7 @@ struct Corrector<'a> {
     /// and for normal rows): the column's normal rows and tangential rows
     /// ([`JointFlexibility::tangential_columns`]), fetched once per correction sequence instead
     /// of from the shared cache (its lock) at every output.
-    tcols: Vec<Option<(Arc<[f64]>, Arc<[f64]>)>>,
+    tcols: Vec<Option<TangentialColumn>>,
     /// Working arrays of one output, kept between outputs (no allocation per output).
     scratch: Scratch,
     /// The run's slip memory at the previous output (2w, mm; empty before the first).
@@ -1326,6 +1326,9 @@ struct Corrector<'a> {
     /// correction's states).
     want_slip: bool,
 }
+
+/// A tangential flexibility column: its normal rows (w) and tangential rows (2w), mm/N.
+type TangentialColumn = (Arc<[f64]>, Arc<[f64]>);
 
 /// The working arrays of [`Corrector::correct`] (their contents do not outlive one output).
 #[derive(Default)]

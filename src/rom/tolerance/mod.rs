@@ -99,6 +99,7 @@
 //! tighter `--rtol/--atol` lower the integration floor).
 
 use std::collections::HashMap;
+use std::sync::Arc;
 use std::time::Instant;
 
 use serde::Serialize;
@@ -390,17 +391,7 @@ pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<Toleran
     let start = Instant::now();
     let cpu_start = process_cpu_s();
     let mut nu = opts.nu;
-    // Craig–Bampton's fixed-interface factorization serves the estimate's truncated modes too.
-    let (flex, cb) = beside(
-        || JointFlexibility::new(model),
-        || -> Result<_, Error> {
-            let fixed = FixedInterface::new(model)?;
-            let cb = craig_bampton_with(model, nu, &fixed)?;
-            Ok((std::sync::Arc::new(fixed), cb))
-        },
-    );
-    let (flex, (fixed, mut cb)) = (flex?, cb?);
-    flex.share_fixed_interface(std::sync::Arc::clone(&fixed));
+    let (flex, fixed, mut cb) = setup(model, nu)?;
     let setup_s = start.elapsed().as_secs_f64();
     let mut chosen = Chosen::default();
     let mut bases = BasisCache::new(model);
@@ -539,6 +530,25 @@ pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<Toleran
             return Ok(result);
         }
     }
+}
+
+/// The joint flexibility, the fixed-interface problem and Craig–Bampton with ν modes, the first
+/// beside the other two; Craig–Bampton's factorization serves the estimate's truncated modes.
+fn setup(
+    model: &Model,
+    nu: usize,
+) -> Result<(JointFlexibility, Arc<FixedInterface>, faer::Mat<f64>), Error> {
+    let (flex, cb) = beside(
+        || JointFlexibility::new(model),
+        || -> Result<_, Error> {
+            let fixed = FixedInterface::new(model)?;
+            let cb = craig_bampton_with(model, nu, &fixed)?;
+            Ok((Arc::new(fixed), cb))
+        },
+    );
+    let (flex, (fixed, cb)) = (flex?, cb?);
+    flex.share_fixed_interface(Arc::clone(&fixed));
+    Ok((flex, fixed, cb))
 }
 
 /// The re-runs of a round (module docs), given as its system, run, scene and transient options:
