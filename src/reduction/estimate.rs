@@ -510,8 +510,8 @@ impl JointFlexibility {
     }
 
     /// Shares the model's fixed-interface problem (e.g. the one Craig–Bampton factored) for the
-    /// truncated modes ([`JointFlexibility::truncation_modes`]): the same modes, bit for bit,
-    /// without factoring `K_ii` again. A second call keeps the first.
+    /// truncated modes of the estimate: the same modes, bit for bit, without factoring `K_ii`
+    /// again. A second call keeps the first.
     pub fn share_fixed_interface(&self, fixed: Arc<FixedInterface>) {
         let _ = self.fixed.set(fixed);
     }
