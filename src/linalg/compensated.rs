@@ -59,14 +59,14 @@ const COMPENSATED_BLOCK: usize = 32;
 /// double-double and rounded once (A symmetric sparse, both triangles stored).
 ///
 /// Row-oriented: column i of the symmetric A is its row i, so `out[i, :]` is one pass over
-/// column i with all right-hand sides of a block at once. `s·x` is stored row-major and
-/// pre-split (Veltkamp), the accumulators are kept as separate `hi`/`lo` arrays over the
-/// columns, so the inner loop is the same straight-line TwoProduct + TwoSum on contiguous data
-/// for every column (vectorizable). The summation order per entry is the column order of A, as
+/// column i with all right-hand sides of a block at once. `s·x` is stored row-major, the
+/// accumulators are kept as separate `hi`/`lo` arrays over the columns, so the inner loop is
+/// the same straight-line TwoProduct + TwoSum on contiguous data for every column
+/// (vectorizable, [`product_sums`]). The summation order per entry is the column order of A, as
 /// in [`Dot2`].
 ///
-/// The columns go in blocks of 32, in parallel (rayon): the split copies of a block take
-/// `2 · 8 · 32 n` bytes (54 MB at 10⁵ DOF) instead of two more n × w matrices, and every entry
+/// The columns go in blocks of 32, in parallel (rayon): the row-major copy of a block takes
+/// `8 · 32 n` bytes (27 MB at 10⁵ DOF) instead of two more n × w matrices, and every entry
 /// is computed by the same operations in the same order whatever the blocks or the threads, so
 /// the result is bit-identical to a single pass.
 pub(crate) fn sym_mul_compensated(
@@ -103,14 +103,11 @@ fn sym_mul_compensated_block(
 ) {
     let n = a.n;
     let w = x.ncols();
-    // Row-major s·x, split into halves.
-    let mut xh = vec![0.0; n * w];
-    let mut xl = vec![0.0; n * w];
+    // Row-major s·x.
+    let mut sx = vec![0.0; n * w];
     for c in 0..w {
         for j in 0..n {
-            let (h, l) = split(s * x[(j, c)]);
-            xh[j * w + c] = h;
-            xl[j * w + c] = l;
+            sx[j * w + c] = s * x[(j, c)];
         }
     }
     let mut hi = vec![0.0; w];
@@ -121,18 +118,8 @@ fn sym_mul_compensated_block(
             lo[c] = 0.0;
         }
         for p in a.col_ptr[i]..a.col_ptr[i + 1] {
-            let av = a.values[p];
-            let (ah, al) = split(av);
             let j = a.row_idx[p];
-            two_product_sums(
-                &mut hi,
-                &mut lo,
-                av,
-                ah,
-                al,
-                &xh[j * w..(j + 1) * w],
-                &xl[j * w..(j + 1) * w],
-            );
+            product_sums(&mut hi, &mut lo, a.values[p], &sx[j * w..(j + 1) * w]);
         }
         for c in 0..w {
             out[(i, c)] = hi[c] + lo[c];
@@ -140,25 +127,34 @@ fn sym_mul_compensated_block(
     }
 }
 
-/// `hi[c] + lo[c] += a · (bh[c] + bl[c])` for every c: Dekker's TwoProduct (`a = ah + al` and
-/// `b = bh + bl` are Veltkamp splits) and Knuth's TwoSum, the error terms summed into `lo` — the
-/// inner loop of [`sym_mul_compensated`]. Compiled for AVX-512 / AVX2 as well as the baseline
-/// and dispatched at run time (`multiversion`); the same IEEE operations on every path (no FMA
-/// contraction in Rust), so the result does not depend on the CPU.
-#[multiversion::multiversion(targets("x86_64+avx512f+avx512vl", "x86_64+avx2"))]
-pub(crate) fn two_product_sums(
-    hi: &mut [f64],
-    lo: &mut [f64],
-    a: f64,
-    ah: f64,
-    al: f64,
-    bh: &[f64],
-    bl: &[f64],
-) {
-    for ((h, l), (&bh, &bl)) in hi.iter_mut().zip(lo.iter_mut()).zip(bh.iter().zip(bl)) {
-        let b = bh + bl;
+/// `hi[c] + lo[c] += a · b[c]` for every c: the error-free product and Knuth's TwoSum, the
+/// error terms summed into `lo` — the inner loop of [`sym_mul_compensated`],
+/// [`compensated_gram`] and the M-orthonormalization. Compiled for AVX-512 / AVX2 as well as
+/// the baseline and dispatched at run time (`multiversion`).
+///
+/// The product's rounding error `a·b − fl(a·b)` is exactly representable, and both ways of
+/// computing it here are exact: Dekker's TwoProduct from Veltkamp splits of `a` and `b`
+/// (every partial product and sum exact) and, where the CPU has FMA, `fma(a, b, −fl(a·b))`
+/// (one rounding of the exact value). So the two paths give the same bits — barring products
+/// within 2⁵³ of the underflow threshold, far below any entry of K, M or a basis here — and
+/// the FMA path does one operation in place of the splits and seven. No other operation is
+/// contracted (Rust does not fuse `a * b + c`).
+#[multiversion::multiversion(targets(
+    "x86_64+avx512f+avx512vl+fma",
+    "x86_64+avx2+fma",
+    "x86_64+avx2"
+))]
+pub(crate) fn product_sums(hi: &mut [f64], lo: &mut [f64], a: f64, b: &[f64]) {
+    let fma = multiversion::target::target_cfg_f!(target_feature = "fma");
+    let (ah, al) = split(a);
+    for ((h, l), &b) in hi.iter_mut().zip(lo.iter_mut()).zip(b) {
         let prod = a * b;
-        let p_err = ((ah * bh - prod) + ah * bl + al * bh) + al * bl;
+        let p_err = if fma {
+            a.mul_add(b, -prod)
+        } else {
+            let (bh, bl) = split(b);
+            ((ah * bh - prod) + ah * bl + al * bh) + al * bl
+        };
         let sum = *h + prod;
         let z = sum - *h;
         let s_err = (*h - (sum - z)) + (prod - z);
@@ -237,8 +233,8 @@ const GRAM_ROWS: usize = 2048;
 /// statics to ≤ 1e-8, against ≈ 5e-7 with plain products on the multilayer sheet).
 ///
 /// Entry `(i, j)`, `i ≤ j`, is the [`Dot2`] sum of `φ_i[k] · (Aφ_j)[k]` over k ascending. The
-/// sums run row block by row block ([`GRAM_ROWS`] rows of `A Φ` split into halves, row-major),
-/// and for each `i` over all `j ≥ i` at once ([`two_product_sums`]: the same operations as
+/// sums run row block by row block ([`GRAM_ROWS`] rows of `A Φ`, row-major), and for
+/// each `i` over all `j ≥ i` at once ([`product_sums`]: the same operations as
 /// `Dot2::add_product(φ_i[k], (Aφ_j)[k])`, vectorized across j), the rows `i` in parallel — the
 /// same bits as the entry-by-entry sums for any thread count (tested), ~1/10 of their time: one
 /// Gram of r = 216 columns at 40 806 DOF took 3–10 s entry by entry, latency-bound.
@@ -251,35 +247,22 @@ pub(crate) fn compensated_gram(a: &SymCsc, phi: faer::MatRef<'_, f64>) -> Mat<f6
     let mut rows: Vec<(Vec<f64>, Vec<f64>)> = (0..r)
         .map(|i| (vec![0.0; r - i], vec![0.0; r - i]))
         .collect();
-    let mut bh = vec![0.0; GRAM_ROWS.min(n) * r];
-    let mut bl = vec![0.0; GRAM_ROWS.min(n) * r];
+    let mut b = vec![0.0; GRAM_ROWS.min(n) * r];
     let mut k0 = 0;
     while k0 < n {
         let rows_b = GRAM_ROWS.min(n - k0);
         for j in 0..r {
             let col = aphi.col(j);
             for k in 0..rows_b {
-                let (h, l) = split(col[k0 + k]);
-                bh[k * r + j] = h;
-                bl[k * r + j] = l;
+                b[k * r + j] = col[k0 + k];
             }
         }
-        let (bh, bl) = (&bh, &bl);
+        let b = &b;
         rows.par_iter_mut().enumerate().for_each(|(i, (hi, lo))| {
             let phi_i = phi.col(i);
             for k in 0..rows_b {
-                let x = phi_i[k0 + k];
-                let (xh, xl) = split(x);
                 let row = k * r + i;
-                two_product_sums(
-                    hi,
-                    lo,
-                    x,
-                    xh,
-                    xl,
-                    &bh[row..row + r - i],
-                    &bl[row..row + r - i],
-                );
+                product_sums(hi, lo, phi_i[k0 + k], &b[row..row + r - i]);
             }
         });
         k0 += rows_b;

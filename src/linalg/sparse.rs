@@ -74,9 +74,11 @@ impl SymCsc {
 
     /// The leading principal submatrix of size `m` (e.g. the Craig–Bampton interior).
     pub fn leading(&self, m: usize) -> SymCsc {
-        let mut col_ptr = vec![0];
-        let mut row_idx = Vec::new();
-        let mut values = Vec::new();
+        let mut col_ptr = Vec::with_capacity(m + 1);
+        col_ptr.push(0);
+        let stored = self.col_ptr[m.min(self.n)];
+        let mut row_idx = Vec::with_capacity(stored);
+        let mut values = Vec::with_capacity(stored);
         for j in 0..m {
             for p in self.col_ptr[j]..self.col_ptr[j + 1] {
                 if self.row_idx[p] < m {

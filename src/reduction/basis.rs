@@ -7,7 +7,7 @@ use faer::{Mat, MatRef};
 use super::pod::DEFAULT_THRESHOLD;
 use super::tvd::TvdOptions;
 use crate::error::{Error, ReductionError};
-use crate::linalg::compensated::{split, two_product_sums};
+use crate::linalg::compensated::product_sums;
 use crate::linalg::sparse::{sym_mul_mat, sym_mul_vec_into, SymCsc};
 use crate::linalg::symmetric_eigen;
 use crate::linalg::LinalgError;
@@ -109,11 +109,9 @@ fn orthonormalize(
 pub struct Orthonormalizer<'m> {
     m: &'m SymCsc,
     drop_tol: f64,
-    /// The accepted columns' M-products and Veltkamp splits (`q = q_hi + q_lo` exactly, so the
-    /// columns themselves are not kept a third time).
+    /// The accepted columns' M-products and the columns.
     mq: Vec<Vec<f64>>,
-    q_hi: Vec<Vec<f64>>,
-    q_lo: Vec<Vec<f64>>,
+    q: Vec<Vec<f64>>,
     /// Per column pushed, the accepted columns after it.
     accepted_after: Vec<usize>,
 }
@@ -125,8 +123,7 @@ impl<'m> Orthonormalizer<'m> {
             m,
             drop_tol,
             mq: Vec::new(),
-            q_hi: Vec::new(),
-            q_lo: Vec::new(),
+            q: Vec::new(),
             accepted_after: Vec::new(),
         }
     }
@@ -138,7 +135,7 @@ impl<'m> Orthonormalizer<'m> {
 
     /// Columns dropped so far (linearly dependent on earlier ones, or zero).
     pub fn dropped(&self) -> usize {
-        self.pushed() - self.q_hi.len()
+        self.pushed() - self.q.len()
     }
 
     /// Forgets every column pushed after the first `pushed`.
@@ -148,27 +145,24 @@ impl<'m> Orthonormalizer<'m> {
         }
         self.accepted_after.truncate(pushed);
         let keep = self.accepted_after.last().copied().unwrap_or(0);
-        for v in [&mut self.mq, &mut self.q_hi, &mut self.q_lo] {
+        for v in [&mut self.mq, &mut self.q] {
             v.truncate(keep);
         }
     }
 
     /// The accepted columns (n × accepted), `Φᵀ M Φ = I`.
     pub fn basis(&self) -> Mat<f64> {
-        Mat::from_fn(self.m.n, self.q_hi.len(), |r, c| {
-            self.q_hi[c][r] + self.q_lo[c][r]
-        })
+        Mat::from_fn(self.m.n, self.q.len(), |r, c| self.q[c][r])
     }
 
     /// [`Orthonormalizer::basis`], releasing each column's working copies as it is placed.
     pub fn into_basis(mut self) -> Mat<f64> {
-        let mut out = Mat::<f64>::zeros(self.m.n, self.q_hi.len());
-        for c in (0..self.q_hi.len()).rev() {
-            let (h, l) = (self.q_hi.pop(), self.q_lo.pop());
+        let mut out = Mat::<f64>::zeros(self.m.n, self.q.len());
+        for c in (0..self.q.len()).rev() {
             self.mq.pop();
-            let (Some(h), Some(l)) = (h, l) else { break };
-            for (r, (a, b)) in h.iter().zip(&l).enumerate() {
-                out[(r, c)] = a + b;
+            let Some(q) = self.q.pop() else { break };
+            for (r, a) in q.iter().enumerate() {
+                out[(r, c)] = *a;
             }
         }
         out
@@ -207,7 +201,7 @@ impl<'m> Orthonormalizer<'m> {
             .into());
         }
         if norm0 == 0.0 {
-            self.accepted_after.push(self.q_hi.len());
+            self.accepted_after.push(self.q.len());
             return Ok(());
         }
         let mut hi = vec![0.0; n];
@@ -217,10 +211,9 @@ impl<'m> Orthonormalizer<'m> {
             // the arithmetic of `Dot2`) and rounded once (see [`final_basis`]).
             hi.copy_from_slice(&v);
             lo.fill(0.0);
-            for ((mqk, qh), ql) in self.mq.iter().zip(&self.q_hi).zip(&self.q_lo) {
+            for (mqk, qk) in self.mq.iter().zip(&self.q) {
                 let a = -dot(mqk, &v);
-                let (ah, al) = split(a);
-                two_product_sums(&mut hi, &mut lo, a, ah, al, qh, ql);
+                product_sums(&mut hi, &mut lo, a, qk);
                 // Modified Gram–Schmidt: the next coefficient sees this update.
                 for ((x, h), l) in v.iter_mut().zip(&hi).zip(&lo) {
                     *x = h + l;
@@ -232,12 +225,10 @@ impl<'m> Orthonormalizer<'m> {
         if norm > self.drop_tol * norm0 {
             v.iter_mut().for_each(|x| *x /= norm);
             mv.iter_mut().for_each(|x| *x /= norm);
-            let (h, l): (Vec<f64>, Vec<f64>) = v.iter().map(|&x| split(x)).unzip();
-            self.q_hi.push(h);
-            self.q_lo.push(l);
+            self.q.push(v);
             self.mq.push(mv);
         }
-        self.accepted_after.push(self.q_hi.len());
+        self.accepted_after.push(self.q.len());
         Ok(())
     }
 }

@@ -4,9 +4,82 @@ use faer::Mat;
 
 use crate::error::{Error, ReductionError};
 use crate::linalg::cholesky::SparseCholesky;
-use crate::linalg::eigen::lowest_modes_factored;
+use crate::linalg::eigen::{lowest_modes_factored, Modes};
 use crate::linalg::LinalgError;
+use crate::linalg::SymCsc;
 use crate::model::Model;
+
+/// The fixed-interface problem of a model (the master node clamped): `K_ii`, `M_ii` (the
+/// leading n − 6 rows and columns) and the Cholesky factor of `K_ii`. Craig–Bampton's
+/// constraint modes and fixed-interface modes and the error estimate's truncated modes
+/// ([`crate::reduction::JointFlexibility::share_fixed_interface`]) are all solves with it: one
+/// factorization instead of one per use, and the same bits as each use factoring on its own
+/// (the factorization is deterministic).
+pub struct FixedInterface {
+    k_ii: SymCsc,
+    m_ii: SymCsc,
+    chol: SparseCholesky,
+}
+
+impl FixedInterface {
+    /// Extracts `K_ii`, `M_ii` of `model` and factors `K_ii`.
+    ///
+    /// # Errors
+    /// The model's checks of [`craig_bampton`] (interior DOF, master DOF last) and a failing
+    /// factorization.
+    pub fn new(model: &Model) -> Result<FixedInterface, Error> {
+        let m = interior_dofs(model)?;
+        let k_ii = model.stiffness.leading(m);
+        let chol = SparseCholesky::new(&k_ii)?;
+        Ok(FixedInterface {
+            m_ii: model.mass.leading(m),
+            k_ii,
+            chol,
+        })
+    }
+
+    /// Number of interior DOF (n − 6).
+    pub fn dofs(&self) -> usize {
+        self.k_ii.n
+    }
+
+    /// The lowest `count` fixed-interface modes (interior DOF only, M-orthonormal): the same
+    /// eigenproblem and bits as `model.modes(count, Interface::Fixed)`.
+    ///
+    /// # Errors
+    /// A failing eigensolve.
+    pub fn modes(&self, count: usize) -> Result<Modes, Error> {
+        Ok(lowest_modes_factored(
+            &self.k_ii, &self.m_ii, &self.chol, count,
+        )?)
+    }
+}
+
+/// The interior DOF count n − 6 of a model whose master node's six DOF are the last six.
+fn interior_dofs(model: &Model) -> Result<usize, Error> {
+    let n = model.dofs();
+    if n <= 6 {
+        return Err(ReductionError::NoInteriorDofs {
+            method: "Craig–Bampton",
+            dofs: n,
+        }
+        .into());
+    }
+    let m = n - 6;
+    let master = model.master_dofs();
+    for (c, &d) in master.iter().enumerate() {
+        if d != m + c {
+            return Err(ReductionError::MasterNotLast {
+                method: "Craig–Bampton",
+                master: c,
+                dof: d,
+                expected: m + c,
+            }
+            .into());
+        }
+    }
+    Ok(m)
+}
 
 /// The Craig–Bampton basis `[Φ_S | Φ_V]` (n × (6 + ν)) of a model whose master node's six DOF
 /// are the last six independent DOF (the boundary set `b`, interior `i` = the leading n − 6).
@@ -20,33 +93,30 @@ use crate::model::Model;
 /// Because `K Φ_S` vanishes on the interior rows and `Φ_V` vanishes on the master rows,
 /// `Φ_Sᵀ K Φ_V = 0` holds exactly (up to the solve's round-off).
 pub fn craig_bampton(model: &Model, nu: usize) -> Result<Mat<f64>, Error> {
-    let n = model.dofs();
-    if n <= 6 {
-        return Err(ReductionError::NoInteriorDofs {
-            method: "Craig–Bampton",
-            dofs: n,
-        }
-        .into());
-    }
-    let m = n - 6;
+    let m = interior_dofs(model)?;
     if nu > m {
         return Err(ReductionError::FixedInterfaceModes { nu, interior: m }.into());
     }
-    let master = model.master_dofs();
-    for (c, &d) in master.iter().enumerate() {
-        if d != m + c {
-            return Err(ReductionError::MasterNotLast {
-                method: "Craig–Bampton",
-                master: c,
-                dof: d,
-                expected: m + c,
-            }
-            .into());
-        }
+    craig_bampton_with(model, nu, &FixedInterface::new(model)?)
+}
+
+/// [`craig_bampton`] on the model's fixed-interface problem `fixed` (its factorization shared
+/// with other uses): the same bits.
+///
+/// # Errors
+/// As [`craig_bampton`]; `fixed` of another model ([`ReductionError::FixedInterfaceModes`] if
+/// its size differs).
+pub fn craig_bampton_with(
+    model: &Model,
+    nu: usize,
+    fixed: &FixedInterface,
+) -> Result<Mat<f64>, Error> {
+    let m = interior_dofs(model)?;
+    if nu > m || fixed.dofs() != m {
+        return Err(ReductionError::FixedInterfaceModes { nu, interior: m }.into());
     }
+    let n = model.dofs();
     let k = &model.stiffness;
-    let k_ii = k.leading(m);
-    let kii = SparseCholesky::new(&k_ii)?;
     // Right-hand sides −K_ib e_c: column m + c of K restricted to interior rows.
     let mut rhs = Mat::<f64>::zeros(m, 6);
     for c in 0..6 {
@@ -58,7 +128,7 @@ pub fn craig_bampton(model: &Model, nu: usize) -> Result<Mat<f64>, Error> {
             }
         }
     }
-    kii.solve_in_place(&mut rhs);
+    fixed.chol.solve_in_place(&mut rhs);
     let mut phi = Mat::<f64>::zeros(n, 6 + nu);
     for c in 0..6 {
         for r in 0..m {
@@ -69,7 +139,7 @@ pub fn craig_bampton(model: &Model, nu: usize) -> Result<Mat<f64>, Error> {
     if nu > 0 {
         // The fixed-interface modes reuse the factorization of K_ii (the same eigenproblem as
         // `model.modes(nu, Interface::Fixed)`).
-        let modes = lowest_modes_factored(&k_ii, &model.mass.leading(m), &kii, nu)?;
+        let modes = fixed.modes(nu)?;
         for c in 0..nu {
             for r in 0..m {
                 phi[(r, 6 + c)] = modes.shapes[(r, c)];

@@ -170,6 +170,7 @@ use crate::linalg::LinalgError;
 use crate::linalg::{SubsetLlt, SymCsc};
 use crate::model::{Interface, Model};
 use crate::reduction::basis::orthonormal_beyond;
+use crate::reduction::craig_bampton::FixedInterface;
 use crate::system::{ReducedSystem, SecondOrderSystem};
 
 /// The joint flexibility of a model: one sparse Cholesky of `K`, the static responses to unit
@@ -193,6 +194,10 @@ pub struct JointFlexibility {
     /// the master), for the truncation part of the estimate: computed on first use
     /// ([`JointFlexibility::truncation_modes`]).
     modes: Mutex<Option<Arc<Mat<f64>>>>,
+    /// The model's fixed-interface problem with its factorization, if shared
+    /// ([`JointFlexibility::share_fixed_interface`]): the truncated modes are then solved with
+    /// it instead of a factorization of their own.
+    fixed: std::sync::OnceLock<Arc<FixedInterface>>,
     /// Per joint row r (3w: normal, t1, t2 of each pair), once solved: the normal rows of its
     /// flexibility column `B_n K⁻¹ b_rᵀ` (w values, mm/N). Shared by every estimate of the
     /// model (sweeps run in parallel), so behind a lock.
@@ -249,6 +254,7 @@ impl JointFlexibility {
             c,
             k_n: model.contact.normal_stiffness,
             modes: Mutex::new(None),
+            fixed: std::sync::OnceLock::new(),
             columns: Mutex::new(vec![None; model.joint.rows()]),
             tangential: Mutex::new(vec![None; model.joint.rows()]),
         })
@@ -516,6 +522,13 @@ impl JointFlexibility {
         })
     }
 
+    /// Shares the model's fixed-interface problem (e.g. the one Craig–Bampton factored) for the
+    /// truncated modes of the estimate: the same modes, bit for bit, without factoring `K_ii`
+    /// again. A second call keeps the first.
+    pub fn share_fixed_interface(&self, fixed: Arc<FixedInterface>) {
+        let _ = self.fixed.set(fixed);
+    }
+
     /// The [`TRUNCATION_MODES`] lowest fixed-interface modes (n × m, zero at the master DOF),
     /// computed on first use: only the transient estimate needs them (not the pair-space
     /// statics), and its first use is on the second core beside a reduced run
@@ -536,7 +549,10 @@ impl JointFlexibility {
         let n = self.stiffness.n;
         let count = TRUNCATION_MODES.min(n.saturating_sub(6) / 2);
         let modes = if count > 0 {
-            let fixed = model.modes(count, Interface::Fixed)?;
+            let fixed = match self.fixed.get() {
+                Some(shared) if shared.dofs() + 6 == n => shared.modes(count)?,
+                _ => model.modes(count, Interface::Fixed)?,
+            };
             let m = n - 6;
             Mat::from_fn(n, fixed.shapes.ncols(), |i, j| {
                 if i < m {
@@ -1021,12 +1037,22 @@ impl Dissipation {
         }
         self.run.push(d);
         self.corrected.push(dc);
-        self.last = Some(OutputState {
-            p: p.to_vec(),
-            pc: pc.to_vec(),
-            s: s.to_vec(),
-            slip: slip.to_vec(),
+        // The last state's buffers are reused: four copies per output, no allocation.
+        let last = self.last.get_or_insert_with(|| OutputState {
+            p: Vec::new(),
+            pc: Vec::new(),
+            s: Vec::new(),
+            slip: Vec::new(),
         });
+        for (to, from) in [
+            (&mut last.p, p),
+            (&mut last.pc, pc),
+            (&mut last.s, s),
+            (&mut last.slip, slip),
+        ] {
+            to.clear();
+            to.extend_from_slice(from);
+        }
     }
 
     /// `|D(T) − D*(T)| / |D*(T)|` (`None` when nothing is dissipated).
@@ -1297,6 +1323,13 @@ struct Corrector<'a> {
     stick_factor: SubsetLlt,
     /// The flexibility columns of the pairs met so far (w entries, `None` before).
     cols: Vec<Option<Arc<[f64]>>>,
+    /// The tangential flexibility columns met so far, per joint row (3w entries, `None` before
+    /// and for normal rows): the column's normal rows and tangential rows
+    /// ([`JointFlexibility::tangential_columns`]), fetched once per correction sequence instead
+    /// of from the shared cache (its lock) at every output.
+    tcols: Vec<Option<TangentialColumn>>,
+    /// Working arrays of one output, kept between outputs (no allocation per output).
+    scratch: Scratch,
     /// The run's slip memory at the previous output (2w, mm; empty before the first).
     last_s: Vec<f64>,
     /// The slip memory of the last corrected state (2w, mm; NaN for open pairs; empty
@@ -1305,6 +1338,25 @@ struct Corrector<'a> {
     /// Whether the corrected slip is wanted (the dissipated energy is summed from this
     /// correction's states).
     want_slip: bool,
+}
+
+/// A tangential flexibility column: its normal rows (w) and tangential rows (2w), mm/N.
+type TangentialColumn = (Arc<[f64]>, Arc<[f64]>);
+
+/// The working arrays of [`Corrector::correct`] (their contents do not outlive one output).
+#[derive(Default)]
+struct Scratch {
+    /// ĝ (w), the gaps (w), the active set as a list and the next active set (w).
+    g_hat: Vec<f64>,
+    gaps: Vec<f64>,
+    set: Vec<usize>,
+    next: Vec<bool>,
+    /// The stuck pairs (w), the tangential rows of the closed pairs, those of them that move
+    /// and the closed pairs.
+    is_stuck: Vec<bool>,
+    rows: Vec<usize>,
+    moving: Vec<usize>,
+    closed: Vec<usize>,
 }
 
 /// Active-set iterations per output before the projected Gauss–Seidel fallback.
@@ -1322,16 +1374,25 @@ const JOIN_FRACTION: f64 = 0.5;
 /// the deepest few open most of the others. The fixed point is the same (no pair outside with
 /// `g < 0`, none inside with `g ≥ 0`), so the solution is; it takes a few more, cheap, iterations.
 fn next_active_set(active: &[bool], gaps: &[f64]) -> Vec<bool> {
+    let mut next = Vec::with_capacity(active.len());
+    next_active_set_into(active, gaps, &mut next);
+    next
+}
+
+/// [`next_active_set`] written into `next`.
+fn next_active_set_into(active: &[bool], gaps: &[f64], next: &mut Vec<bool>) {
     let deepest = gaps
         .iter()
         .zip(active)
         .filter(|(_, &a)| !a)
         .map(|(&g, _)| g)
         .fold(0.0f64, f64::min);
-    gaps.iter()
-        .zip(active)
-        .map(|(&g, &a)| g < 0.0 && (a || g <= JOIN_FRACTION * deepest))
-        .collect()
+    next.clear();
+    next.extend(
+        gaps.iter()
+            .zip(active)
+            .map(|(&g, &a)| g < 0.0 && (a || g <= JOIN_FRACTION * deepest)),
+    );
 }
 
 impl<'a> Corrector<'a> {
@@ -1344,6 +1405,8 @@ impl<'a> Corrector<'a> {
             factor: SubsetLlt::new(),
             stick_factor: SubsetLlt::new(),
             cols: vec![None; flex.pairs()],
+            tcols: vec![None; 3 * flex.pairs()],
+            scratch: Scratch::default(),
             last_s: Vec::new(),
             slip: Vec::new(),
             want_slip: true,
@@ -1358,8 +1421,15 @@ impl<'a> Corrector<'a> {
         if set.is_empty() {
             return Ok(());
         }
-        for (&k, c) in set.iter().zip(self.flex.normal_columns(set)?) {
-            self.cols[k] = Some(c);
+        let missing: Vec<usize> = set
+            .iter()
+            .copied()
+            .filter(|&k| self.cols[k].is_none())
+            .collect();
+        if !missing.is_empty() {
+            for (&k, c) in missing.iter().zip(self.flex.normal_columns(&missing)?) {
+                self.cols[k] = Some(c);
+            }
         }
         let cols = &self.cols;
         let col = |k: usize| cols[k].as_deref().expect("fetched above");
@@ -1386,19 +1456,41 @@ impl<'a> Corrector<'a> {
         Ok(())
     }
 
+    /// Fetches the tangential flexibility columns of the joint rows `rows` not met yet into
+    /// `tcols`.
+    fn fetch_tangential(&mut self, rows: &[usize]) -> Result<(), Error> {
+        let missing: Vec<usize> = rows
+            .iter()
+            .copied()
+            .filter(|&r| self.tcols[r].is_none())
+            .collect();
+        if !missing.is_empty() {
+            for (&r, c) in missing.iter().zip(self.flex.tangential_columns(&missing)?) {
+                self.tcols[r] = Some(c);
+            }
+        }
+        Ok(())
+    }
+
     /// The corrected pair forces `p*` (3w) from the pair kinematics `u0 = û − F_{·,t} p_t`
     /// (with the run's tangential forces as loads) and the run's forces `p`.
     fn correct(&mut self, u0: &[f64], p: &[f64], s: &[f64]) -> Result<Vec<f64>, Error> {
         let w = self.w;
         let k_n = self.law.k_n;
-        let g_hat: Vec<f64> = (0..w).map(|k| u0[3 * k + NORMAL]).collect();
+        let mut g_hat = std::mem::take(&mut self.scratch.g_hat);
+        g_hat.clear();
+        g_hat.extend((0..w).map(|k| u0[3 * k + NORMAL]));
         let nrm = |k: usize| 3 * k + NORMAL;
         // Semismooth Newton on the active set (see `crate::joint::statics`), warm-started.
         let mut active = std::mem::take(&mut self.active);
-        let mut gaps = vec![0.0; w];
+        let mut gaps = std::mem::take(&mut self.scratch.gaps);
+        gaps.resize(w, 0.0);
+        let mut set = std::mem::take(&mut self.scratch.set);
+        let mut next = std::mem::take(&mut self.scratch.next);
         let mut converged = false;
         for _ in 0..MAX_ACTIVE_SET_ITERATIONS {
-            let set: Vec<usize> = (0..w).filter(|&k| active[k]).collect();
+            set.clear();
+            set.extend((0..w).filter(|&k| active[k]));
             self.gaps(&set, &g_hat, &mut gaps)?;
             if let Some(k) = gaps.iter().position(|g| !g.is_finite()) {
                 return Err(Error::LinearAlgebra(LinalgError::GapNotFinite {
@@ -1407,12 +1499,12 @@ impl<'a> Corrector<'a> {
                     value: None,
                 }));
             }
-            let next = next_active_set(&active, &gaps);
+            next_active_set_into(&active, &gaps, &mut next);
             if next == active {
                 converged = true;
                 break;
             }
-            active = next;
+            std::mem::swap(&mut active, &mut next);
         }
         let forces: Vec<f64> = if converged {
             gaps.iter()
@@ -1427,6 +1519,10 @@ impl<'a> Corrector<'a> {
             forces
         };
         self.active = active;
+        self.scratch.g_hat = g_hat;
+        self.scratch.gaps = gaps;
+        self.scratch.set = set;
+        self.scratch.next = next;
         let mut pc = vec![0.0; 3 * w];
         for (k, &pk) in forces.iter().enumerate() {
             pc[nrm(k)] = pk;
@@ -1527,21 +1623,21 @@ impl<'a> Corrector<'a> {
             let loaded: Vec<usize> = (0..3 * w)
                 .filter(|&r| r % 3 != NORMAL && pc[r] != 0.0)
                 .collect();
-            let cols = self.flex.tangential_columns(&rows)?;
-            let loads = self.flex.tangential_columns(&loaded)?;
+            self.fetch_tangential(&rows)?;
+            self.fetch_tangential(&loaded)?;
+            let tcols = &self.tcols;
+            let col = |r: usize| tcols[r].as_ref().expect("fetched above");
             // Tangential row r of pair k sits at 2k (t1) or 2k + 1 (t2) of a column's
             // tangential rows and of the slip memory.
             let t_at = |r: usize| 2 * (r / 3) + (r % 3 - 1);
+            // The pairs with a normal force, ascending: the others would add only zeros.
+            let closed: Vec<usize> = (0..w).filter(|&k| pc[nrm(k)] != 0.0).collect();
             let mut rhs: Vec<f64> = rows
                 .iter()
-                .zip(&cols)
-                .map(|(&r, (normal, _))| {
-                    let from_normal: f64 = (0..w).map(|k| normal[k] * pc[nrm(k)]).sum();
-                    let from_sliding: f64 = loaded
-                        .iter()
-                        .zip(&loads)
-                        .map(|(&l, (_, t))| t[t_at(r)] * pc[l])
-                        .sum();
+                .map(|&r| {
+                    let normal = &col(r).0;
+                    let from_normal: f64 = closed.iter().map(|&k| normal[k] * pc[nrm(k)]).sum();
+                    let from_sliding: f64 = loaded.iter().map(|&l| col(l).1[t_at(r)] * pc[l]).sum();
                     k_t * (u0[r] - from_normal - from_sliding - s[t_at(r)])
                 })
                 .collect();
@@ -1554,7 +1650,7 @@ impl<'a> Corrector<'a> {
             self.stick_factor
                 .update(&index, |i, j| {
                     let d = if i == j { 1.0 } else { 0.0 };
-                    d + k_t * 0.5 * (cols[col_of[j]].1[i] + cols[col_of[i]].1[j])
+                    d + k_t * 0.5 * (col(rows[col_of[j]]).1[i] + col(rows[col_of[i]]).1[j])
                 })
                 .map_err(|e| {
                     Error::LinearAlgebra(LinalgError::ContactMatrix {
@@ -1604,28 +1700,46 @@ impl<'a> Corrector<'a> {
         let t_at = |r: usize| 2 * (r / 3) + (r % 3 - 1);
         self.slip.clear();
         self.slip.resize(2 * w, f64::NAN);
-        let mut is_stuck = vec![false; w];
+        let Scratch {
+            is_stuck,
+            rows,
+            moving,
+            closed,
+            ..
+        } = &mut self.scratch;
+        is_stuck.clear();
+        is_stuck.resize(w, false);
         for &k in stuck {
             is_stuck[k] = true;
             self.slip[2 * k] = s[2 * k];
             self.slip[2 * k + 1] = s[2 * k + 1];
         }
-        let rows: Vec<usize> = (0..w)
-            .filter(|&k| pc[nrm(k)] != 0.0)
-            .flat_map(|k| [3 * k + T1, 3 * k + T2])
-            .collect();
-        let moving: Vec<usize> = rows.iter().copied().filter(|&r| !is_stuck[r / 3]).collect();
+        // The pairs with a normal force, ascending (the others would add only zeros), and
+        // their tangential rows.
+        closed.clear();
+        closed.extend((0..w).filter(|&k| pc[nrm(k)] != 0.0));
+        rows.clear();
+        rows.extend(closed.iter().flat_map(|&k| [3 * k + T1, 3 * k + T2]));
+        moving.clear();
+        moving.extend(rows.iter().copied().filter(|&r| !is_stuck[r / 3]));
         if moving.is_empty() {
             return Ok(());
         }
-        let cols = self.flex.tangential_columns(&moving)?;
-        for (&r, (normal, tangential)) in moving.iter().zip(&cols) {
+        let (rows, moving, closed) = (
+            std::mem::take(rows),
+            std::mem::take(moving),
+            std::mem::take(closed),
+        );
+        self.fetch_tangential(&moving)?;
+        for &r in &moving {
+            let (normal, tangential) = self.tcols[r].as_ref().expect("fetched above");
             // F is symmetric: row r of F is column r.
-            let from_normal: f64 = (0..w).map(|k| normal[k] * pc[nrm(k)]).sum();
+            let from_normal: f64 = closed.iter().map(|&k| normal[k] * pc[nrm(k)]).sum();
             let from_tangential: f64 = rows.iter().map(|&l| tangential[t_at(l)] * pc[l]).sum();
             let u = u0[r] - from_normal - from_tangential;
             self.slip[t_at(r)] = if k_t > 0.0 { u - pc[r] / k_t } else { u };
         }
+        (self.scratch.rows, self.scratch.moving, self.scratch.closed) = (rows, moving, closed);
         Ok(())
     }
 }

@@ -65,7 +65,7 @@ pub use competitors::{
     alldof_vectors, jim_dofs, jim_vectors, joint_interface_modes, snapshot_basis, snapshot_pod,
     JointInterfaceModes,
 };
-pub use craig_bampton::craig_bampton;
+pub use craig_bampton::{craig_bampton, craig_bampton_with, FixedInterface};
 pub use estimate::{
     CurveErrors, ErrorEstimator, Estimate, JointFlexibility, Quantities, Quantity, RunStates,
 };

@@ -13,9 +13,11 @@ use jointrom::joint::NORMAL;
 use jointrom::linalg::cholesky::SparseCholesky;
 use jointrom::linalg::SymCsc;
 use jointrom::model::contact_static_full;
+use jointrom::model::Interface;
 use jointrom::reduction::{
-    active_pairs, build_basis, craig_bampton, displacement_scales, final_basis, pod, pod_tvd,
-    trial_vector_derivatives, BasisKind, BasisOptions, TvdOptions, DEFAULT_THRESHOLD,
+    active_pairs, build_basis, craig_bampton, craig_bampton_with, displacement_scales, final_basis,
+    pod, pod_tvd, trial_vector_derivatives, BasisKind, BasisOptions, FixedInterface, TvdOptions,
+    DEFAULT_THRESHOLD,
 };
 use jointrom::system::ReducedSystem;
 
@@ -36,6 +38,23 @@ fn max_dev_from_identity(g: &Mat<f64>) -> f64 {
         }
     }
     d
+}
+
+/// One fixed-interface factorization serves Craig–Bampton (as ν grows) and the estimate's
+/// truncated modes: the shared path gives the bits of each use factoring on its own.
+#[test]
+fn shared_fixed_interface_gives_the_same_bits() {
+    let model = common::model("friction_bar");
+    let fixed = FixedInterface::new(&model).unwrap();
+    for nu in [10, 20] {
+        let own = craig_bampton(&model, nu).unwrap();
+        let shared = craig_bampton_with(&model, nu, &fixed).unwrap();
+        assert!(own == shared, "Craig–Bampton ν = {nu}");
+    }
+    let own = model.modes(40, Interface::Fixed).unwrap();
+    let shared = fixed.modes(40).unwrap();
+    assert!(own.shapes == shared.shapes, "fixed-interface mode shapes");
+    assert_eq!(own.eigenvalues, shared.eigenvalues);
 }
 
 #[test]

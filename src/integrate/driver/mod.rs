@@ -265,7 +265,7 @@ impl<S: SecondOrderSystem> Driver<S> {
             }
             .into());
         }
-        output_count(end, opts.output_step)?;
+        let outputs = output_count(end, opts.output_step)?;
         if let Some(b) = opts.budget_s {
             if !(b.is_finite() && b > 0.0) {
                 return Err(crate::error::IntegrationError::NotPositive {
@@ -287,7 +287,8 @@ impl<S: SecondOrderSystem> Driver<S> {
         let mut curves = Curves::default();
         curves.push(&ode.sample(0.0, &y0));
         let trajectory = opts.record.then(|| {
-            let mut tr = Trajectory::default();
+            // Room for every output at once: no regrowth (and copy) of the largest arrays.
+            let mut tr = Trajectory::with_capacity(outputs + 1, &y0[..dim], &ode);
             tr.push(&y0[..dim], &ode);
             tr
         });

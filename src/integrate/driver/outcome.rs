@@ -131,6 +131,20 @@ pub struct Trajectory {
 }
 
 impl Trajectory {
+    /// An empty trajectory with room for `outputs` outputs of the sizes of `q` and of the
+    /// problem's forces and slip memory.
+    pub(super) fn with_capacity<S: SecondOrderSystem>(
+        outputs: usize,
+        q: &[f64],
+        ode: &MechanicalOde<S>,
+    ) -> Trajectory {
+        Trajectory {
+            q: Vec::with_capacity(outputs * q.len()),
+            p: Vec::with_capacity(outputs * ode.pair_forces().len()),
+            s: Vec::with_capacity(outputs * ode.slip_memory().len()),
+        }
+    }
+
     /// Appends one output: `q` and the forces and slip memory of the problem's last sample.
     pub(super) fn push<S: SecondOrderSystem>(&mut self, q: &[f64], ode: &MechanicalOde<S>) {
         self.q.extend_from_slice(q);

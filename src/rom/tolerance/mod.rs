@@ -99,6 +99,7 @@
 //! tighter `--rtol/--atol` lower the integration floor).
 
 use std::collections::HashMap;
+use std::sync::Arc;
 use std::time::Instant;
 
 use serde::Serialize;
@@ -111,8 +112,8 @@ use crate::reduction::estimate::TRUNCATION_MODES;
 #[cfg(doc)]
 use crate::reduction::Estimate;
 use crate::reduction::{
-    craig_bampton, modal_rotation, CurveErrors, JointFlexibility, Orthonormalizer, Quantities,
-    Quantity, DEFAULT_DROP_TOL,
+    craig_bampton, craig_bampton_with, modal_rotation, CurveErrors, FixedInterface,
+    JointFlexibility, Orthonormalizer, Quantities, Quantity, DEFAULT_DROP_TOL,
 };
 use crate::rom::estimate::{
     add_checks, add_combined_check, beside, check_factor, drop_combined, drop_truncation,
@@ -408,8 +409,7 @@ pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<Toleran
     let start = Instant::now();
     let cpu_start = process_cpu_s();
     let mut nu = opts.nu;
-    let (flex, cb) = beside(|| JointFlexibility::new(model), || craig_bampton(model, nu));
-    let (flex, mut cb) = (flex?, cb?);
+    let (flex, fixed, mut cb) = setup(model, nu)?;
     let setup_s = start.elapsed().as_secs_f64();
     let mut chosen = Chosen::default();
     let mut bases = BasisCache::new(model);
@@ -496,7 +496,7 @@ pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<Toleran
                 .max(estimate.truncation.map_or(0.0, |t| worst(&t, on)));
             if !changed && truncated > part && nu + NU_STEP <= max_nu(model) {
                 nu += NU_STEP;
-                cb = craig_bampton(model, nu)?;
+                cb = craig_bampton_with(model, nu, &fixed)?;
                 changed = true;
                 expect_result = true;
             }
@@ -548,6 +548,25 @@ pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<Toleran
             return Ok(result);
         }
     }
+}
+
+/// The joint flexibility, the fixed-interface problem and Craig–Bampton with ν modes, the first
+/// beside the other two; Craig–Bampton's factorization serves the estimate's truncated modes.
+fn setup(
+    model: &Model,
+    nu: usize,
+) -> Result<(JointFlexibility, Arc<FixedInterface>, faer::Mat<f64>), Error> {
+    let (flex, cb) = beside(
+        || JointFlexibility::new(model),
+        || -> Result<_, Error> {
+            let fixed = FixedInterface::new(model)?;
+            let cb = craig_bampton_with(model, nu, &fixed)?;
+            Ok((Arc::new(fixed), cb))
+        },
+    );
+    let (flex, (fixed, cb)) = (flex?, cb?);
+    flex.share_fixed_interface(Arc::clone(&fixed));
+    Ok((flex, fixed, cb))
 }
 
 /// The re-runs of a round (module docs), given as its system, run, scene and transient options:
