@@ -1343,6 +1343,26 @@ struct Corrector<'a> {
 /// A tangential flexibility column: its normal rows (w) and tangential rows (2w), mm/N.
 type TangentialColumn = (Arc<[f64]>, Arc<[f64]>);
 
+/// Fills the entries of `cache` at `keys` that are still empty by one `solve` of those keys
+/// (blocked: one call for all of them).
+fn fetch_missing<T>(
+    cache: &mut [Option<T>],
+    keys: &[usize],
+    solve: impl FnOnce(&[usize]) -> Result<Vec<T>, Error>,
+) -> Result<(), Error> {
+    let missing: Vec<usize> = keys
+        .iter()
+        .copied()
+        .filter(|&k| cache[k].is_none())
+        .collect();
+    if !missing.is_empty() {
+        for (&k, c) in missing.iter().zip(solve(&missing)?) {
+            cache[k] = Some(c);
+        }
+    }
+    Ok(())
+}
+
 /// The working arrays of [`Corrector::correct`] (their contents do not outlive one output).
 #[derive(Default)]
 struct Scratch {
@@ -1421,16 +1441,8 @@ impl<'a> Corrector<'a> {
         if set.is_empty() {
             return Ok(());
         }
-        let missing: Vec<usize> = set
-            .iter()
-            .copied()
-            .filter(|&k| self.cols[k].is_none())
-            .collect();
-        if !missing.is_empty() {
-            for (&k, c) in missing.iter().zip(self.flex.normal_columns(&missing)?) {
-                self.cols[k] = Some(c);
-            }
-        }
+        let flex = self.flex;
+        fetch_missing(&mut self.cols, set, |keys| flex.normal_columns(keys))?;
         let cols = &self.cols;
         let col = |k: usize| cols[k].as_deref().expect("fetched above");
         self.factor
@@ -1459,17 +1471,8 @@ impl<'a> Corrector<'a> {
     /// Fetches the tangential flexibility columns of the joint rows `rows` not met yet into
     /// `tcols`.
     fn fetch_tangential(&mut self, rows: &[usize]) -> Result<(), Error> {
-        let missing: Vec<usize> = rows
-            .iter()
-            .copied()
-            .filter(|&r| self.tcols[r].is_none())
-            .collect();
-        if !missing.is_empty() {
-            for (&r, c) in missing.iter().zip(self.flex.tangential_columns(&missing)?) {
-                self.tcols[r] = Some(c);
-            }
-        }
-        Ok(())
+        let flex = self.flex;
+        fetch_missing(&mut self.tcols, rows, |keys| flex.tangential_columns(keys))
     }
 
     /// The corrected pair forces `p*` (3w) from the pair kinematics `u0 = û − F_{·,t} p_t`
