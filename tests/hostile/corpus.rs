@@ -1388,6 +1388,27 @@ fn flags(fx: &Fixture) -> Vec<Hostile> {
             Fails("--tolerance"),
         ),
         entry(
+            "flag-compress-joint-value",
+            "flag",
+            "--compress-joint maybe",
+            &[
+                "transient",
+                "friction_bar",
+                "--tolerance",
+                "1e-2",
+                "--compress-joint",
+                "maybe",
+            ],
+            Fails("--compress-joint"),
+        ),
+        entry(
+            "flag-compress-joint-without-tolerance",
+            "flag",
+            "--compress-joint on without --tolerance",
+            &["transient", "friction_bar", "--compress-joint", "on"],
+            Fails("--tolerance"),
+        ),
+        entry(
             "flag-nu-huge",
             "flag",
             "--nu 100000",
