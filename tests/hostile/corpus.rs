@@ -174,6 +174,7 @@ pub fn corpus() -> Vec<Hostile> {
     v.extend(maps(fx));
     v.extend(rom_files(fx));
     v.extend(flags(fx));
+    v.extend(compress_flags());
     v.extend(method_flags());
     v.extend(variants(fx));
     v.extend(outputs(fx));
@@ -1302,6 +1303,34 @@ fn method_flags() -> Vec<Hostile> {
     ]
 }
 
+/// `--compress-joint`: an unknown value, and the flag without `--tolerance`.
+fn compress_flags() -> Vec<Hostile> {
+    use Expect::Fails;
+    vec![
+        entry(
+            "flag-compress-joint-value",
+            "flag",
+            "--compress-joint maybe",
+            &[
+                "transient",
+                "friction_bar",
+                "--tolerance",
+                "1e-2",
+                "--compress-joint",
+                "maybe",
+            ],
+            Fails("--compress-joint"),
+        ),
+        entry(
+            "flag-compress-joint-without-tolerance",
+            "flag",
+            "--compress-joint on without --tolerance",
+            &["transient", "friction_bar", "--compress-joint", "on"],
+            Fails("--tolerance"),
+        ),
+    ]
+}
+
 fn flags(fx: &Fixture) -> Vec<Hostile> {
     use Expect::Fails;
     let stiff = set(&fx.case, "/contact/normal_stiffness", json!(1e15));
@@ -1385,27 +1414,6 @@ fn flags(fx: &Fixture) -> Vec<Hostile> {
             "flag",
             "--tolerance 2",
             &["transient", "friction_bar", "--tolerance", "2"],
-            Fails("--tolerance"),
-        ),
-        entry(
-            "flag-compress-joint-value",
-            "flag",
-            "--compress-joint maybe",
-            &[
-                "transient",
-                "friction_bar",
-                "--tolerance",
-                "1e-2",
-                "--compress-joint",
-                "maybe",
-            ],
-            Fails("--compress-joint"),
-        ),
-        entry(
-            "flag-compress-joint-without-tolerance",
-            "flag",
-            "--compress-joint on without --tolerance",
-            &["transient", "friction_bar", "--compress-joint", "on"],
             Fails("--tolerance"),
         ),
         entry(
