@@ -25,28 +25,6 @@ impl OnOff {
     }
 }
 
-/// `--compress-joint`: when the tolerance model compresses its joint columns.
-#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum CompressArg {
-    #[value(name = "auto")]
-    Auto,
-    #[value(name = "on")]
-    On,
-    #[value(name = "off")]
-    Off,
-}
-
-impl CompressArg {
-    pub fn mode(self) -> jointrom::rom::CompressJoint {
-        use jointrom::rom::CompressJoint;
-        match self {
-            CompressArg::Auto => CompressJoint::Auto,
-            CompressArg::On => CompressJoint::On,
-            CompressArg::Off => CompressJoint::Off,
-        }
-    }
-}
-
 /// `--method`: CVODE's BDF (the default) or an ARKODE DIRK method (`--dirk-table`).
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum MethodKind {

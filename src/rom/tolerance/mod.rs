@@ -156,8 +156,9 @@ pub struct ToleranceOptions {
     pub compress: CompressJoint,
 }
 
-/// When the tolerance model compresses its joint columns ([`ToleranceOptions::compress`]).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+/// When the tolerance model compresses its joint columns ([`ToleranceOptions::compress`]; the
+/// CLI's `--compress-joint` values).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, clap::ValueEnum)]
 #[serde(rename_all = "lowercase")]
 pub enum CompressJoint {
     /// Never: the per-pair model is the result.

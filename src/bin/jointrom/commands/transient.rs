@@ -14,12 +14,14 @@ use jointrom::integrate::{Curves, RunChoices, TransientOptions};
 use jointrom::rom::compare::{ReferenceCurves, ReferenceErrors};
 use jointrom::rom::spec::DEFAULT_SNAPSHOTS;
 use jointrom::rom::tolerance::{worst, IntegrationTolerances};
-use jointrom::rom::{run_model, ModelFlags, ModelRun, ModelSpec, RunEstimate, RunSettings};
+use jointrom::rom::{
+    run_model, CompressJoint, ModelFlags, ModelRun, ModelSpec, RunEstimate, RunSettings,
+};
 use jointrom::{Error, Model};
 
 use jointrom::studies::stability::IterKind;
 
-use crate::args::{CompressArg, MethodKind, OnOff};
+use crate::args::{MethodKind, OnOff};
 use crate::common::{create_dir, positive, print_json, write_file};
 
 #[derive(Args)]
@@ -39,7 +41,7 @@ pub struct TransientArgs {
     /// model only where its basis is at most three quarters of the per-pair one. JSON
     /// `"tolerance"."compression"`.
     #[arg(long, value_enum, default_value = "auto", requires = "tolerance")]
-    compress_joint: CompressArg,
+    compress_joint: CompressJoint,
     /// `--model pod`: end of the full-FE training run, s (default: the run's end time).
     #[arg(long)]
     train_end: Option<f64>,
@@ -167,7 +169,7 @@ pub fn run(a: TransientArgs) -> Result<(), Error> {
             } else {
                 IntegrationTolerances::FromTolerance
             },
-            compress_joint: a.compress_joint.mode(),
+            compress_joint: a.compress_joint,
         },
     )?;
     // The largest estimated error of the quantities the tolerance holds for.
