@@ -211,18 +211,22 @@ mod tests {
     fn kept_modes_span_the_snapshots_to_the_energy_rule() {
         let c = 9;
         let (k, z, x, pod) = fixture(c);
+        // The energy of X outside the K-orthogonal projection on the leading `rank` modes.
+        let left_outside = |rank: usize| -> f64 {
+            let u = &z * pod.coefficients.subcols(0, rank);
+            let coords = u.transpose() * &k * &x;
+            let rest = &x - &u * &coords;
+            (rest.transpose() * &k * &rest)
+                .diagonal()
+                .column_vector()
+                .sum()
+        };
         for fraction in [1e-1, 1e-2, 1e-4] {
             let rank = pod.rank_for(fraction);
             assert!(rank < c, "fraction {fraction}: rank {rank} of {c}");
             // The K-orthogonal projection of X on the kept modes leaves at most fraction² of
             // its energy outside.
-            let u = &z * pod.coefficients.subcols(0, rank);
-            let coords = u.transpose() * &k * &x;
-            let rest = &x - &u * &coords;
-            let left: f64 = (rest.transpose() * &k * &rest)
-                .diagonal()
-                .column_vector()
-                .sum();
+            let left = left_outside(rank);
             assert!(
                 left <= fraction * fraction * pod.total * (1.0 + 1e-8),
                 "fraction {fraction}: rank {rank} leaves {left} of {}",
@@ -230,14 +234,7 @@ mod tests {
             );
             // One mode fewer leaves more than that (the rank is the fewest).
             if rank > 0 {
-                let u = &z * pod.coefficients.subcols(0, rank - 1);
-                let coords = u.transpose() * &k * &x;
-                let rest = &x - &u * &coords;
-                let left: f64 = (rest.transpose() * &k * &rest)
-                    .diagonal()
-                    .column_vector()
-                    .sum();
-                assert!(left > fraction * fraction * pod.total);
+                assert!(left_outside(rank - 1) > fraction * fraction * pod.total);
             }
         }
         // Three patterns carry the forces: 1e-2 of the norm needs three modes.
