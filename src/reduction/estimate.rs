@@ -901,6 +901,13 @@ pub struct Estimate {
     /// Per pair, `Σ_t |p_{t,k}(t) − p_{t,k}*(t)|²` (N²) with the joint-only correction: where
     /// the reduced run's tangential forces differ from the corrected ones.
     pub pair_tangential_error: Vec<f64>,
+    /// Per pair, the part of [`Estimate::pair_tangential_error`] from the outputs at which the
+    /// run sticks the pair (closed, its friction force inside its cone), N²: the error of its
+    /// stick force, an elastic stretch that the structure's tangential compliance at the pair
+    /// sets. At the other outputs the correction puts the pair on its corrected cone
+    /// `μ|p_n*|` in the run's direction (or opens or closes it), so the error there is its
+    /// normal force's.
+    pub pair_stick_error: Vec<f64>,
     /// Per pair, the moments `Σ_t [p_1², p_1 p_2, p_2²]` (N²) of the tangential forces of the
     /// run and of the joint-only correction: their principal direction is the pair's main
     /// direction of friction.
@@ -922,9 +929,10 @@ pub struct Estimate {
 
 impl Estimate {
     /// Adds one output's per-pair shares (the run's forces `p`, the correction's `pc`, the
-    /// joint-only correction's `pj`) and returns its squared norms `[‖p_n*‖², ‖p_t*‖²,
-    /// ‖p_n‖², ‖p_t‖², ‖p_n^j‖², ‖p_t^j‖²]`.
-    fn add_output(&mut self, p: &[f64], pc: &[f64], pj: &[f64]) -> [f64; 6] {
+    /// joint-only correction's `pj`; `mu` the friction coefficient, which tells the pairs the
+    /// run sticks) and returns its squared norms `[‖p_n*‖², ‖p_t*‖², ‖p_n‖², ‖p_t‖², ‖p_n^j‖²,
+    /// ‖p_t^j‖²]`.
+    fn add_output(&mut self, p: &[f64], pc: &[f64], pj: &[f64], mu: f64) -> [f64; 6] {
         let mut sums = [0.0; 6];
         let sq = |v: &[f64], k: usize| {
             [
@@ -941,8 +949,13 @@ impl Estimate {
         self.corrected_pair_forces.push(forces);
         for k in 0..self.pair_error.len() {
             let (a1, a2) = (pj[3 * k + T1], pj[3 * k + T2]);
-            self.pair_tangential_error[k] +=
-                (a1 - p[3 * k + T1]).powi(2) + (a2 - p[3 * k + T2]).powi(2);
+            let e = (a1 - p[3 * k + T1]).powi(2) + (a2 - p[3 * k + T2]).powi(2);
+            self.pair_tangential_error[k] += e;
+            // Stuck in the run: closed, inside its cone (the correction's sliding test).
+            let cone = mu * p[3 * k + NORMAL].abs();
+            if cone > 0.0 && p[3 * k + T1].hypot(p[3 * k + T2]) < (1.0 - 1e-9) * cone {
+                self.pair_stick_error[k] += e;
+            }
             let m = &mut self.pair_tangential_moment[k];
             for (b1, b2) in [(a1, a2), (p[3 * k + T1], p[3 * k + T2])] {
                 m[0] += b1 * b1;
@@ -1119,6 +1132,7 @@ impl ErrorEstimator<'_> {
         let mut fc_joint = Vec::with_capacity(outputs);
         let mut fr_joint = Vec::with_capacity(outputs);
         out.pair_tangential_error = vec![0.0; w];
+        out.pair_stick_error = vec![0.0; w];
         out.pair_tangential_moment = vec![[0.0; 3]; w];
         let mut dissipation = Dissipation::default();
         let mut corr = Corrector::new(self.flex, law);
@@ -1191,7 +1205,7 @@ impl ErrorEstimator<'_> {
                 if law.friction {
                     dissipation.push(p, pj, &states.s[ns * j..ns * (j + 1)], slip_j);
                 }
-                let [fc, fr, fc_rom, fr_rom, fcj, frj] = out.add_output(p, pc, pj);
+                let [fc, fr, fc_rom, fr_rom, fcj, frj] = out.add_output(p, pc, pj, law.mu);
                 fc_joint.push(fcj.sqrt());
                 fr_joint.push(frj.sqrt());
                 // x_m* = C f_m − G_m q̈ − Hᵀ p* (the tangential part of p* as in the gaps: the

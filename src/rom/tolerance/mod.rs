@@ -7,8 +7,12 @@
 //! rules are written for ‖f_c‖; ‖f_R‖ and D add **tangential attachment modes**
 //! `K⁻¹ B_{t,k}ᵀ d_k` by the same selection on the tangential shares
 //! `e_{t,k} = Σ_t |p_{t,k} − p_{t,k}*|²` ([`Estimate::pair_tangential_error`]), first in the
-//! pair's main direction of friction, later across it, and only in rounds that add no normal
-//! modes (the friction cone follows the normal force). D, a sum of what each pair dissipates,
+//! pair's main direction of friction, later across it, and in rounds that add no normal modes
+//! (the friction cone follows the normal force). A round that adds normal modes while the
+//! normal part is already within TOL takes tangential modes too, selected by the shares of the
+//! outputs at which the run sticks each pair ([`Estimate::pair_stick_error`]): a stick force
+//! is an elastic stretch, set by the tangential compliance that only tangential modes add.
+//! D, a sum of what each pair dissipates,
 //! has its own rule when neither force rule adds anything: the pairs with the largest shares
 //! `σ_k` of its error ([`Estimate::pair_dissipation_error`]; the shares bound it by their sum)
 //! get their normal attachment mode, or their next tangential one if they hold it already.
@@ -719,7 +723,8 @@ impl Chosen {
     /// docs, "Choosing S"): normal ones while the joint part of the ‖f_c‖ estimate (or of u_y)
     /// exceeds its share and a controlled quantity depends on the normal forces, tangential ones
     /// while the joint part of the ‖f_R‖ estimate exceeds its share and ‖f_R‖ or D is
-    /// controlled. Returns whether anything was added, and whether that is all the estimate
+    /// controlled — in a round that adds normal ones only those the stick shares ask for, and
+    /// only once the normal part is within `tol`. Returns whether anything was added, and whether that is all the estimate
     /// asked for (no cap cut the selection, no tangential modes wait for the normal ones).
     fn enrich(
         &mut self,
@@ -759,25 +764,17 @@ impl Chosen {
                 complete = all && !wants_tangential;
             }
         }
-        // The cone of a pair's friction force is μ|p_n|: while the normal forces are being
-        // corrected, the tangential errors are theirs, so tangential modes wait for them.
+        // The cone of a sliding pair's friction force is μ|p_n|: while the normal forces are
+        // being corrected, the errors of the sliding friction forces are theirs, so tangential
+        // modes wait for them. A sticking pair's force is its elastic stretch, which the
+        // tangential compliance at the pair sets and normal modes do not add: once the normal
+        // forces are within the tolerance (and so their coupling into the stick forces), the
+        // stick part of the tangential shares joins the round.
+        if changed && wants_tangential && d.joint.unwrap_or(f64::INFINITY) <= tol {
+            self.add_tangential(d, &d.pair_stick_error, tol, cb_size);
+        }
         if !changed && wants_tangential {
-            let tangential = &self.tangential;
-            let held = |k: usize| tangential.iter().filter(|&&j| j == k).count();
-            if let Some((add, all)) = more_pairs(
-                &d.pair_tangential_error,
-                d.corrected_joint_friction_norm2,
-                |k| held(k) >= 2,
-                tol,
-                self.tangential.len().max(cb_size),
-            ) {
-                let first: Vec<bool> = add.iter().map(|&k| held(k) == 0).collect();
-                for (k, first) in add.into_iter().zip(first) {
-                    let main = main_direction(d.pair_tangential_moment[k]);
-                    self.directions
-                        .push(if first { main } else { [-main[1], main[0]] });
-                    self.tangential.push(k);
-                }
+            if let Some(all) = self.add_tangential(d, &d.pair_tangential_error, tol, cb_size) {
                 changed = true;
                 complete = all;
             }
@@ -821,6 +818,36 @@ impl Chosen {
             }
         }
         Enriched { changed, complete }
+    }
+
+    /// Adds the tangential attachment modes that the tangential shares `shares` (per pair, N²,
+    /// against the joint-only correction's `Σ_t ‖p_t*‖²`) ask for, by the rule of the normal
+    /// ones: a pair's main direction of friction first, the direction across it in a later
+    /// round. Returns whether anything was added and whether that is all the shares ask for.
+    fn add_tangential(
+        &mut self,
+        d: &crate::reduction::Estimate,
+        shares: &[f64],
+        tol: f64,
+        cb_size: usize,
+    ) -> Option<bool> {
+        let tangential = &self.tangential;
+        let held = |k: usize| tangential.iter().filter(|&&j| j == k).count();
+        let (add, all) = more_pairs(
+            shares,
+            d.corrected_joint_friction_norm2,
+            |k| held(k) >= 2,
+            tol,
+            self.tangential.len().max(cb_size),
+        )?;
+        let first: Vec<bool> = add.iter().map(|&k| held(k) == 0).collect();
+        for (k, first) in add.into_iter().zip(first) {
+            let main = main_direction(d.pair_tangential_moment[k]);
+            self.directions
+                .push(if first { main } else { [-main[1], main[0]] });
+            self.tangential.push(k);
+        }
+        Some(all)
     }
 }
 
