@@ -42,35 +42,146 @@ pub fn mul_t_add_row_major(a: &[f64], p: &[f64], y: &mut [f64]) {
     lincomb_rows_add(a, p, y);
 }
 
+/// `y_i = (A x)_i` for the listed rows `i` only (other entries of `y` untouched), `A` (`y.len()`
+/// × `x.len()`) given row-major: the same value, bit for bit, as [`mul_col_major`] gives that
+/// entry from the column-major copy of `A` — the same terms, grouped four at a time in the
+/// same order (`(x₀a₀ + x₁a₁) + (x₂a₂ + x₃a₃)` per group of non-zero `x`, the rest one by one).
+/// For products of which only a few rows are needed.
+///
+/// # Panics
+/// If `a_rows.len() != y.len() · x.len()` or a listed row is out of range.
+pub fn mul_rows_listed(a_rows: &[f64], x: &[f64], rows: &[usize], y: &mut [f64]) {
+    let n = x.len();
+    assert_eq!(a_rows.len(), n * y.len(), "mul_rows_listed: matrix size");
+    if x.iter().all(|&v| v != 0.0) {
+        // Every term present: the groups are the consecutive fours.
+        rows_listed_dense(a_rows, x, rows, y);
+        return;
+    }
+    for &i in rows {
+        let a = &a_rows[i * n..i * n + n];
+        let mut acc = 0.0;
+        let mut idx = [0usize; 4];
+        let mut len = 0;
+        for (j, &xj) in x.iter().enumerate() {
+            if xj == 0.0 {
+                continue;
+            }
+            idx[len] = j;
+            len += 1;
+            if len == 4 {
+                let [j0, j1, j2, j3] = idx;
+                acc += (x[j0] * a[j0] + x[j1] * a[j1]) + (x[j2] * a[j2] + x[j3] * a[j3]);
+                len = 0;
+            }
+        }
+        for &j in &idx[..len] {
+            acc += x[j] * a[j];
+        }
+        y[i] = acc;
+    }
+}
+
+/// [`mul_rows_listed`] for an `x` without zeros.
+#[multiversion::multiversion(targets("x86_64+avx512f+avx512vl", "x86_64+avx2+fma"))]
+fn rows_listed_dense(a_rows: &[f64], x: &[f64], rows: &[usize], y: &mut [f64]) {
+    let n = x.len();
+    let (xc, xr) = x.split_at(n - n % 4);
+    for &i in rows {
+        let a = &a_rows[i * n..i * n + n];
+        let (ac, ar) = a.split_at(xc.len());
+        let mut acc = 0.0;
+        for (xs, as_) in xc.chunks_exact(4).zip(ac.chunks_exact(4)) {
+            acc += (xs[0] * as_[0] + xs[1] * as_[1]) + (xs[2] * as_[2] + xs[3] * as_[3]);
+        }
+        for (xj, aj) in xr.iter().zip(ar) {
+            acc += xj * aj;
+        }
+        y[i] = acc;
+    }
+}
+
 /// `y += Σ_i s_i a_i` over the rows `a_i` (length `y.len()`) of the row-major `a`, `s_i ≠ 0`.
+///
+/// The non-zero factors are taken four at a time in index order (a *group*), the last one to
+/// three one by one; each entry of `y` gets `(s₀a₀ + s₁a₁) + (s₂a₂ + s₃a₃)` per group in that
+/// order. The groups are collected first (up to [`GROUPS`] at a time) and applied to blocks of
+/// [`BLOCK`] entries of `y` held in registers across all of them, so that `y` is read and
+/// written once per block instead of once per group: the same operations per entry, in the
+/// same order, as one pass per group.
 #[multiversion::multiversion(targets("x86_64+avx512f+avx512vl", "x86_64+avx2+fma"))]
 fn lincomb_rows_add(a: &[f64], p: &[f64], y: &mut [f64]) {
     let n = y.len();
     if n == 0 {
         return;
     }
-    let mut idx = [0usize; 4];
+    // Indices written in place (copying a group of four written one by one would stall on
+    // store forwarding).
+    let mut groups = [[0usize; 4]; GROUPS];
+    let mut ng = 0;
     let mut len = 0;
     for (i, &pi) in p.iter().enumerate() {
         if pi == 0.0 {
             continue;
         }
-        idx[len] = i;
+        groups[ng][len] = i;
         len += 1;
         if len == 4 {
-            let row = |k: usize| &a[idx[k] * n..idx[k] * n + n];
-            let (r0, r1, r2, r3) = (row(0), row(1), row(2), row(3));
-            let s = [p[idx[0]], p[idx[1]], p[idx[2]], p[idx[3]]];
-            for ((((o, a0), a1), a2), a3) in y.iter_mut().zip(r0).zip(r1).zip(r2).zip(r3) {
-                *o += (s[0] * a0 + s[1] * a1) + (s[2] * a2 + s[3] * a3);
-            }
+            ng += 1;
             len = 0;
+            if ng == GROUPS {
+                apply_groups(a, p, &groups, y);
+                ng = 0;
+            }
         }
     }
-    for &i in &idx[..len] {
+    apply_groups(a, p, &groups[..ng], y);
+    let rest = groups[ng];
+    for &i in &rest[..len] {
         let s = p[i];
         for (o, v) in y.iter_mut().zip(&a[i * n..i * n + n]) {
             *o += s * v;
+        }
+    }
+}
+
+/// Groups collected before they are applied ([`lincomb_rows_add`]).
+const GROUPS: usize = 16;
+
+/// Entries of `y` held in registers while the groups are applied ([`lincomb_rows_add`]).
+const BLOCK: usize = 32;
+
+/// `y += (s₀a₀ + s₁a₁) + (s₂a₂ + s₃a₃)` for each group of four rows in turn, block by block.
+#[inline(always)]
+fn apply_groups(a: &[f64], p: &[f64], groups: &[[usize; 4]], y: &mut [f64]) {
+    let n = y.len();
+    if groups.is_empty() {
+        return;
+    }
+    let mut start = 0;
+    while start + BLOCK <= n {
+        let mut acc = [0.0f64; BLOCK];
+        acc.copy_from_slice(&y[start..start + BLOCK]);
+        for g in groups {
+            let row = |k: usize| &a[g[k] * n + start..g[k] * n + start + BLOCK];
+            let (r0, r1, r2, r3) = (row(0), row(1), row(2), row(3));
+            let s = [p[g[0]], p[g[1]], p[g[2]], p[g[3]]];
+            for k in 0..BLOCK {
+                acc[k] += (s[0] * r0[k] + s[1] * r1[k]) + (s[2] * r2[k] + s[3] * r3[k]);
+            }
+        }
+        y[start..start + BLOCK].copy_from_slice(&acc);
+        start += BLOCK;
+    }
+    if start < n {
+        let tail = &mut y[start..];
+        for g in groups {
+            let row = |k: usize| &a[g[k] * n + start..g[k] * n + n];
+            let (r0, r1, r2, r3) = (row(0), row(1), row(2), row(3));
+            let s = [p[g[0]], p[g[1]], p[g[2]], p[g[3]]];
+            for ((((o, a0), a1), a2), a3) in tail.iter_mut().zip(r0).zip(r1).zip(r2).zip(r3) {
+                *o += (s[0] * a0 + s[1] * a1) + (s[2] * a2 + s[3] * a3);
+            }
         }
     }
 }
@@ -111,6 +222,88 @@ mod tests {
                         (got - want).abs() <= 1e-11 * (1.0 + want.abs()),
                         "{m}x{n} t"
                     );
+                }
+            }
+        }
+    }
+
+    /// One pass over `y` per group of four non-zero factors: the order every entry's terms
+    /// must keep.
+    fn one_pass_per_group(a: &[f64], p: &[f64], y: &mut [f64]) {
+        let n = y.len();
+        let nz: Vec<usize> = (0..p.len()).filter(|&i| p[i] != 0.0).collect();
+        let mut chunks = nz.chunks_exact(4);
+        for g in &mut chunks {
+            for (j, o) in y.iter_mut().enumerate() {
+                let t = |k: usize| p[g[k]] * a[g[k] * n + j];
+                *o += (t(0) + t(1)) + (t(2) + t(3));
+            }
+        }
+        for &i in chunks.remainder() {
+            for (j, o) in y.iter_mut().enumerate() {
+                *o += p[i] * a[i * n + j];
+            }
+        }
+    }
+
+    #[test]
+    fn blocked_sum_keeps_the_order_of_one_pass_per_group() {
+        // Up to 300 factors (more groups than are collected at once), y shorter and longer
+        // than a block.
+        for m in [3, 4, 9, 300] {
+            for n in [1, 7, 31, 32, 33, 70, 156] {
+                let (a, _) = data(m, n);
+                let p: Vec<f64> = (0..m)
+                    .map(|i| {
+                        if i % 7 == 3 {
+                            0.0
+                        } else {
+                            (i as f64 - 4.5) / 3.0
+                        }
+                    })
+                    .collect();
+                let y0: Vec<f64> = (0..n).map(|j| (j as f64).sin()).collect();
+                let (mut got, mut want) = (y0.clone(), y0);
+                mul_t_add_row_major(&a, &p, &mut got);
+                one_pass_per_group(&a, &p, &mut want);
+                for j in 0..n {
+                    assert_eq!(got[j].to_bits(), want[j].to_bits(), "{m}x{n} entry {j}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn listed_rows_are_bit_identical_to_the_full_product() {
+        for m in [1, 5, 156] {
+            for n in [1, 3, 4, 9, 38] {
+                for zeros in [false, true] {
+                    let (a, mut x) = data(m, n);
+                    x.iter_mut().for_each(|v| {
+                        if *v == 0.0 {
+                            *v = 0.5
+                        }
+                    });
+                    // Zeros in x change the grouping: every fifth one.
+                    if zeros {
+                        x.iter_mut().step_by(5).for_each(|v| *v = 0.0);
+                    }
+                    let mut full = vec![0.0; m];
+                    mul_col_major(&a, &x, &mut full);
+                    let rows_major: Vec<f64> = (0..m)
+                        .flat_map(|i| (0..n).map(move |j| (i, j)))
+                        .map(|(i, j)| a[j * m + i])
+                        .collect();
+                    let rows: Vec<usize> = (0..m).filter(|i| i % 3 != 1).collect();
+                    let mut got = vec![f64::NAN; m];
+                    mul_rows_listed(&rows_major, &x, &rows, &mut got);
+                    for i in 0..m {
+                        if rows.contains(&i) {
+                            assert_eq!(got[i].to_bits(), full[i].to_bits(), "{m}x{n} row {i}");
+                        } else {
+                            assert!(got[i].is_nan(), "{m}x{n} row {i} touched");
+                        }
+                    }
                 }
             }
         }
