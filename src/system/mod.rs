@@ -63,6 +63,16 @@ impl Scene {
     }
 }
 
+/// One kind of row of the joint operator `B` (rows normal, t1, t2 per pair):
+/// [`SecondOrderSystem::joint_apply_rows_into`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum JointRows {
+    /// The normal rows `3z` (the gaps).
+    Normal,
+    /// The tangential rows `3z + 1`, `3z + 2`.
+    Tangential,
+}
+
 /// A linear undamped second-order system with joint pairs.
 pub trait SecondOrderSystem {
     /// Number of coordinates (n full, r reduced).
@@ -119,6 +129,22 @@ pub trait SecondOrderSystem {
         for &z in pairs {
             out[3 * z..3 * z + 3].copy_from_slice(&self.joint_pair(q, z));
         }
+    }
+    /// Parts of `out = B q` where only some rows are needed, with the same values, bit for
+    /// bit, as [`SecondOrderSystem::joint_apply_into`] gives those entries: the rows of one
+    /// kind for every pair if `all` names one ([`JointRows`]), written through `scratch` (2w
+    /// entries), then the listed rows `extra` (indices into `out`). The other entries of `out` are left as they are. `false` (the
+    /// default) if the system does not offer it: nothing is written, and the caller takes the
+    /// whole product. A reduced model offers it: its dense `B q` costs 3w·r per product.
+    fn joint_apply_rows_into(
+        &self,
+        _q: &[f64],
+        _all: Option<JointRows>,
+        _extra: &[usize],
+        _scratch: &mut [f64],
+        _out: &mut [f64],
+    ) -> bool {
+        false
     }
     /// `out += Σ_{z ∈ pairs} B_zᵀ p_z` (the rows of the other pairs are skipped).
     fn joint_transpose_add_pairs(&self, p: &[f64], pairs: &[usize], out: &mut [f64]) {

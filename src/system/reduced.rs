@@ -28,7 +28,7 @@ use faer::linalg::matmul::matmul;
 use faer::{Accum, Col, Conj, Mat, MatMut, Par};
 
 use super::modal_newton::{modal_diagonal, ModalNewton};
-use super::SecondOrderSystem;
+use super::{JointRows, SecondOrderSystem};
 use crate::case::LoadSpec;
 use crate::error::{Error, SystemError};
 use crate::joint::JointOperator;
@@ -68,6 +68,11 @@ pub struct ReducedSystem {
     m_cols: Vec<f64>,
     b_cols: Vec<f64>,
     b_rows: Vec<f64>,
+    /// `BΦ`'s normal rows (w × r) and tangential rows (2w × r, t1 and t2 of each pair in
+    /// turn), each column by column: the products of one kind of row
+    /// ([`SecondOrderSystem::joint_apply_rows_into`]).
+    bn_cols: Vec<f64>,
+    bt_cols: Vec<f64>,
     /// Rows of Φ at the six master DOF (6 × r: ux, uy, uz (mm), rx, ry, rz (rad) per unit).
     pub phi_master: Mat<f64>,
     /// The Euclidean norm of each basis column over the full model's DOF (mm or rad per unit
@@ -105,6 +110,16 @@ fn row_major(a: &Mat<f64>) -> Vec<f64> {
     let mut out = Vec::with_capacity(a.nrows() * a.ncols());
     for i in 0..a.nrows() {
         out.extend((0..a.ncols()).map(|j| a[(i, j)]));
+    }
+    out
+}
+
+/// The rows `i` of a dense matrix with `keep(i)`, as one matrix, column by column.
+fn col_major_rows(a: &Mat<f64>, keep: impl Fn(usize) -> bool) -> Vec<f64> {
+    let rows: Vec<usize> = (0..a.nrows()).filter(|&i| keep(i)).collect();
+    let mut out = Vec::with_capacity(rows.len() * a.ncols());
+    for j in 0..a.ncols() {
+        out.extend(rows.iter().map(|&i| a[(i, j)]));
     }
     out
 }
@@ -304,6 +319,8 @@ impl ReducedSystem {
             m_cols: col_major(&m),
             b_cols: col_major(&b_phi),
             b_rows: row_major(&b_phi),
+            bn_cols: col_major_rows(&b_phi, |i| i % 3 == 0),
+            bt_cols: col_major_rows(&b_phi, |i| i % 3 != 0),
             k,
             m,
             m_identity,
@@ -378,6 +395,8 @@ impl Clone for ReducedSystem {
             m_cols: self.m_cols.clone(),
             b_cols: self.b_cols.clone(),
             b_rows: self.b_rows.clone(),
+            bn_cols: self.bn_cols.clone(),
+            bt_cols: self.bt_cols.clone(),
             phi_master: self.phi_master.clone(),
             error_scale: self.error_scale.clone(),
             load: self.load.clone(),
@@ -446,6 +465,33 @@ impl SecondOrderSystem for ReducedSystem {
     fn joint_transpose_add(&self, p: &[f64], out: &mut [f64]) {
         kernels::mul_t_add_row_major(&self.b_rows, p, out);
     }
+    fn joint_apply_rows_into(
+        &self,
+        q: &[f64],
+        all: Option<JointRows>,
+        extra: &[usize],
+        scratch: &mut [f64],
+        out: &mut [f64],
+    ) -> bool {
+        let w = self.pairs();
+        // The same column grouping per entry as the whole product (`kernels`): same bits.
+        if all == Some(JointRows::Normal) {
+            let g = &mut scratch[..w];
+            kernels::mul_col_major(&self.bn_cols, q, g);
+            for (z, &v) in g.iter().enumerate() {
+                out[3 * z] = v;
+            }
+        } else if all == Some(JointRows::Tangential) {
+            let t = &mut scratch[..2 * w];
+            kernels::mul_col_major(&self.bt_cols, q, t);
+            for z in 0..w {
+                out[3 * z + 1] = t[2 * z];
+                out[3 * z + 2] = t[2 * z + 1];
+            }
+        }
+        kernels::mul_rows_listed(&self.b_rows, q, extra, out);
+        true
+    }
     fn joint_normal_row_norms(&self) -> Option<Vec<f64>> {
         let r = self.r;
         Some(
@@ -494,9 +540,14 @@ impl SecondOrderSystem for ReducedSystem {
                 return Ok(());
             }
         }
+        // M̃ + γ² K̃ column by column from the contiguous copies.
         for j in 0..r {
-            for i in 0..r {
-                self.newton[(i, j)] = self.m[(i, j)] + g2 * self.k[(i, j)];
+            let (m, k) = (
+                &self.m_cols[j * r..j * r + r],
+                &self.k_cols[j * r..j * r + r],
+            );
+            for ((o, mi), ki) in self.newton.col_mut(j).iter_mut().zip(m).zip(k) {
+                *o = mi + g2 * ki;
             }
         }
         // γ² (BΦ)ᵀ K_c (BΦ) over the pairs with a non-zero block, as one matrix product of the
