@@ -233,7 +233,7 @@ use crate::case::ContactSpec;
 use crate::error::{Error, IntegrationError};
 use crate::integrate::problem::{CallbackError, OdeProblem};
 use crate::joint::law::{evaluate_listed_pairs, evaluate_pairs, PairLaw, PairState, DEFAULT_TAU};
-use crate::system::SecondOrderSystem;
+use crate::system::{JointRows, SecondOrderSystem};
 
 mod newton;
 mod refresh;
@@ -394,6 +394,13 @@ pub struct MechanicalOde<S: SecondOrderSystem> {
     live: Vec<usize>,
     /// Pair screening, if on.
     screen: Option<screen::PairScreen>,
+    /// The time of the load in `f` (NaN: none): a Newton solve at the time of the last
+    /// right-hand side reuses it.
+    f_time: f64,
+    /// Rows of `B` a product needs beyond one kind of row for every pair (scratch, capacity
+    /// 3w; [`SecondOrderSystem::joint_apply_rows_into`]) and that product's scratch (2w).
+    rows: Vec<usize>,
+    rows_scratch: Vec<f64>,
     /// Slip-memory offsets (2w with friction, mm): the memory (`s`, or `e` with `stretch`) is
     /// `slip_scale · state + offset`, zero unless a pair joined the screened set ([`screen`]).
     offset: Vec<f64>,
@@ -490,6 +497,9 @@ impl<S: SecondOrderSystem> MechanicalOde<S> {
             live: (0..w).collect(),
             screen,
             offset: vec![0.0; if opts.friction { 2 * w } else { 0 }],
+            f_time: f64::NAN,
+            rows: Vec::with_capacity(3 * w),
+            rows_scratch: vec![0.0; 2 * w],
             sys,
         })
     }
@@ -516,6 +526,7 @@ impl<S: SecondOrderSystem> MechanicalOde<S> {
             }
             .into());
         }
+        self.f_time = f64::NAN;
         if scale == 1.0 && master.iter().all(|&v| v == 0.0) {
             self.load_hook = None;
             return Ok(());
@@ -546,6 +557,15 @@ impl<S: SecondOrderSystem> MechanicalOde<S> {
             for (fi, e) in self.f.iter_mut().zip(&h.forces) {
                 *fi = h.scale * *fi + e;
             }
+        }
+        self.f_time = t;
+    }
+
+    /// `self.f = f(t)`, unless it already holds the load at `t` (a Newton solve at the time
+    /// of the last right-hand side).
+    fn load_at(&mut self, t: f64) {
+        if self.f_time != t {
+            self.total_load_into_f(t);
         }
     }
 
@@ -608,6 +628,40 @@ impl<S: SecondOrderSystem> MechanicalOde<S> {
                 }
             }
         }
+    }
+
+    /// `u = B q` for [`MechanicalOde::sample`]: every row, or, where the system offers it
+    /// and no screen is on, the normal rows and the tangential rows of the closed pairs only
+    /// (an open pair's force and stored energy do not depend on them; same values).
+    fn apply_for_sample(&mut self, q: &[f64]) {
+        if self.screen.is_none() && !self.stretch {
+            let mut rows = std::mem::take(&mut self.rows);
+            rows.clear();
+            let done = self.sys.joint_apply_rows_into(
+                q,
+                Some(JointRows::Normal),
+                &rows,
+                &mut self.rows_scratch,
+                &mut self.u,
+            );
+            if done {
+                for k in 0..self.w {
+                    if self.u[3 * k] < 0.0 {
+                        rows.extend([3 * k + 1, 3 * k + 2]);
+                    } else {
+                        self.u[3 * k + 1] = 0.0;
+                        self.u[3 * k + 2] = 0.0;
+                    }
+                }
+                self.sys
+                    .joint_apply_rows_into(q, None, &rows, &mut self.rows_scratch, &mut self.u);
+            }
+            self.rows = rows;
+            if done {
+                return;
+            }
+        }
+        self.sys.joint_apply_into(q, &mut self.u);
     }
 
     /// `u = B q` on the live pairs (all pairs without screening).
@@ -701,7 +755,7 @@ impl<S: SecondOrderSystem> MechanicalOde<S> {
         let (q, rest) = y.split_at(n);
         let (v, rest) = rest.split_at(n);
         let rest = &rest[self.ns()..];
-        self.sys.joint_apply_into(q, &mut self.u);
+        self.apply_for_sample(q);
         self.load_slip(y);
         if self.screen.is_some() && self.law.friction {
             // An untracked pair is open, its memory its tangential displacement.

@@ -5,7 +5,7 @@
 use super::{dot, MechanicalOde, PairLin};
 use crate::integrate::problem::CallbackError;
 use crate::joint::law::PairState;
-use crate::system::SecondOrderSystem;
+use crate::system::{JointRows, SecondOrderSystem};
 
 impl<S: SecondOrderSystem> MechanicalOde<S> {
     /// The pair tangents at the kinematics in `u` and the slip memory in `s_phys` (loaded by
@@ -43,6 +43,7 @@ impl<S: SecondOrderSystem> MechanicalOde<S> {
 
     /// Pair k's kinematics `[g, u_t1, u_t2]` in `u` and slip memory in `s_phys` (zero with
     /// friction off), mm.
+    #[inline(always)]
     pub(super) fn pair_kinematics(&self, k: usize) -> ([f64; 3], [f64; 2]) {
         let uk = [self.u[3 * k], self.u[3 * k + 1], self.u[3 * k + 2]];
         let sk = if self.law.friction {
@@ -188,18 +189,49 @@ impl<S: SecondOrderSystem> MechanicalOde<S> {
         if fr {
             // Untracked pairs: frozen memory, zero Jacobian rows (`c = r_s`).
             zs.copy_from_slice(rs);
-            self.apply_live(za);
+            self.apply_for_corrections(za);
             if self.stretch {
                 self.stretch_corrections(rs, zs, g, &mut zd);
             } else {
                 self.slip_corrections(rs, zs, g, &mut zd);
             }
         }
-        self.total_load_into_f(t);
+        self.load_at(t);
         ze[0] = rest[0] + g * dot(&self.f, zb) / self.e_scale;
         ze[1] = zd / self.e_scale;
         // Checked by the CVODE trampoline, as the right-hand side.
         Ok(())
+    }
+
+    /// `u = B a` for the slip states' corrections ([`MechanicalOde::slip_corrections`]): on
+    /// the live pairs, or, where the system offers it and neither screening nor the stretch
+    /// states are on, the tangential rows of every pair and the normal rows of the sliding
+    /// ones only — the normal row enters through `∂ṡ/∂g` and `∂d/∂g`, zero on the open and
+    /// stuck branches (their entries are set to 0). The same values.
+    fn apply_for_corrections(&mut self, a: &[f64]) {
+        if self.screen.is_none() && !self.stretch {
+            let mut rows = std::mem::take(&mut self.rows);
+            rows.clear();
+            for k in 0..self.w {
+                if self.branch[k] == PairState::Slip {
+                    rows.push(3 * k);
+                } else {
+                    self.u[3 * k] = 0.0;
+                }
+            }
+            let done = self.sys.joint_apply_rows_into(
+                a,
+                Some(JointRows::Tangential),
+                &rows,
+                &mut self.rows_scratch,
+                &mut self.u,
+            );
+            self.rows = rows;
+            if done {
+                return;
+            }
+        }
+        self.apply_live(a);
     }
 
     /// The slip states' corrections of a Newton solve, given `u = B a` on the live pairs:
