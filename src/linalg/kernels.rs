@@ -16,7 +16,13 @@
 //!
 //! The summation order is fixed (rows in index order, four at a time, `(s₀a₀ + s₁a₁) + (s₂a₂ +
 //! s₃a₃)` per block), so results do not depend on the machine's vector width; compiled for
-//! AVX-512 and AVX2 + FMA as well and dispatched once per call.
+//! AVX-512 and AVX2 + FMA as well and dispatched once per call. The groups are applied to 32
+//! entries of `y` at a time held in registers (one load and store of `y` per product instead of
+//! one per group; the same order per entry), and [`mul_rows_listed`] gives single rows of
+//! `A x` with the same order, bit for bit: a caller that needs only some rows of a product
+//! (the reduced model's Newton solve and outputs) gets the values the whole product would.
+//! At the friction bar's sizes (156 × 38, ~47 kB) a product streams its matrix from L2: its
+//! cost is the bytes it reads, so the rows not needed are the ones worth skipping.
 
 /// `y = A x` for a column-major `A` (`x.len()` contiguous columns of `y.len()` entries).
 ///

@@ -52,6 +52,16 @@
 //! iteration corrects. `z_W = r_W + γ f(t)·b` and `z_D = r_D + γ ∇D'·[a; c]` are exact
 //! (`newton`).
 //!
+//! The corrections `c` read `B a` through `D_s`, `φ_g` and `∂d/∂(g, u_t)` only: on an open pair
+//! `D_s = I/τ` and the rest vanish, on a stuck one all of them vanish, and only a sliding pair
+//! needs its normal row. Where the system offers products of selected rows
+//! ([`SecondOrderSystem::joint_apply_rows_into`], the reduced model's dense `BΦ`, whose
+//! products stream the matrix and cost what they read) the solve forms the tangential rows of
+//! every pair and the normal rows of the sliding ones, and an output sample the normal rows and
+//! the closed pairs' tangential rows (an open pair's force and stored energy read its gap
+//! alone) — the values the whole product gives those entries, bit for bit. The right-hand
+//! side needs every row: an open pair's memory follows its tangential displacement.
+//!
 //! ## Active-set refresh
 //!
 //! CVODE's Newton iteration is a *modified* Newton: the matrix above is factored at a setup
