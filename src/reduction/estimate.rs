@@ -190,10 +190,13 @@ pub struct JointFlexibility {
     c: Mat<f64>,
     /// Normal penalty stiffness of the model's contact law, N/mm.
     k_n: f64,
-    /// The lowest [`TRUNCATION_MODES`] fixed-interface modes (n × count, M-orthonormal, zero at
-    /// the master), for the truncation part of the estimate: computed on first use
-    /// ([`JointFlexibility::truncation_modes`]).
+    /// The lowest fixed-interface modes (n × count, M-orthonormal, zero at the master) for the
+    /// truncation part of the estimate: computed on first use
+    /// ([`JointFlexibility::truncation_modes`]), again with more when more are asked for.
     modes: Mutex<Option<Arc<Mat<f64>>>>,
+    /// How many truncated modes the estimate holds: [`TRUNCATION_MODES`], or more once a
+    /// basis's ν needs them ([`JointFlexibility::hold_truncation_modes`]).
+    held: std::sync::atomic::AtomicUsize,
     /// The model's fixed-interface problem with its factorization, if shared
     /// ([`JointFlexibility::share_fixed_interface`]): the truncated modes are then solved with
     /// it instead of a factorization of their own.
@@ -209,8 +212,21 @@ pub struct JointFlexibility {
 }
 
 /// Fixed-interface modes computed for the truncation part of the estimate (module docs): the
-/// modes of these beyond a basis's span are the ones whose dynamics it checks.
+/// modes of these beyond a basis's span are the ones whose dynamics it checks. At least this
+/// many; a basis of ν fixed-interface modes has [`truncated_modes_for`]`(ν)` held.
 pub const TRUNCATION_MODES: usize = 40;
+
+/// Fixed-interface modes the estimate checks beyond a basis's ν once ν is past
+/// `TRUNCATION_MODES − TRUNCATION_BEYOND`.
+pub const TRUNCATION_BEYOND: usize = 20;
+
+/// The truncated modes held for a basis of `nu` fixed-interface modes: the lowest
+/// [`TRUNCATION_MODES`], or `nu + TRUNCATION_BEYOND` when that is more — a scene whose motion
+/// needs many fixed-interface modes (impacts in the joint ring up modes far above the load's)
+/// keeps having the modes beyond its ν checked.
+pub fn truncated_modes_for(nu: usize) -> usize {
+    TRUNCATION_MODES.max(nu + TRUNCATION_BEYOND)
+}
 
 /// Refinement steps (double-double residuals) of the flexibility columns and the friction
 /// term: one, where the basis vectors take two (the pair-space statics still equal the full
@@ -254,6 +270,7 @@ impl JointFlexibility {
             c,
             k_n: model.contact.normal_stiffness,
             modes: Mutex::new(None),
+            held: std::sync::atomic::AtomicUsize::new(TRUNCATION_MODES),
             fixed: std::sync::OnceLock::new(),
             columns: Mutex::new(vec![None; model.joint.rows()]),
             tangential: Mutex::new(vec![None; model.joint.rows()]),
@@ -529,9 +546,17 @@ impl JointFlexibility {
         let _ = self.fixed.set(fixed);
     }
 
-    /// The [`TRUNCATION_MODES`] lowest fixed-interface modes (n × m, zero at the master DOF),
-    /// computed on first use: only the transient estimate needs them (not the pair-space
-    /// statics), and its first use is on the second core beside a reduced run
+    /// Holds at least `count` truncated modes from the next estimator on (the set only grows;
+    /// [`truncated_modes_for`]).
+    pub fn hold_truncation_modes(&self, count: usize) {
+        self.held
+            .fetch_max(count, std::sync::atomic::Ordering::Relaxed);
+    }
+
+    /// The lowest fixed-interface modes the estimate holds ([`TRUNCATION_MODES`], or more after
+    /// [`JointFlexibility::hold_truncation_modes`]; n × m, zero at the master DOF), computed on
+    /// first use: only the transient estimate needs them (not the pair-space statics), and its
+    /// first use is on the second core beside a reduced run
     /// ([`crate::rom::estimate::run_estimated`]).
     pub(crate) fn truncation_modes(&self, model: &Model) -> Result<Arc<Mat<f64>>, Error> {
         // Not held while computing: the modes' solves may run on rayon's pool, and a worker
@@ -543,11 +568,14 @@ impl JointFlexibility {
                 .lock()
                 .unwrap_or_else(std::sync::PoisonError::into_inner)
         };
-        if let Some(m) = slot().as_ref() {
+        let n = self.stiffness.n;
+        let count = self
+            .held
+            .load(std::sync::atomic::Ordering::Relaxed)
+            .min(n.saturating_sub(6) / 2);
+        if let Some(m) = slot().as_ref().filter(|m| m.ncols() >= count) {
             return Ok(Arc::clone(m));
         }
-        let n = self.stiffness.n;
-        let count = TRUNCATION_MODES.min(n.saturating_sub(6) / 2);
         let modes = if count > 0 {
             let fixed = match self.fixed.get() {
                 Some(shared) if shared.dofs() + 6 == n => shared.modes(count)?,
@@ -564,7 +592,11 @@ impl JointFlexibility {
         } else {
             Mat::zeros(n, 0)
         };
-        Ok(Arc::clone(slot().get_or_insert_with(|| Arc::new(modes))))
+        let mut held = slot();
+        match held.as_ref() {
+            Some(m) if m.ncols() >= modes.ncols() => Ok(Arc::clone(m)),
+            _ => Ok(Arc::clone(held.insert(Arc::new(modes)))),
+        }
     }
 
     /// The basis Φ of `rom` if an estimator of it can be built on this flexibility: `rom`

@@ -68,7 +68,8 @@
 //! added: the model keeps only the joint directions the scene uses. The estimate's truncation
 //! part (the dynamics of the fixed-interface modes beyond ν) is not removed by pairs: when it
 //! exceeds θ·TOL once the joint part is within its share, ν grows by [`NU_STEP`] (up to
-//! `TRUNCATION_MODES − NU_STEP`). The truncated modes are driven by the run's own contact forces,
+//! [`MAX_NU`]; the estimate then holds [`truncated_modes_for`]`(ν)` modes, so that the modes
+//! beyond every ν are checked). The truncated modes are driven by the run's own contact forces,
 //! so while those are wrong the truncation part is inflated by orders of magnitude: growing ν in
 //! the same round as the pairs would make every model [`NU_STEP`] columns larger for nothing.
 //! The rounds' e_k come from the joint part alone, so truncation does not masquerade as pair
@@ -112,7 +113,7 @@ use crate::error::{Error, RomError};
 use crate::integrate::{Run, TransientOptions};
 use crate::joint::statics::ContactOptions;
 use crate::model::Model;
-use crate::reduction::estimate::TRUNCATION_MODES;
+use crate::reduction::estimate::{truncated_modes_for, TRUNCATION_BEYOND};
 #[cfg(doc)]
 use crate::reduction::Estimate;
 use crate::reduction::{
@@ -220,7 +221,7 @@ impl ToleranceOptions {
             tolerance,
             nu: 10,
             transient: TransientOptions::default(),
-            max_rounds: 8,
+            max_rounds: 12,
             integration: IntegrationTolerances::FromTolerance,
             quantities: None,
             compress: CompressJoint::Auto,
@@ -502,6 +503,7 @@ pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<Toleran
             if !changed && truncated > part && nu + NU_STEP <= max_nu(model) {
                 nu += NU_STEP;
                 cb = craig_bampton_with(model, nu, &fixed)?;
+                flex.hold_truncation_modes(truncated_modes_for(nu));
                 changed = true;
                 expect_result = true;
             }
@@ -910,13 +912,16 @@ pub const RANKING_LOOSENING: f64 = 10.0;
 /// ν again).
 pub const NU_STEP: usize = 10;
 
-/// The largest ν the enrichment uses: [`TRUNCATION_MODES`] − [`NU_STEP`], so that the estimate
-/// still checks [`NU_STEP`] modes beyond the basis.
+/// The largest ν the enrichment uses: [`MAX_NU`], and no more than leaves the estimate
+/// [`TRUNCATION_BEYOND`] modes to check beyond the basis.
 fn max_nu(model: &Model) -> usize {
-    TRUNCATION_MODES
-        .saturating_sub(NU_STEP)
-        .min(model.dofs().saturating_sub(6) / 2)
+    MAX_NU.min((model.dofs().saturating_sub(6) / 2).saturating_sub(TRUNCATION_BEYOND))
 }
+
+/// The most fixed-interface modes a tolerance model grows to (the estimate then holds
+/// [`truncated_modes_for`]`(ν)` of them): beyond it, the scene's motion is not one a
+/// Craig–Bampton base of the joint's interface reduces well.
+pub const MAX_NU: usize = 100;
 
 /// The reduced system on Craig–Bampton plus the attachment modes of `pairs`.
 pub fn reduced_on_pairs(
