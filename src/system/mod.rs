@@ -133,9 +133,10 @@ pub trait SecondOrderSystem {
     /// Parts of `out = B q` where only some rows are needed, with the same values, bit for
     /// bit, as [`SecondOrderSystem::joint_apply_into`] gives those entries: the rows of one
     /// kind for every pair if `all` names one ([`JointRows`]), written through `scratch` (2w
-    /// entries), then the listed rows `extra` (indices into `out`). The other entries of `out` are left as they are. `false` (the
-    /// default) if the system does not offer it: nothing is written, and the caller takes the
-    /// whole product. A reduced model offers it: its dense `B q` costs 3w·r per product.
+    /// entries), then the listed rows `extra` (indices into `out`). The other entries of `out`
+    /// are left as they are. `false` (the default) if the system does not offer it: nothing is
+    /// written, and the caller takes the whole product. A reduced model offers it: its dense
+    /// `B q` costs 3w·r per product.
     fn joint_apply_rows_into(
         &self,
         _q: &[f64],

@@ -726,8 +726,9 @@ impl Chosen {
     /// exceeds its share and a controlled quantity depends on the normal forces, tangential ones
     /// while the joint part of the ‖f_R‖ estimate exceeds its share and ‖f_R‖ or D is
     /// controlled — in a round that adds normal ones only those the stick shares ask for, and
-    /// only once the normal part is within `tol`. Returns whether anything was added, and whether that is all the estimate
-    /// asked for (no cap cut the selection, no tangential modes wait for the normal ones).
+    /// only once the normal part is within `tol`. Returns whether anything was added, and
+    /// whether that is all the estimate asked for (no cap cut the selection, no tangential
+    /// modes wait for the normal ones).
     fn enrich(
         &mut self,
         estimate: &RunEstimate,
