@@ -136,13 +136,46 @@ impl SymCsc {
 /// its column j, so `y_j = Σ_p a_p x_{row(p)}` over column j — sequential reads, one write per
 /// row, no scattered updates. The same products as [`SymCsc::mul_vec`], summed in column order.
 pub(crate) fn sym_mul_vec_into(a: &SymCsc, x: &[f64], y: &mut [f64]) {
-    for (j, yj) in y.iter_mut().enumerate().take(a.n) {
+    // From −0.0, as `Iterator::sum` of f64 starts (an empty or all −0.0 row stays −0.0).
+    gather_into(a, x, y, -0.0);
+}
+
+/// `y_j = Σ_p a_p x_{row(p)}` over column j of A for every row j (the gather form of `A x`),
+/// each sum sequential from `zero` (0.0 or −0.0) in column order. Four rows go
+/// together: each row's sum is a chain of dependent adds, so one row at a time waits on the
+/// add latency at every entry, while four independent chains overlap. Every row still gets the
+/// same operations in the same order: the same bits as one row at a time.
+fn gather_into(a: &SymCsc, x: &[f64], y: &mut [f64], zero: f64) {
+    let n = a.n.min(y.len());
+    let column = |j: usize| {
         let range = a.col_ptr[j]..a.col_ptr[j + 1];
-        *yj = a.values[range.clone()]
-            .iter()
-            .zip(&a.row_idx[range])
-            .map(|(v, &r)| v * x[r])
-            .sum();
+        (&a.values[range.clone()], &a.row_idx[range])
+    };
+    let mut j = 0;
+    while j + 4 <= n {
+        let cols = [column(j), column(j + 1), column(j + 2), column(j + 3)];
+        let common = cols.iter().map(|c| c.0.len()).min().unwrap_or(0);
+        let mut acc = [zero; 4];
+        for i in 0..common {
+            for (s, (v, r)) in acc.iter_mut().zip(&cols) {
+                *s += v[i] * x[r[i]];
+            }
+        }
+        for (s, (v, r)) in acc.iter_mut().zip(&cols) {
+            for (vi, &ri) in v[common..].iter().zip(&r[common..]) {
+                *s += vi * x[ri];
+            }
+        }
+        y[j..j + 4].copy_from_slice(&acc);
+        j += 4;
+    }
+    for (jj, yj) in y.iter_mut().enumerate().take(n).skip(j) {
+        let (v, r) = column(jj);
+        let mut s = zero;
+        for (vi, &ri) in v.iter().zip(r) {
+            s += vi * x[ri];
+        }
+        *yj = s;
     }
 }
 
@@ -162,14 +195,12 @@ pub(crate) fn sym_mul_mat(a: &SymCsc, y: MatRef<'_, f64>) -> Mat<f64> {
     let p = y.ncols();
     let mut out = Mat::<f64>::zeros(n, p);
     if p == 1 {
-        let x = y.col(0);
-        for (j, o) in out.col_mut(0).iter_mut().enumerate() {
-            let mut acc = 0.0f64;
-            for p in a.col_ptr[j]..a.col_ptr[j + 1] {
-                acc += a.values[p] * x[a.row_idx[p]];
-            }
-            *o = acc;
-        }
+        let col = y.col(0);
+        let x: std::borrow::Cow<'_, [f64]> = match col.try_as_col_major() {
+            Some(c) => c.as_slice().into(),
+            None => col.iter().copied().collect::<Vec<f64>>().into(),
+        };
+        gather_into(a, &x, out.col_as_slice_mut(0), 0.0);
         return out;
     }
     let mut block = vec![[0.0f64; BLOCK]; n];
@@ -199,4 +230,80 @@ pub(crate) fn sym_mul_mat(a: &SymCsc, y: MatRef<'_, f64>) -> Mat<f64> {
         }
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::linalg::random::SplitMix64;
+
+    /// A symmetric pattern whose columns have different lengths (so the four rows of a group
+    /// end at different entries), with values that make the order of a sum matter.
+    fn uneven(n: usize) -> SymCsc {
+        let mut rng = SplitMix64::new(7);
+        let mut dense = vec![vec![None; n]; n];
+        for j in 0..n {
+            dense[j][j] = Some(1.0 + rng.next_signed().abs());
+            for i in 0..j {
+                if rng.next_u64() % (1 + j as u64 % 5) == 0 {
+                    let v = rng.next_signed() * 10f64.powi((rng.next_u64() % 9) as i32 - 4);
+                    dense[i][j] = Some(v);
+                    dense[j][i] = Some(v);
+                }
+            }
+        }
+        let (mut col_ptr, mut row_idx, mut values) = (vec![0], Vec::new(), Vec::new());
+        for j in 0..n {
+            for (i, row) in dense.iter().enumerate() {
+                if let Some(v) = row[j] {
+                    row_idx.push(i);
+                    values.push(v);
+                }
+            }
+            col_ptr.push(row_idx.len());
+        }
+        SymCsc {
+            n,
+            col_ptr,
+            row_idx,
+            values,
+        }
+    }
+
+    #[test]
+    fn gathered_rows_are_the_sequential_sums_bit_for_bit() {
+        for n in [1, 3, 4, 7, 33] {
+            let a = uneven(n);
+            let mut rng = SplitMix64::new(11);
+            let x: Vec<f64> = (0..n).map(|_| rng.next_signed()).collect();
+            for zero in [0.0, -0.0] {
+                let mut y = vec![f64::NAN; n];
+                gather_into(&a, &x, &mut y, zero);
+                for (j, got) in y.iter().enumerate() {
+                    let mut want = zero;
+                    for p in a.col_ptr[j]..a.col_ptr[j + 1] {
+                        want += a.values[p] * x[a.row_idx[p]];
+                    }
+                    assert_eq!(got.to_bits(), want.to_bits(), "n = {n}, row {j}");
+                }
+            }
+            let mut y = vec![f64::NAN; n];
+            sym_mul_vec_into(&a, &x, &mut y);
+            for (j, got) in y.iter().enumerate() {
+                let want: f64 = (a.col_ptr[j]..a.col_ptr[j + 1])
+                    .map(|p| a.values[p] * x[a.row_idx[p]])
+                    .sum();
+                assert_eq!(got.to_bits(), want.to_bits(), "n = {n}, row {j}");
+            }
+            // One column alone has the bits of the same column in a block.
+            let one = sym_mul_mat(&a, Mat::from_fn(n, 1, |i, _| x[i]).as_ref());
+            let two = sym_mul_mat(
+                &a,
+                Mat::from_fn(n, 2, |i, j| x[i] * (j + 1) as f64).as_ref(),
+            );
+            for j in 0..n {
+                assert_eq!(one[(j, 0)].to_bits(), two[(j, 0)].to_bits(), "n = {n}");
+            }
+        }
+    }
 }
