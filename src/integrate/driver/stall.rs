@@ -24,6 +24,18 @@
 //!   (1.1 and 2.5 CPU s for the last two); healthy runs (friction bar and multilayer, full and
 //!   reduced, events off and on) never exceed 1.9 s in one interval, and where their steps grow
 //!   fourfold twice in a row the interval costs well under a second.
+//!
+//! ## The clock
+//!
+//! The thread's CPU clock is a system call (the monotonic clock is read in user space), and a
+//! reduced run reaches an output every 10–40 µs of CPU: read at every output it was
+//! 1 % of a tolerance model's CPU. The watch reads it only once [`CPU_CLOCK_INTERVAL`] of wall
+//! time has passed since its last reading, and otherwise keeps that reading. A thread's CPU
+//! time grows no faster than the wall time, so every mark's CPU time lags its true value by
+//! less than that interval, and a window's or interval's CPU time is off by less than it:
+//! 1 % of the least CPU time either rule acts on.
+
+use std::time::Instant;
 
 use super::thread_cpu_s;
 use crate::integrate::mechanical::DEFAULT_VELOCITY_SCALE;
@@ -45,6 +57,8 @@ pub const COLLAPSE_INTERVALS: usize = 3;
 pub const COLLAPSE_MIN_STEPS: u64 = 1000;
 /// Least CPU time of the last interval of a collapse, s.
 pub const COLLAPSE_MIN_CPU_S: f64 = 1.0;
+/// Wall time between two readings of the thread's CPU clock, s (module docs, "The clock").
+pub const CPU_CLOCK_INTERVAL: f64 = 0.01;
 
 /// Why a run was stopped before its end ([`RunStatus::Stalled`](super::RunStatus::Stalled)).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -76,14 +90,45 @@ struct Mark {
 }
 
 impl Mark {
-    fn now(t: f64, stats: &OdeStats, roots: u64) -> Mark {
+    fn now(t: f64, stats: &OdeStats, roots: u64, cpu: f64) -> Mark {
         Mark {
             t,
             steps: stats.steps,
             error_test_failures: stats.error_test_failures,
             roots,
+            cpu,
+        }
+    }
+}
+
+/// The thread's CPU clock, read at most once per [`CPU_CLOCK_INTERVAL`] of wall time (module
+/// docs, "The clock").
+#[derive(Clone, Copy, Debug)]
+struct CpuClock {
+    /// When it was last read, and what it read (s).
+    read_at: Instant,
+    cpu: f64,
+}
+
+impl CpuClock {
+    fn new() -> CpuClock {
+        CpuClock {
+            read_at: Instant::now(),
             cpu: thread_cpu_s(),
         }
+    }
+
+    /// The thread's CPU time, s: read anew if the last reading is [`CPU_CLOCK_INTERVAL`] old
+    /// (wall time), else that reading.
+    fn now(&mut self) -> f64 {
+        let now = Instant::now();
+        if now.duration_since(self.read_at).as_secs_f64() >= CPU_CLOCK_INTERVAL {
+            *self = CpuClock {
+                read_at: now,
+                cpu: thread_cpu_s(),
+            };
+        }
+        self.cpu
     }
 }
 
@@ -91,6 +136,7 @@ impl Mark {
 #[derive(Clone, Debug)]
 pub(super) struct StallWatch {
     max_order: usize,
+    clock: CpuClock,
     velocity_scale: f64,
     window: Mark,
     /// The marks at the last outputs (at most `COLLAPSE_INTERVALS + 1`).
@@ -103,9 +149,11 @@ pub(super) struct StallWatch {
 
 impl StallWatch {
     pub(super) fn new(t0: f64, max_order: usize, velocity_scale: f64) -> StallWatch {
-        let start = Mark::now(t0, &OdeStats::default(), 0);
+        let clock = CpuClock::new();
+        let start = Mark::now(t0, &OdeStats::default(), 0, clock.cpu);
         StallWatch {
             max_order,
+            clock,
             velocity_scale,
             window: start,
             outputs: vec![start],
@@ -116,12 +164,14 @@ impl StallWatch {
 
     /// At a root: the reason to stop, if the run chatters.
     pub(super) fn at_root(&mut self, t: f64, stats: &OdeStats, roots: u64) -> Option<String> {
-        self.chatter(Mark::now(t, stats, roots))
+        let cpu = self.clock.now();
+        self.chatter(Mark::now(t, stats, roots, cpu))
     }
 
     /// At an output: the reason to stop, if the run chatters or its step collapsed.
     pub(super) fn at_output(&mut self, t: f64, stats: &OdeStats, roots: u64) -> Option<String> {
-        let now = Mark::now(t, stats, roots);
+        let cpu = self.clock.now();
+        let now = Mark::now(t, stats, roots, cpu);
         if let Some(reason) = self.chatter(now) {
             return Some(reason);
         }
@@ -235,6 +285,7 @@ mod tests {
         let start = mark(0.0, 0, 0, 0.0);
         StallWatch {
             max_order: 5,
+            clock: CpuClock::new(),
             velocity_scale: 1.0,
             window: start,
             outputs: vec![start],
@@ -263,6 +314,25 @@ mod tests {
         assert!(w.chatter(mark(3e-8, 300, 0, 1.1)).is_none());
         assert!(w.chatter(mark(3.1e-8, 600, 400, 1.5)).is_none());
         assert!(w.stalled.is_none());
+    }
+
+    #[test]
+    fn the_cpu_clock_is_read_only_after_its_interval() {
+        use std::time::Duration;
+        // A reading younger than the interval is kept (a reading "from the future" is young).
+        let mut clock = CpuClock {
+            read_at: Instant::now() + Duration::from_secs(3600),
+            cpu: -1.0,
+        };
+        assert_eq!(clock.now(), -1.0);
+        // An old one is replaced by the thread's clock.
+        let Some(old) = Instant::now().checked_sub(Duration::from_secs(1)) else {
+            return;
+        };
+        clock.read_at = old;
+        let cpu = clock.now();
+        assert!(cpu.is_nan() || cpu >= 0.0, "{cpu}");
+        assert!(clock.read_at > old);
     }
 
     #[test]
