@@ -146,6 +146,21 @@ fn tolerance_model_meets_the_stored_full_reference() {
     }
 }
 
+/// A tolerance model started at a ν the default truncated-mode set does not reach beyond
+/// (`--nu 40 --tolerance`) still gets its truncation checked: the estimate holds ν + 20 modes.
+#[test]
+fn truncation_is_checked_beyond_a_large_start_nu() {
+    let m = model("friction_bar");
+    let mut opts = ToleranceOptions::new(1e-1);
+    opts.nu = 40;
+    let t = tolerance_model(&m, &opts).unwrap();
+    assert_eq!(t.nu, 40);
+    assert!(
+        t.estimate.truncation.is_some() || t.estimate.combined.is_some(),
+        "no truncation check beyond ν = 40"
+    );
+}
+
 /// The default `auto` compression runs a compressed model only at most
 /// [`AUTO_COMPRESSION_SHRINK`] of the per-pair basis; where it runs none, the per-pair model
 /// is the result.

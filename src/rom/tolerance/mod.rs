@@ -416,6 +416,8 @@ pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<Toleran
     let cpu_start = process_cpu_s();
     let mut nu = opts.nu;
     let (flex, fixed, mut cb) = setup(model, nu)?;
+    // A start ν given above the held set's default keeps modes beyond it checked too.
+    flex.hold_truncation_modes(truncated_modes_for(nu));
     let setup_s = start.elapsed().as_secs_f64();
     let mut chosen = Chosen::default();
     let mut bases = BasisCache::new(model);
