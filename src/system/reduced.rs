@@ -126,11 +126,7 @@ fn col_major_rows(a: &Mat<f64>, keep: impl Fn(usize) -> bool) -> Vec<f64> {
 
 /// A dense matrix's columns, concatenated.
 fn col_major(a: &Mat<f64>) -> Vec<f64> {
-    let mut out = Vec::with_capacity(a.nrows() * a.ncols());
-    for j in 0..a.ncols() {
-        out.extend(a.col(j).iter().copied());
-    }
-    out
+    col_major_rows(a, |_| true)
 }
 
 /// The most columns a rank update of the dense Newton factor takes (module docs): k columns cost

@@ -644,7 +644,7 @@ impl<S: SecondOrderSystem> MechanicalOde<S> {
     /// and no screen is on, the normal rows and the tangential rows of the closed pairs only
     /// (an open pair's force and stored energy do not depend on them; same values).
     fn apply_for_sample(&mut self, q: &[f64]) {
-        if self.screen.is_none() && !self.stretch {
+        if self.rows_selectable() {
             let mut rows = std::mem::take(&mut self.rows);
             rows.clear();
             let done = self.sys.joint_apply_rows_into(
@@ -672,6 +672,12 @@ impl<S: SecondOrderSystem> MechanicalOde<S> {
             }
         }
         self.sys.joint_apply_into(q, &mut self.u);
+    }
+
+    /// Whether products of selected rows of `B` may stand in for the whole product: neither
+    /// screening (its live set) nor the stretch states (their memory reads every row) is on.
+    fn rows_selectable(&self) -> bool {
+        self.screen.is_none() && !self.stretch
     }
 
     /// `u = B q` on the live pairs (all pairs without screening).

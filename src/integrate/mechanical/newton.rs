@@ -209,7 +209,7 @@ impl<S: SecondOrderSystem> MechanicalOde<S> {
     /// ones only — the normal row enters through `∂ṡ/∂g` and `∂d/∂g`, zero on the open and
     /// stuck branches (their entries are set to 0). The same values.
     fn apply_for_corrections(&mut self, a: &[f64]) {
-        if self.screen.is_none() && !self.stretch {
+        if self.rows_selectable() {
             let mut rows = std::mem::take(&mut self.rows);
             rows.clear();
             for k in 0..self.w {
