@@ -9,7 +9,7 @@ Geometry (mm, N, t, s):
   sheet A  x in [0,125],  z in [0,25], y in [-0.25, 0.25]
   sheet B  x in [40,165], z in [0,25], y in [ 0.25, 0.75]
   the sheets touch on y = 0.25 over x in [40,125]; the interface nodes are
-  duplicated (no connection, no contact) except inside two weld discs of
+  duplicated (no connection; contact only with --contact-per-area) except inside two weld discs of
   diameter 5 at (x,z) = (60,12.5) and (105,12.5), where the solid is continuous.
   sheet A: face x = 0 clamped.  sheet B: face x = 165 rigidly tied to a 6-DOF
   master node at (165, 0.5, 12.5) (exact elimination, u_s = u_m + th x (x_s - x_m)).
@@ -31,8 +31,13 @@ Usage:
   python3 scripts/solid_reference.py --case friction_bar --refine 1,2,3,4 --out fb.json
   python3 scripts/solid_reference.py --case friction_bar --refine 2,2,2 --nt 2,3,4 --out fb_nt.json
   python3 scripts/solid_reference.py --case strip --refine 1,2,3,4 --out strip.json
+  python3 scripts/solid_reference.py --case friction_bar --refine 0,1,2 --contact-per-area 160 --modes 2 --out fbc.json
   (--welds none: sheets not bonded, fixed-interface problem only;
-   --elem 27: 27-node Lagrange bricks instead of 20-node serendipity)
+   --elem 27: 27-node Lagrange bricks instead of 20-node serendipity;
+   --contact-per-area KAPPA: the statics under Fy & Mx once more with frictionless penalty
+   contact p = KAPPA max(0, -g) on the sheets' interface outside the welds, integrated at the
+   3 x 3 Gauss points of its faces -- the surface-to-surface penalty of a node-matching
+   interface -- by active-set iteration; resultant, contact area, peak pressure, penetration)
 
 refine N -> nz = 4 (N + 1): nominal in-plane element size 25/nz.  nt (elements
 through each sheet's thickness) defaults to 2.  Several levels in one call give
@@ -40,7 +45,11 @@ level-to-level differences and a Richardson estimate (error ~ C h^p, last 3 leve
 Checks printed and stored: K symmetry, K times the 6 rigid motions of the free
 body, total mass = rho V, eigen-residuals, tie kinematics, bonded area = 2 pi r^2.
 
-Solver: scikit-sparse CHOLMOD if importable, else scipy SuperLU (symmetric mode).
+Solver: scikit-sparse CHOLMOD if importable, else scipy SuperLU (symmetric mode); with
+CHOLMOD the contact's active-set changes of up to 500 points are rank updates of the
+factor.  On Debian bookworm (SuiteSparse 5): apt install libsuitesparse-dev, then in a
+venv pip install 'numpy<2' 'scipy<1.14' 'cython<3' setuptools wheel and
+pip install --no-build-isolation scikit-sparse==0.4.12.
 """
 
 import argparse
@@ -459,12 +468,61 @@ def build_3d(case, nz, nt, nnode, welds='area', grade=1.0):
     info.update(dict(nt=nt, element=f'hex{nnode}', n_elements=int(len(conn)),
                      n_nodes=int(len(X)), n_dof=int(3 * len(X)),
                      n_bonded_interface_nodes=int(bonded_pts.sum()) if welds == 'area' else 0))
+    iface = None
     if case == 'friction_bar':
         # bonded area (the 2-D quadratic elements inside the discs)
         A = area_2d(P2, E2, bonded_el)
         info['bonded_area_mm2'] = A
         info['bonded_area_exact_2_pi_r2'] = 2 * math.pi * WELD_R ** 2
-    return el, X, conn, esheet, s_n, info
+        iface = interface_faces(P2, E2, bonded_el, bonded_pts, NP, L, uniq, nnode)
+    return el, X, conn, esheet, s_n, info, iface
+
+
+def interface_faces(P2, E2, bonded_el, bonded_pts, NP, L, uniq, nnode):
+    """The sheets' contact interface y = 0.25 over the overlap 40 < x < 125, outside the
+    weld discs: for every 2-D element there, its face nodes on sheet A's top layer and on
+    sheet B's bottom layer (one node where the disc's rim makes the solid continuous), the
+    face's shape functions (8-node serendipity for hex20, 9-node Lagrange for hex27) and a
+    3 x 3 Gauss rule.  Returns the gap operator's pieces: for each Gauss point, the nodes
+    and weights of g = u_y(B) - u_y(A), and its area weight w |J|."""
+    cx = P2[E2[:, 1, 1], 0]
+    mask = (cx > 40.0) & (cx < 125.0) & ~bonded_el
+    E = E2[mask]
+    loc2 = [(a, b) for b in range(3) for a in range(3) if nnode == 27 or (a, b) != (1, 1)]
+    loc2 = np.array(loc2, dtype=np.int64)
+    exps = [(i, j) for j in range(3) for i in range(3) if nnode == 27 or (i, j) != (2, 2)]
+    exps = np.array(exps, dtype=np.int64)
+    xi_n = (loc2 - 1).astype(float)
+
+    def mono(P, dx=0, dz=0):
+        e = exps.copy()
+        c = np.ones(len(e))
+        for d, k in ((0, dx), (1, dz)):
+            for _ in range(k):
+                c = c * e[:, d]
+                e[:, d] = np.maximum(e[:, d] - 1, 0)
+        return c[None, :] * P[:, None, 0] ** e[None, :, 0] * P[:, None, 1] ** e[None, :, 1]
+
+    C = np.linalg.inv(mono(xi_n))
+    g = math.sqrt(0.6)
+    p1, w1 = np.array([-g, 0.0, g]), np.array([5.0, 8.0, 5.0]) / 9.0
+    gp = np.array([(a, b) for b in p1 for a in p1])
+    gw = np.array([wa * wb for wb in w1 for wa in w1])
+    N = mono(gp) @ C
+    dNa, dNb = mono(gp, dx=1) @ C, mono(gp, dz=1) @ C
+    assert np.allclose(mono(xi_n) @ C, np.eye(len(loc2)), atol=1e-12)
+    pts = E[:, loc2[:, 0], loc2[:, 1]]                       # (ne, nn) lattice points
+    Xf = P2[pts]                                            # (ne, nn, 2): (x, z)
+    ja = np.einsum('gn,enk->egk', dNa, Xf)
+    jb = np.einsum('gn,enk->egk', dNb, Xf)
+    detJ = np.abs(ja[:, :, 0] * jb[:, :, 1] - ja[:, :, 1] * jb[:, :, 0])
+    code_a = pts * L + (L - 1)
+    code_b = np.where(bonded_pts[pts], code_a, (NP + pts) * L)
+    node_a, node_b = np.searchsorted(uniq, code_a), np.searchsorted(uniq, code_b)
+    assert np.all(uniq[node_a] == code_a) and np.all(uniq[node_b] == code_b)
+    return dict(node_a=node_a, node_b=node_b, N=N, wJ=gw[None, :] * detJ,
+                xz=np.einsum('gn,enk->egk', N, Xf), area=float((gw[None, :] * detJ).sum()),
+                n_faces=int(len(E)))
 
 
 # ----------------------------------------------------------------------------
@@ -626,12 +684,79 @@ def mirror_map(X):
 # one refinement level
 # ----------------------------------------------------------------------------
 
-def run_level(case, refine, nt, nnode, welds, nmodes, grade=1.0):
+def contact_statics(Kr, F, T, iface, kappa, q0, nr):
+    """Frictionless penalty contact on the interface, per area: p = kappa max(0, -g) at the
+    Gauss points of the interface faces (g = u_y(B) - u_y(A), small displacements; the
+    consistent surface integral of a node-matching interface), solved by active-set
+    iteration (semi-smooth Newton on the piecewise-linear problem) from the contact of the
+    solution without it.  Returns the resultant int p dA, the contact area, the peak
+    pressure, the largest penetration and the master's displacement."""
+    node_a, node_b, N, wJ = iface['node_a'], iface['node_b'], iface['N'], iface['wJ']
+    ne, ng = wJ.shape
+    nn = N.shape[1]
+    rows = np.broadcast_to(np.arange(ne * ng).reshape(ne, ng, 1), (ne, ng, nn)).ravel()
+    vals = np.broadcast_to(N[None, :, :], (ne, ng, nn)).ravel()
+    cols_b = np.broadcast_to((3 * node_b + 1)[:, None, :], (ne, ng, nn)).ravel()
+    cols_a = np.broadcast_to((3 * node_a + 1)[:, None, :], (ne, ng, nn)).ravel()
+    G = sp.csr_matrix((np.concatenate([vals, -vals]),
+                       (np.concatenate([rows, rows]), np.concatenate([cols_b, cols_a]))),
+                      shape=(ne * ng, T.shape[0]))
+    GT = (G @ T).tocsr()
+    w = kappa * wJ.ravel()
+    active = (GT @ q0) < 0
+    history = []
+    GTt = GT.T.tocsc()
+    fac = Factor((Kr + GT.T @ sp.diags(w * active) @ GT).tocsc())
+    for it in range(1, 61):
+        q = fac.solve(F)
+        gap = GT @ q
+        new = gap < 0
+        history.append(int(new.sum()))
+        changed = int((new != active).sum())
+        log(f"    contact iteration {it}: {int(new.sum())} of {len(new)} Gauss points closed, "
+            f"{changed} changed")
+        if changed == 0:
+            break
+        if fac.kind == 'cholmod' and changed <= 500:
+            # rank-k update and downdate of the factor by the points that closed / opened
+            # (a refactorization is cheaper for larger changes)
+            for sel, sub in ((new & ~active, False), (active & ~new, True)):
+                idx = np.flatnonzero(sel)
+                if len(idx):
+                    fac.F.update_inplace((GTt[:, idx] @ sp.diags(np.sqrt(w[idx]))).tocsc(),
+                                         subtract=sub)
+        else:
+            fac = Factor((Kr + GT.T @ sp.diags(w * new) @ GT).tocsc())
+        active = new
+    else:
+        raise RuntimeError('contact active set did not settle in 60 iterations')
+    pen = np.maximum(-gap, 0.0)
+    p = kappa * pen
+    force = p * wJ.ravel()
+    xz = iface['xz'].reshape(-1, 2)
+    near_end = (xz[:, 0] < 45.0) | (xz[:, 0] > 120.0)
+    d_weld = np.min([np.hypot(xz[:, 0] - wx, xz[:, 1] - WELD_Z) for wx in WELDS_X], axis=0)
+    total = float(force.sum())
+    return dict(kappa_n_per_mm3=kappa,
+                contact_resultant_n=total,
+                contact_area_mm2=float(wJ.ravel()[gap < 0].sum()),
+                interface_area_mm2=iface['area'],
+                peak_pressure_n_per_mm2=float(p.max()),
+                max_penetration_mm=float(pen.max()),
+                max_penetration_over_thickness=float(pen.max() / T_SHEET),
+                share_within_5mm_of_sheet_ends=float(force[near_end].sum() / total),
+                share_within_5mm_of_weld_rims=float(force[d_weld < WELD_R + 5.0].sum() / total),
+                master_displacement=q[nr:].tolist(),
+                gauss_points=int(len(gap)), faces=iface['n_faces'],
+                active_set_iterations=len(history), closed_points_history=history)
+
+
+def run_level(case, refine, nt, nnode, welds, nmodes, grade=1.0, kappa=None):
     nz = 4 * (refine + 1)
     t_start = time.time()
     res = {'refine': refine}
     log(f"level {refine}: nz={nz} nt={nt} hex{nnode} case={case} welds={welds}")
-    el, X, conn, esheet, s_n, info = build_3d(case, nz, nt, nnode, welds, grade)
+    el, X, conn, esheet, s_n, info, iface = build_3d(case, nz, nt, nnode, welds, grade)
     res['mesh'] = info
     log(f"  mesh: {info['n_elements']} elements, {info['n_nodes']} nodes, {info['n_dof']} dof; "
         f"2-D elements {info['n_2d_elements_by_kind']}")
@@ -778,6 +903,15 @@ def run_level(case, refine, nt, nnode, welds, nmodes, grade=1.0):
         log(f"  statics (factor {t_fac2:.1f} s): Fy -> {np.array2string(um[:, 0], precision=7)}")
         log(f"                          Mx -> {np.array2string(um[:, 1], precision=7)}")
         log(f"                        both -> {np.array2string(um[:, 2], precision=7)}")
+        if kappa is not None:
+            t0 = time.time()
+            cs = contact_statics(Kr, F[:, 2], T, iface, kappa, Q[:, 2], nr)
+            cs['cpu_s'] = time.time() - t0
+            res['contact_statics'] = cs
+            log(f"  contact statics (kappa {kappa} N/mm^3, {cs['cpu_s']:.1f} s): resultant "
+                f"{cs['contact_resultant_n']:.4f} N, area {cs['contact_area_mm2']:.2f} mm^2, "
+                f"peak {cs['peak_pressure_n_per_mm2']:.4f} N/mm^2, u_y "
+                f"{cs['master_displacement'][1]:.6f} mm")
         t0 = time.time()
         lam, vec, resid = lowest_modes(Kr, Mr, nmodes, fac)
         t_eig2 = time.time() - t0
@@ -854,6 +988,9 @@ def main():
                          '(25/nz)/grade, growth ratio 1.4 (default 8; 1 = uniform strips and '
                          'full-width weld boxes)')
     ap.add_argument('--modes', type=int, default=None)
+    ap.add_argument('--contact-per-area', type=float, default=None, metavar='KAPPA',
+                    help='also solve the statics under Fy & Mx with frictionless penalty contact '
+                         'on the interface, KAPPA N/mm^3 per area (friction bar only)')
     ap.add_argument('--out', required=True)
     args = ap.parse_args()
     levels = [int(v) for v in str(args.refine).split(',')]
@@ -879,7 +1016,8 @@ def main():
         out['geometry'] = dict(strip=dict(x=[0, 165], z=[0, 25], y=[-0.25, 0.25]),
                                clamp='faces x=0 and x=165, all translations')
     for N, nt in zip(levels, nts):
-        out['levels'].append(run_level(args.case, N, nt, args.elem, args.welds, nmodes, args.grade))
+        out['levels'].append(run_level(args.case, N, nt, args.elem, args.welds, nmodes, args.grade,
+                                       args.contact_per_area))
         with open(args.out, 'w') as fh:
             json.dump(out, fh, indent=1)
     # differences between successive levels and an extrapolated estimate
