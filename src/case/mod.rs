@@ -342,6 +342,31 @@ pub struct ContactSpec {
     /// inside the joint's faces ([`ContactSampling`]). Only with the stiffnesses per area.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub sampling: Option<ContactSampling>,
+    /// Where the tangential slips are taken (default `mid_surface`, the paper's node-to-node
+    /// kinematics): `faces` adds each sheet's rotation times its half thickness, the slip of
+    /// the contacting faces of sheets that bend together ([`SlipSurface`]).
+    #[serde(default, skip_serializing_if = "SlipSurface::is_mid_surface")]
+    pub slip: SlipSurface,
+}
+
+/// Where a joint's tangential slips are measured.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SlipSurface {
+    /// At the shells' mid-surface nodes, from their translations (the paper's node-to-node
+    /// pairs, NASTRAN's CGAP between grid points).
+    #[default]
+    MidSurface,
+    /// At the contacting faces, half a thickness from each mid-surface: the translations plus
+    /// each sheet's rotation times its half thickness (`crate::joint::operator`).
+    Faces,
+}
+
+impl SlipSurface {
+    /// True for the default (kept out of written files).
+    pub fn is_mid_surface(&self) -> bool {
+        *self == SlipSurface::MidSurface
+    }
 }
 
 /// Contact points inside the joint's faces (`crate::model::sampling`): each face of the joint
@@ -394,6 +419,7 @@ impl ContactSpec {
             normal_stiffness_per_area: None,
             stick_stiffness_per_area: None,
             sampling: None,
+            slip: SlipSurface::MidSurface,
         }
     }
 

@@ -13,6 +13,10 @@ pub struct PairFrame {
     pub t1: [f64; 3],
     /// Second unit tangent (⊥ normal, ⊥ t1).
     pub t2: [f64; 3],
+    /// Distances (mm, ≥ 0) from the lower and the upper node's mid-surface to the contacting
+    /// faces, `[t_lower / 2, t_upper / 2]` when the slips are taken at the faces
+    /// (`"slip": "faces"`), `[0, 0]` for the paper's mid-surface node-to-node kinematics.
+    pub face_offsets: [f64; 2],
 }
 
 impl PairFrame {
@@ -55,12 +59,28 @@ impl PairFrame {
             normal,
             t1,
             t2,
+            face_offsets: [0.0; 2],
         })
     }
 
     /// The three directions in row order (normal, t1, t2).
     pub fn directions(&self) -> [[f64; 3]; 3] {
         [self.normal, self.t1, self.t2]
+    }
+
+    /// The coefficients of a sheet's rotation `θ` (rad, global axes) in a pair row along
+    /// `dir` when the contacting face lies `offset` (mm) from the mid-surface: the face
+    /// point of the upper sheet is `x − offset·n`, of the lower `x + offset·n`, so with
+    /// `u_face = u + θ × d` the row `dir·(u_face,upper − u_face,lower)` gains
+    /// `−offset (n × dir)·θ` from either sheet (zero for the normal row, `n × n = 0`).
+    pub fn face_rotation_row(&self, dir: [f64; 3], offset: f64) -> [f64; 3] {
+        let n = self.normal;
+        let c = [
+            n[1] * dir[2] - n[2] * dir[1],
+            n[2] * dir[0] - n[0] * dir[2],
+            n[0] * dir[1] - n[1] * dir[0],
+        ];
+        c.map(|v| -offset * v)
     }
 
     /// The global axis (0 = x, 1 = y, 2 = z) closest to the normal.

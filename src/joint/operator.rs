@@ -10,7 +10,12 @@
 //! `t1 = +x`, `t2 = +z`, so the rows are `u_y`, `u_x`, `u_z` differences).
 //!
 //! These are node-to-node quantities at the shell mid-surface nodes, as in the paper's
-//! NASTRAN model (Section 4, "node-to-node contact and friction model"). Pair forces
+//! NASTRAN model (Section 4, "node-to-node contact and friction model"). With the slips taken
+//! at the contacting faces (`"slip": "faces"`, [`PairFrame::face_offsets`] `[t_l/2, t_u/2]`),
+//! the tangential rows add each sheet's rotation: the face point `x ∓ (t/2) n` moves by
+//! `u ∓ (t/2) θ × n`, so `s = t·(u_upper − u_lower) − (t_u/2)(n × t)·θ_upper −
+//! (t_l/2)(n × t)·θ_lower` — the interleaf slip of sheets that bend together about their own
+//! mid-surfaces, which the mid-surface translations miss. The normal row is unchanged. Pair forces
 //! `p` (N, same row order, positive pulls the upper node along +n/+t1/+t2) return to the structure as
 //! `f = Bᵀ p`. For a reduced model `q = Φ η` the operator [`JointOperator::reduce`] gives the dense
 //! `B Φ` (3w × r) once, so a pseudoforce costs O(w r), never O(n).
@@ -50,11 +55,25 @@ impl JointOperator {
         for (k, pair) in pairs.iter().enumerate() {
             for dir in pair.directions() {
                 let mut entries: Vec<(usize, f64)> = Vec::new();
-                for (node, sign) in [(pair.upper, 1.0), (pair.lower, -1.0)] {
+                let sides = [
+                    (pair.upper, 1.0, pair.face_offsets[1]),
+                    (pair.lower, -1.0, pair.face_offsets[0]),
+                ];
+                for (node, sign, offset) in sides {
                     let dep = map
                         .nodes
                         .get(node)
                         .ok_or_else(|| Error::Joint(JointError::UnknownNode { pair: k, node }))?;
+                    // The slips at the faces: the rotations carry the faces along (a fixed
+                    // rotation contributes nothing).
+                    if offset != 0.0 {
+                        let rot = pair.face_rotation_row(dir, offset);
+                        for (axis, &w) in rot.iter().enumerate() {
+                            if w != 0.0 {
+                                entries.extend(dep[3 + axis].terms().map(|(i, c)| (i, w * c)));
+                            }
+                        }
+                    }
                     for (axis, &w) in dir.iter().enumerate() {
                         if w == 0.0 {
                             continue;

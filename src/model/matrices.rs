@@ -823,6 +823,7 @@ impl MapReader<'_> {
             normal: frame.normal,
             t1: frame.t1,
             t2: frame.t2,
+            face_offsets: [0.0; 2],
         })
     }
 

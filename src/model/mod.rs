@@ -205,6 +205,7 @@ impl Model {
     pub fn from_case(case: Case) -> Result<Model, Error> {
         let mesh = Mesh::from_case(&case)?;
         let (normal, t1, t2) = PairFrame::SHEET_AXES;
+        let half = node_half_thickness(&mesh, case.contact.slip);
         let pairs: Vec<PairFrame> = mesh
             .pairs
             .iter()
@@ -214,6 +215,7 @@ impl Model {
                 normal,
                 t1,
                 t2,
+                face_offsets: [half[p.lower], half[p.upper]],
             })
             .collect();
         let node_ids = (1..=mesh.nodes.len() as u64).collect();
@@ -468,4 +470,18 @@ impl Model {
             })
             .collect())
     }
+}
+
+/// Per node, the distance (mm) from its mid-surface to its contacting face: half the largest
+/// thickness of the shells at the node where the slips are taken at the faces, else 0.
+fn node_half_thickness(mesh: &Mesh, slip: crate::case::SlipSurface) -> Vec<f64> {
+    let mut half = vec![0.0; mesh.nodes.len()];
+    if slip == crate::case::SlipSurface::Faces {
+        for s in &mesh.shells {
+            for &n in &s.nodes {
+                half[n] = f64::max(half[n], 0.5 * s.thickness);
+            }
+        }
+    }
+    half
 }

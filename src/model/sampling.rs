@@ -33,7 +33,9 @@
 //!   either bilinear in the corner deflections or the face's own DKMQ edge cubics blended over
 //!   the face ([`crate::element::Shell4::deflection_row`]: it uses the corners' rotations, so a
 //!   face bends inside; on a thin rectangle it is the 12-term ACM interpolation);
-//! - the slips `t1·(u_upper − u_lower)`, `t2·(…)` bilinear in the corner translations.
+//! - the slips `t1·(u_upper − u_lower)`, `t2·(…)` bilinear in the corner translations (and,
+//!   with `"slip": "faces"`, in the corner rotations times the half thicknesses:
+//!   `crate::joint::operator`).
 //!
 //! The frame of a point is the shape-weighted mean of its corners' pair normals (`+y` for the
 //! generated sheets). A point is a pair of the per-area law ([`super::per_area`]): its rows are
@@ -172,10 +174,20 @@ impl Model {
             .map(|(p, a)| {
                 let rows = p.directions().map(|d| {
                     let mut r = Vec::new();
-                    for (node, sign) in [(p.upper, 1.0), (p.lower, -1.0)] {
+                    let sides = [
+                        (p.upper, 1.0, p.face_offsets[1]),
+                        (p.lower, -1.0, p.face_offsets[0]),
+                    ];
+                    for (node, sign, offset) in sides {
                         for k in 0..3 {
                             if d[k] != 0.0 {
                                 r.push((node, k, sign * d[k]));
+                            }
+                        }
+                        let rot = p.face_rotation_row(d, offset);
+                        for (k, &c) in rot.iter().enumerate() {
+                            if c != 0.0 {
+                                r.push((node, 3 + k, c));
                             }
                         }
                     }
@@ -204,6 +216,7 @@ impl Model {
             .iter()
             .map(|p| ((p.lower, p.upper), *p))
             .collect();
+        let faces_slip = self.contact.slip == crate::case::SlipSurface::Faces;
         let mut out = Vec::new();
         for f in faces {
             let lower = mesh.shells[f.lower];
@@ -250,7 +263,11 @@ impl Model {
                         continue;
                     };
                     let mut rows: [Vec<(usize, usize, f64)>; 3] = Default::default();
-                    for (sh, nodes, sign) in [(&su, f.upper, 1.0), (&sl, corners, -1.0)] {
+                    let sides = [
+                        (&su, f.upper, 1.0, upper_elem.thickness),
+                        (&sl, corners, -1.0, lower.thickness),
+                    ];
+                    for (sh, nodes, sign, thickness) in sides {
                         let wrow = sh.deflection_row(r, s, edges);
                         let sn: f64 = (0..3).map(|k| sh.normal()[k] * frame.normal[k]).sum();
                         let orient = sign * sn.signum();
@@ -259,11 +276,16 @@ impl Model {
                                 rows[0].push((nodes[d / 6], d % 6, orient * v));
                             }
                         }
+                        let offset = if faces_slip { 0.5 * thickness } else { 0.0 };
                         for (row, t) in rows[1..].iter_mut().zip([frame.t1, frame.t2]) {
+                            let rot = frame.face_rotation_row(t, offset);
                             for b in 0..4 {
                                 for k in 0..3 {
                                     if t[k] != 0.0 && n[b] != 0.0 {
                                         row.push((nodes[b], k, sign * n[b] * t[k]));
+                                    }
+                                    if rot[k] != 0.0 && n[b] != 0.0 {
+                                        row.push((nodes[b], 3 + k, n[b] * rot[k]));
                                     }
                                 }
                             }

@@ -11,4 +11,5 @@ mod model;
 mod per_area;
 mod petsc;
 mod sampling;
+mod slip;
 mod weld_targets;

@@ -116,14 +116,7 @@ fn system() -> Jenkins {
 
 fn scene() -> Scene {
     Scene {
-        contact: ContactSpec {
-            normal_stiffness: K_N,
-            friction_coefficient: MU,
-            stick_stiffness: K_T,
-            normal_stiffness_per_area: None,
-            stick_stiffness_per_area: None,
-            sampling: None,
-        },
+        contact: ContactSpec::per_pair(K_N, MU, K_T),
         end_time: 1.0,
     }
 }
