@@ -58,6 +58,21 @@ pub trait OdeProblem {
         false
     }
 
+    /// Whether the problem changes the integrator's error weights
+    /// ([`OdeProblem::adjust_error_weights`]). The default `false` leaves them
+    /// `1 / (rtol |y_i| + atol_i)` without a callback.
+    fn adjusts_error_weights(&self) -> bool {
+        false
+    }
+
+    /// Changes the error weights of the step starting at `y`: on entry `ewt_i = 1 / (rtol
+    /// |y_i| + atol_i)` (the integrator's own weights, bit for bit); a problem may lower
+    /// entries, down to zero for a component whose error the step's test should not see.
+    /// Called once per step (CVODE only, when [`OdeProblem::adjusts_error_weights`]).
+    fn adjust_error_weights(&mut self, _y: &[f64], _ewt: &mut [f64]) -> Result<(), CallbackError> {
+        Ok(())
+    }
+
     /// Whether [`OdeProblem::newton_setup`] / [`OdeProblem::newton_solve`] are implemented.
     fn has_newton_solver(&self) -> bool {
         false

@@ -13,3 +13,4 @@ mod screen;
 mod stepper;
 mod system;
 mod transient_reference;
+mod weights;

@@ -193,6 +193,12 @@ impl<P: OdeProblem> OdeProblem for Deadline<P> {
     fn atol_scale(&self, scale: &mut [f64]) -> bool {
         self.inner.atol_scale(scale)
     }
+    fn adjusts_error_weights(&self) -> bool {
+        self.inner.adjusts_error_weights()
+    }
+    fn adjust_error_weights(&mut self, y: &[f64], ewt: &mut [f64]) -> Result<(), CallbackError> {
+        self.inner.adjust_error_weights(y, ewt)
+    }
     fn has_newton_solver(&self) -> bool {
         self.inner.has_newton_solver()
     }

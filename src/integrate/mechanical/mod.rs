@@ -207,6 +207,40 @@
 //! `reduced_error_test_is_the_full_models_on_the_field`); jointrom's M-orthonormal columns are
 //! near it.
 //!
+//! ## The error test of the open pairs' slip memory
+//!
+//! An open pair (`g ≥ 0`, stick radius 0) has `ṡ = (u_t − s)/τ`: its memory is slaved to its
+//! tangential displacement. A BDF step `s_{n+1} = a_s + γ ṡ_{n+1}` (`a_s` the history's
+//! combination, `γ = h β_0`) gives, with `a_s = a_u − a_e` the same combination of `u_t` and
+//! of the elastic part `e = u_t − s`,
+//!
+//! ```text
+//! e_{n+1} = τγ/(τ + γ) · [ (u_{t,n+1} − a_u)/γ + a_e/γ ]  ≈  τ u̇_t^BDF + (τ/γ) a_e
+//! ```
+//!
+//! — `τ` times the formula's derivative of `u_t`, plus the history's stretch damped by
+//! `τ/γ` (~1e-2 at the reduced models' steps). What the pair carries into its closing is
+//! therefore fixed by the implicit equation and by the coordinates, whose own error test
+//! bounds the velocity error δu̇_t: `|δe| ≲ τ |δu̇_t|` (1e-8 mm at the 1 % model's velocity
+//! tolerance). The memory's local error estimate (predictor against corrector) measures
+//! instead how well the history extrapolates `u_t` itself, held to the slip tolerance
+//! `atol · L · slip_scale` — 1000× tighter than the field's `atol · L`: a control of the open
+//! interface's tangential motion that the field test already gives at its own level.
+//!
+//! So a reduced model's step (unless [`ProblemOptions::open_slip_test`]) gives the memory
+//! states of the pairs open by more than the refresh margin zero error weight
+//! ([`OdeProblem::adjust_error_weights`], CVODE's `CVodeWFtolerances`); every other weight is
+//! CVODE's own `1/(rtol |y_i| + atol_i)`, bit for bit, and a closed pair's memory — its
+//! elastic stretch and the friction force — is tested as before. The gaps are those of the
+//! last right-hand side (the accepted step's last Newton iterate, within the Newton
+//! tolerance of the step's state; no product of its own). Pairs within the margin of the
+//! switch keep their test: they hover at round-off around `g = 0` under the load ramp's start,
+//! and switching their weights on and off with every sign change made that phase take ~1.8×
+//! the steps. The Newton matrix treats an open pair's memory exactly (`D_s = I/τ`), so the
+//! Newton convergence test, which uses the same weights, loses nothing either. The full model
+//! keeps every state in its test (its bits are unchanged); so do screening and the stretch
+//! states, whose memory states are not the slip of every pair.
+//!
 //! ## Running
 //!
 //! [`crate::integrate::driver`] drives a [`MechanicalOde`] with [`crate::integrate::Cvode`]
@@ -308,6 +342,12 @@ pub struct ProblemOptions {
     /// friction off, with events on and by the full model. Off by default: at equal
     /// tolerances it is less accurate than the slip form.
     pub stretch: bool,
+    /// Keep the slip memory of open pairs in the reduced model's error test (module docs,
+    /// *The error test of the open pairs' slip memory*). Off (the default): a reduced model's
+    /// step gives the memory states of the pairs open at its start zero error weight, the
+    /// closed pairs' the weights of the tolerances. The full model, and a reduced model with
+    /// screening or the stretch states, always test every state.
+    pub open_slip_test: bool,
 }
 
 impl Default for ProblemOptions {
@@ -322,6 +362,7 @@ impl Default for ProblemOptions {
             refresh: Some(DEFAULT_REFRESH_MARGIN),
             screen: false,
             stretch: false,
+            open_slip_test: false,
         }
     }
 }
@@ -414,6 +455,14 @@ pub struct MechanicalOde<S: SecondOrderSystem> {
     /// Slip-memory offsets (2w with friction, mm): the memory (`s`, or `e` with `stretch`) is
     /// `slip_scale · state + offset`, zero unless a pair joined the screened set ([`screen`]).
     offset: Vec<f64>,
+    /// The open pairs' memory states get zero error weight (module docs, *The error test of
+    /// the open pairs' slip memory*).
+    free_open_slip: bool,
+    /// The gap (mm) beyond which a pair counts as open for the error weights: the refresh
+    /// margin (the default's when the refresh is off).
+    open_margin: f64,
+    /// `B q` of the error weights' state (normal rows; 3w, scratch of `free_open_slip`).
+    ewt_u: Vec<f64>,
 }
 
 /// A load other than the system's own ([`MechanicalOde::set_load`]):
@@ -465,6 +514,11 @@ impl<S: SecondOrderSystem> MechanicalOde<S> {
         let w = sys.pairs();
         let screening = sys.joint_normal_row_norms().is_some() && !opts.events;
         let stretch = opts.stretch && opts.friction && screening;
+        let free_open_slip = opts.friction
+            && !opts.open_slip_test
+            && sys.joint_normal_row_norms().is_some()
+            && !opts.screen
+            && !stretch;
         let screen = if opts.screen && !opts.events {
             sys.joint_normal_row_norms()
                 .map(|norms| screen::PairScreen::new(norms, n))
@@ -510,6 +564,9 @@ impl<S: SecondOrderSystem> MechanicalOde<S> {
             f_time: f64::NAN,
             rows: Vec::with_capacity(3 * w),
             rows_scratch: vec![0.0; 2 * w],
+            free_open_slip,
+            open_margin: opts.refresh.unwrap_or(DEFAULT_REFRESH_MARGIN),
+            ewt_u: vec![0.0; if free_open_slip { 3 * w } else { 0 }],
             sys,
         })
     }
@@ -983,6 +1040,44 @@ impl<S: SecondOrderSystem> OdeProblem for MechanicalOde<S> {
                     [self.u[3 * k], self.u[3 * k + 1], self.u[3 * k + 2]],
                     [s[2 * k], s[2 * k + 1]],
                 );
+            }
+        }
+        Ok(())
+    }
+
+    fn adjusts_error_weights(&self) -> bool {
+        self.free_open_slip
+    }
+
+    /// Zero weight for the memory states of the pairs open by more than the margin
+    /// (`g > open_margin`) at the last right-hand side — the step just accepted, at its last
+    /// Newton iterate — or at `y` before any; every other weight as given (module docs,
+    /// *The error test of the open pairs' slip memory*).
+    fn adjust_error_weights(&mut self, y: &[f64], ewt: &mut [f64]) -> Result<(), CallbackError> {
+        if !self.free_open_slip {
+            return Ok(());
+        }
+        let after_rhs = self.rhs_q.first().is_some_and(|x| !x.is_nan());
+        let u = if after_rhs {
+            &self.rhs_u
+        } else {
+            let q = &y[..self.n];
+            let done = self.sys.joint_apply_rows_into(
+                q,
+                Some(JointRows::Normal),
+                &[],
+                &mut self.rows_scratch,
+                &mut self.ewt_u,
+            );
+            if !done {
+                self.sys.joint_apply_into(q, &mut self.ewt_u);
+            }
+            &self.ewt_u
+        };
+        let slip = &mut ewt[2 * self.n..2 * self.n + 2 * self.w];
+        for (wk, uk) in slip.chunks_exact_mut(2).zip(u.chunks_exact(3)) {
+            if uk[0] > self.open_margin {
+                wk.fill(0.0);
             }
         }
         Ok(())

@@ -158,6 +158,8 @@ impl<P: OdeProblem> Arkode<P> {
             poisoned: false,
             cvode_message: None,
             warnings: 0,
+            ewt_rtol: 0.0,
+            ewt_atol: Vec::new(),
         });
         let mut ark = Arkode {
             mem,

@@ -47,6 +47,10 @@ pub(crate) struct Shared<P> {
     pub cvode_message: Option<String>,
     /// Warnings CVODE reported through its error handler (e.g. `t + h = t`).
     pub warnings: u64,
+    /// With the problem's error weights ([`error_weights`]): `rtol` and the per-component
+    /// `atol_i` the weights start from (empty otherwise).
+    pub ewt_rtol: f64,
+    pub ewt_atol: Vec<f64>,
 }
 
 /// Clears the upper halves of the AVX registers (`VZEROUPPER`) on CPUs that have them.
@@ -235,6 +239,38 @@ pub(crate) unsafe extern "C" fn roots<P: OdeProblem>(
                         CallbackError::Fatal(m)
                     }
                 })
+        })
+    }
+}
+
+/// `CVEwtFn`: the error weights of the step starting at `y`, `ewt_i = 1 / (rtol |y_i| +
+/// atol_i)` (what CVODE's own per-component tolerances give, the same operations) changed by
+/// the problem's [`OdeProblem::adjust_error_weights`]. A non-positive `rtol |y_i| + atol_i` or
+/// a failure of the problem → nonzero (CVODE stops with `CV_ILL_INPUT`).
+///
+/// # Safety
+/// As [`rhs`]; `ewt` is a live serial vector of length `n` distinct from `y`.
+pub(crate) unsafe extern "C" fn error_weights<P: OdeProblem>(
+    y: N_Vector,
+    ewt: N_Vector,
+    data: *mut c_void,
+) -> c_int {
+    // SAFETY: as in `rhs`; CVODE passes its own distinct weight vector.
+    unsafe {
+        run::<P>(data, "error_weights", f64::NAN, |s| {
+            check_distinct(y, ewt)?;
+            let (yv, w) = (entries(y, s.n), entries_mut(ewt, s.n));
+            let rtol = s.ewt_rtol;
+            for ((wi, &yi), &ai) in w.iter_mut().zip(yv).zip(&s.ewt_atol) {
+                let d = rtol * yi.abs() + ai;
+                if d.is_nan() || d <= 0.0 {
+                    return Err(CallbackError::Fatal(format!(
+                        "rtol |y| + atol = {d} is not positive"
+                    )));
+                }
+                *wi = 1.0 / d;
+            }
+            s.problem.adjust_error_weights(yv, w)
         })
     }
 }

@@ -47,8 +47,9 @@ use sundials_sys::{
     CVodeSVtolerances, CVodeSetEpsLin, CVodeSetErrHandlerFn, CVodeSetEtaFixedStepBounds,
     CVodeSetInitStep, CVodeSetLinearSolver, CVodeSetMaxNumSteps, CVodeSetMaxOrd, CVodeSetMaxStep,
     CVodeSetNoInactiveRootWarn, CVodeSetNonlinearSolver, CVodeSetPreconditioner,
-    CVodeSetRootDirection, CVodeSetStabLimDet, CVodeSetStopTime, CVodeSetUserData, SUNDenseMatrix,
-    SUNLinSol_Dense, SUNNonlinSol_FixedPoint, CV_ADAMS, CV_BDF, CV_NORMAL, CV_ROOT_RETURN,
+    CVodeSetRootDirection, CVodeSetStabLimDet, CVodeSetStopTime, CVodeSetUserData,
+    CVodeWFtolerances, SUNDenseMatrix, SUNLinSol_Dense, SUNNonlinSol_FixedPoint, CV_ADAMS, CV_BDF,
+    CV_NORMAL, CV_ROOT_RETURN,
 };
 
 use super::callbacks::{self, Failure, Shared};
@@ -198,6 +199,8 @@ impl<P: OdeProblem> Cvode<P> {
             poisoned: false,
             cvode_message: None,
             warnings: 0,
+            ewt_rtol: 0.0,
+            ewt_atol: Vec::new(),
         });
         let mut cvode = Cvode {
             mem,
@@ -216,6 +219,11 @@ impl<P: OdeProblem> Cvode<P> {
             max_steps: opts.max_steps as u64,
         };
         let atol_vector = cvode.atol_vector(&context, opts.atol)?;
+        if let Some(v) = &atol_vector {
+            let shared = cvode.shared.get_mut();
+            shared.ewt_rtol = opts.rtol;
+            shared.ewt_atol = v.as_slice().to_vec();
+        }
         cvode.init(t0, opts, atol_vector.as_ref())?;
         match opts.iteration {
             Iteration::Functional { anderson } => cvode.attach_fixed_point(&context, anderson)?,
@@ -277,6 +285,10 @@ impl<P: OdeProblem> Cvode<P> {
                 CVodeInit(m, Some(callbacks::rhs::<P>), t0, self.y.as_raw()),
             )?;
             match atol_vector {
+                Some(_) if self.shared.get().problem.adjusts_error_weights() => self.check_cv(
+                    "CVodeWFtolerances",
+                    CVodeWFtolerances(m, Some(callbacks::error_weights::<P>)),
+                )?,
                 Some(v) => self.check_cv(
                     "CVodeSVtolerances",
                     CVodeSVtolerances(m, opts.rtol, v.as_raw()),

@@ -98,6 +98,11 @@ pub struct TransientArgs {
     /// (off); the same law and curves. The full model keeps `s`. Default off
     #[arg(long, value_enum)]
     stretch: Option<OnOff>,
+    /// Reduced models: keep the slip memory of open pairs in the error test (on), or give it
+    /// zero weight, its value being slaved to the pair's tangential motion (off). The full
+    /// model tests every state. Default off
+    #[arg(long, value_enum)]
+    open_slip_test: Option<OnOff>,
     /// `--model full`: capacity of the exact low-rank update of the Newton factor at active-set
     /// refreshes, columns (one per changed pair row; a refresh that would exceed it refactors);
     /// 0 refactors at every refresh. Default 96.
@@ -299,6 +304,9 @@ fn transient_options(a: &TransientArgs) -> Result<TransientOptions, Error> {
     }
     if let Some(s) = a.stretch {
         o.problem.stretch = s.is_on();
+    }
+    if let Some(s) = a.open_slip_test {
+        o.problem.open_slip_test = s.is_on();
     }
     if let Some(r) = &a.refresh {
         o.problem.refresh = if r == "off" {
