@@ -172,6 +172,7 @@ fn run_tolerance(
         transient,
         cpu_s,
         compression,
+        force_atol,
     } = tolerance_model(model, &topts)?;
     let frames = match (every, &rom.phi) {
         (Some(every), Some(phi)) => {
@@ -202,6 +203,7 @@ fn run_tolerance(
             rounds,
             rtol: transient.ode.rtol,
             atol: transient.ode.atol,
+            force_atol,
             compression,
         }),
     })

@@ -143,7 +143,44 @@ fn tolerance_model_meets_the_stored_full_reference() {
         );
         assert!(t.offline_s > 0.0 && t.run.wall_s > 0.0 && t.estimate_s > 0.0);
         auto_compression_keeps_its_rule(name, &t);
+        // The force floor is looser than the tolerance's own atol here: it caps nothing.
+        let floor = t.force_atol.expect("‖f_c‖ controlled: a force floor");
+        assert!(floor > 2.0 * t.transient.ode.atol, "{name}: floor {floor}");
     }
+}
+
+/// The force floor follows the joint forces (`force_floor_atol`: `k_n · atol ≤ θ·TOL·F`, F the
+/// first estimate's `(Σ_t ‖f_c*‖²)^{1/2}`). The friction bar with its load scaled by 1/100
+/// carries 1/100 of the forces (the penalty and friction laws are homogeneous of degree one),
+/// so its floor is 1/100 of the unscaled bar's, and it caps every round's atol there (the
+/// tolerance's own is 1e-4 mm for ‖f_c‖ alone); the ranking round, whose own floor was coarser
+/// than the forces, is repeated at its cap before the floor is kept.
+#[test]
+fn tolerance_force_floor_follows_the_joint_forces() {
+    let mut opts = ToleranceOptions::new(1e-2);
+    opts.quantities = Some(Quantities::of(&[Quantity::ContactForce]));
+    let m = model("friction_bar");
+    let unscaled = tolerance_model(&m, &opts).unwrap();
+    let floor = unscaled.force_atol.expect("a force floor");
+    let mut small = model("friction_bar");
+    let l = &mut small.load.master;
+    for x in [
+        &mut l.fx, &mut l.fy, &mut l.fz, &mut l.mx, &mut l.my, &mut l.mz,
+    ] {
+        *x *= 1e-2;
+    }
+    let t = tolerance_model(&small, &opts).unwrap();
+    let small_floor = t.force_atol.expect("a force floor");
+    let ratio = floor / small_floor;
+    assert!(
+        (ratio - 100.0).abs() < 5.0,
+        "floors {floor} / {small_floor}"
+    );
+    // The result's atol is the floor: below the tolerance's own (1e-4 mm) and the paper's.
+    assert!((t.transient.ode.atol / small_floor - 1.0).abs() < 1e-12);
+    assert!(unscaled.transient.ode.atol > 1e-6 && t.transient.ode.atol < 1e-6);
+    let ranking = t.rounds.iter().take_while(|r| r.ranking).count();
+    assert!(ranking > 1, "the ranking round was not repeated");
 }
 
 /// A tolerance model started at a ν the default truncated-mode set does not reach beyond

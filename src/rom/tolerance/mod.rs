@@ -17,7 +17,10 @@
 //! `σ_k` of its error ([`Estimate::pair_dissipation_error`]; the shares bound it by their sum)
 //! get their normal attachment mode, or their next tangential one if they hold it already.
 //! With ‖f_R‖ or D controlled the integration starts ten times tighter
-//! ([`integration_looseness_for`]).
+//! ([`integration_looseness_for`]). With ‖f_c‖ controlled the rounds' atol is capped by the
+//! force floor ([`force_floor_atol`]): `k_n · atol ≤ θ·TOL·F`, F the first estimate's
+//! `(Σ_t ‖f_c*‖²)^{1/2}`, so that the force resolution follows the forces asked for, not a
+//! length fixed in mm (on a refined mesh more pairs share the load and F falls).
 //!
 //! ## Why not the paper's w(g)
 //!
@@ -114,7 +117,6 @@ use crate::integrate::{Run, TransientOptions};
 use crate::joint::statics::ContactOptions;
 use crate::model::Model;
 use crate::reduction::estimate::{truncated_modes_for, TRUNCATION_BEYOND};
-#[cfg(doc)]
 use crate::reduction::Estimate;
 use crate::reduction::{
     craig_bampton, craig_bampton_with, modal_rotation, CurveErrors, FixedInterface,
@@ -211,6 +213,122 @@ pub fn integration_looseness_for(tol: f64, on: Quantities) -> f64 {
         (tol / 1e-3).clamp(1.0, 1e4)
     } else {
         integration_looseness(tol)
+    }
+}
+
+/// θ of the force-floor rule ([`force_floor_atol`]): one output's flicker at the force floor may
+/// use at most this fraction of the tolerance on ‖f_c‖.
+pub const FORCE_FLOOR_SHARE: f64 = SELECTION_MARGIN;
+
+/// The absolute tolerance (mm) at which the force floor of the normal penalty law, `k_n · atol`,
+/// is at most θ·TOL ([`FORCE_FLOOR_SHARE`]) of the run's force scale
+/// `F = (Σ_t ‖f_c*(t)‖²)^{1/2}` — the denominator of the relative L2 error of ‖f_c‖(t) over the
+/// outputs, taken from the first estimate's correction (`corrected_norm2`, N²):
+///
+/// ```text
+/// atol_f = θ · TOL · F / k_n
+/// ```
+///
+/// A gap is resolved to about atol, so a pair near its closure flickers by a force of about
+/// `k_n · atol`; one output that reads it moves the relative L2 error of ‖f_c‖ by
+/// `k_n · atol / F`. The rule keeps that within θ·TOL whatever the mesh: on a refined mesh more
+/// pairs share the load and `F` falls, while an atol in mm holds the same force floor. `None`
+/// where the scale is zero or not finite (no contact: nothing to resolve).
+pub fn force_floor_atol(tol: f64, corrected_norm2: f64, k_n: f64) -> Option<f64> {
+    let scale = corrected_norm2.sqrt();
+    let atol = FORCE_FLOOR_SHARE * tol * scale / k_n;
+    (atol.is_finite() && atol > 0.0).then_some(atol)
+}
+
+/// How many times the ranking round is repeated at most because its own run was coarser than
+/// [`RANKING_LOOSENING`]× the force floor it measured ([`force_floor_atol`]): a run whose force
+/// floor exceeds the joint forces measures its own noise, not their scale. It is repeated at
+/// that atol until the floor it measures agrees with the previous one within a factor 2.
+pub const FORCE_FLOOR_REPEATS: usize = 3;
+
+/// `opts` with its atol lowered to `cap` where that is tighter (the force floor,
+/// [`force_floor_atol`]).
+fn capped(mut opts: TransientOptions, cap: Option<f64>) -> TransientOptions {
+    if let Some(cap) = cap {
+        opts.ode.atol = opts.ode.atol.min(cap);
+    }
+    opts
+}
+
+/// The rounds' integration tolerances ([`tolerance_model`]): the user's, or the paper's times
+/// the looseness `s` ([`integration_looseness_for`]), the atol capped by the force floor where
+/// ‖f_c‖ is controlled ([`force_floor_atol`]).
+struct RoundTolerances {
+    /// The factor `s` on the user's (or the paper's) rtol and atol.
+    looseness: f64,
+    /// Whether the force floor applies (‖f_c‖ controlled, tolerances from the tolerance).
+    force_rule: bool,
+    /// The force floor's atol, once a ranking round has measured it.
+    force_atol: Option<f64>,
+    /// Ranking rounds repeated so far ([`FORCE_FLOOR_REPEATS`]).
+    repeats: usize,
+}
+
+impl RoundTolerances {
+    fn new(opts: &ToleranceOptions, on: Quantities) -> RoundTolerances {
+        let from_tolerance = opts.integration == IntegrationTolerances::FromTolerance;
+        RoundTolerances {
+            looseness: if from_tolerance {
+                integration_looseness_for(opts.tolerance, on)
+            } else {
+                1.0
+            },
+            force_rule: from_tolerance && on.contains(Quantity::ContactForce),
+            force_atol: None,
+            repeats: 0,
+        }
+    }
+
+    /// The transient options of a round: `opts` times the looseness, the ranking round's
+    /// [`RANKING_LOOSENING`]× that (and its force floor).
+    fn transient(&self, opts: &TransientOptions, ranking: bool) -> TransientOptions {
+        let factor = if ranking { RANKING_LOOSENING } else { 1.0 };
+        capped(
+            loosened(opts, self.looseness * factor),
+            self.force_atol.map(|a| a * factor),
+        )
+    }
+
+    /// Measures the force floor from a ranking round's estimate `d` (its run at `run_atol`) and
+    /// returns whether the ranking round is to be repeated: its run was coarser than
+    /// [`RANKING_LOOSENING`]× the floor, the floor moved by more than a factor 2 from the last
+    /// measurement, and repeats (and, `room`, rounds) are left.
+    fn measure(
+        &mut self,
+        model: &Model,
+        tol: f64,
+        d: &Estimate,
+        run_atol: f64,
+        room: bool,
+    ) -> bool {
+        if !self.force_rule {
+            return false;
+        }
+        let previous = self.force_atol;
+        let k_n = model.contact.normal_stiffness;
+        self.force_atol = force_floor_atol(tol, d.corrected_joint_norm2, k_n);
+        let coarse = self
+            .force_atol
+            .is_some_and(|a| run_atol > a * RANKING_LOOSENING * (1.0 + 1e-9));
+        let moved = match (previous, self.force_atol) {
+            (Some(p), Some(a)) => (p / a).max(a / p) > 2.0,
+            _ => true,
+        };
+        let repeat = coarse && moved && room && self.repeats < FORCE_FLOOR_REPEATS;
+        self.repeats += usize::from(repeat);
+        repeat
+    }
+
+    /// Ten times tighter, down to the user's (or the paper's) tolerances: whether it tightened.
+    fn tighten(&mut self) -> bool {
+        let tightened = self.looseness > 1.0;
+        self.looseness = (self.looseness / 10.0).max(1.0);
+        tightened
     }
 }
 
@@ -364,6 +482,9 @@ pub struct ToleranceModel {
     pub cpu_s: f64,
     /// What the compression of the joint columns did (`None`: not tried).
     pub compression: Option<Compression>,
+    /// The force floor's atol ([`force_floor_atol`], mm): the cap on the rounds' atol (`None`:
+    /// no cap — ‖f_c‖ not controlled, `--rtol/--atol` given, or no contact).
+    pub force_atol: Option<f64>,
 }
 
 /// What the tolerance model chose, as the outputs report it (`"tolerance"` in a run's JSON).
@@ -395,6 +516,10 @@ pub struct ToleranceChoice {
     pub rtol: f64,
     /// See `rtol`.
     pub atol: f64,
+    /// The force floor's atol (mm) that capped the rounds' atol (absent: no cap;
+    /// [`force_floor_atol`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub force_atol: Option<f64>,
     /// What the compression of the joint columns did (absent: not tried): how many compressed
     /// columns replaced how many per-pair ones, and whether that model is the result.
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -428,19 +553,13 @@ pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<Toleran
     let mut expect_result = false;
     // Whether the last estimate says a combined check would miss (combined_may_meet).
     let mut separate = false;
-    // The integration tolerances: the user's, or the paper's times s (integration_looseness).
-    let mut looseness = match opts.integration {
-        IntegrationTolerances::FromTolerance => integration_looseness_for(tol, on),
-        IntegrationTolerances::Given => 1.0,
-    };
+    // The integration tolerances: the user's, or the paper's times s, capped by the force floor.
+    let mut tolerances = RoundTolerances::new(opts, on);
     loop {
         let round_start = Instant::now();
         let rom = reduced_on(model, &cb, &flex, &chosen, &mut bases)?;
         let basis_s = round_start.elapsed().as_secs_f64();
-        let transient = loosened(
-            &opts.transient,
-            looseness * if ranking { RANKING_LOOSENING } else { 1.0 },
-        );
+        let transient = tolerances.transient(&opts.transient, ranking);
         // A round expected to be the result makes its two checks beside its run (on a second
         // core); any other round makes them after its correction, only if it may be the result.
         let scene = Scene::of(model);
@@ -488,6 +607,12 @@ pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<Toleran
             (combined, made, ranking),
             (run.wall_s, basis_s, estimate_s),
         ));
+        // The force floor from the ranking round's correction, the ranking round again if
+        // its own run was too coarse to measure it (RoundTolerances::measure).
+        let room = rounds.len() < opts.max_rounds;
+        if ranking && tolerances.measure(model, tol, d, transient.ode.atol, room) {
+            continue;
+        }
         let mut changed = false;
         // The next round repeats this model or adds all the estimate asked for: the result?
         expect_result = true;
@@ -530,8 +655,7 @@ pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<Toleran
         // again, ten times tighter (the reduction part is within its share, or the loop would
         // have enriched the basis).
         let total = worst(&estimate.total, on);
-        if !changed && looseness > 1.0 && estimate.integration.is_some() && total > tol {
-            looseness = (looseness / 10.0).max(1.0);
+        if !changed && estimate.integration.is_some() && total > tol && tolerances.tighten() {
             continue;
         }
         if !changed {
@@ -551,6 +675,7 @@ pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<Toleran
                 transient,
                 cpu_s: f64::NAN,
                 compression: None,
+                force_atol: tolerances.force_atol,
             };
             compress::compress_result(model, &flex, (&chosen, &bases, &cb), opts, &mut result)?;
             result.cpu_s = process_cpu_s() - cpu_start;
@@ -1186,6 +1311,31 @@ pub fn check_tolerance(tol: f64) -> Result<(), Error> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn force_floor_follows_the_force_scale() {
+        let k_n = 1e4;
+        // The friction bar's corrected ‖f_c*‖ over its 2 001 outputs, F ≈ 69 N: k_n·atol =
+        // θ·TOL·F at 3.45e-5 mm, looser than TOL 1e-2's atol with friction (1e-5): no cap.
+        let bar = force_floor_atol(1e-2, 69.0_f64.powi(2), k_n).unwrap();
+        assert!((bar - 3.45e-5).abs() < 1e-15, "{bar}");
+        let opts = loosened(&TransientOptions::default(), 10.0);
+        let kept = capped(opts.clone(), Some(bar));
+        assert_eq!(kept.ode.atol, opts.ode.atol);
+        assert_eq!(kept.ode.rtol, opts.ode.rtol);
+        // Forces 100× smaller: the floor 100× tighter, and it caps the atol (not the rtol).
+        let small = force_floor_atol(1e-2, 0.69_f64.powi(2), k_n).unwrap();
+        assert!((bar / small - 100.0).abs() < 1e-9, "{small}");
+        let tight = capped(opts.clone(), Some(small));
+        assert_eq!(tight.ode.atol, small);
+        assert_eq!(tight.ode.rtol, opts.ode.rtol);
+        // Linear in TOL, inverse in k_n; no contact, no floor.
+        let half = force_floor_atol(5e-3, 69.0_f64.powi(2), 2.0 * k_n).unwrap();
+        assert!((bar / half - 4.0).abs() < 1e-12);
+        assert!(force_floor_atol(1e-2, 0.0, k_n).is_none());
+        assert!(force_floor_atol(1e-2, f64::NAN, k_n).is_none());
+        assert_eq!(capped(opts.clone(), None).ode.atol, opts.ode.atol);
+    }
 
     #[test]
     fn summed_selection_adds_the_largest_shares_until_the_rest_fits() {
