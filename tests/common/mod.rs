@@ -254,6 +254,28 @@ pub fn rel_l2(a: &[f64], b: &[f64], n: usize) -> f64 {
     (num / den).sqrt()
 }
 
+/// Relative L2 differences of ‖f_c‖, ‖f_R‖, u_y and D between two runs with the same outputs.
+pub fn curve_differences(
+    a: &jointrom::integrate::Run,
+    b: &jointrom::integrate::Run,
+) -> [(&'static str, f64); 4] {
+    assert_eq!(a.curves.t.len(), b.curves.t.len(), "output count");
+    let n = a.curves.t.len();
+    let (x, y) = (&a.curves, &b.curves);
+    [
+        (
+            "|f_c|",
+            rel_l2(&x.contact_force_norm, &y.contact_force_norm, n),
+        ),
+        (
+            "|f_R|",
+            rel_l2(&x.friction_force_norm, &y.friction_force_norm, n),
+        ),
+        ("u_y", rel_l2(&x.master_uy, &y.master_uy, n)),
+        ("D", rel_l2(&x.dissipated, &y.dissipated, n)),
+    ]
+}
+
 // ---------------------------------------------------------------------------------------------
 // Random numbers
 

@@ -33,25 +33,6 @@ fn runs(case: &str, end: f64, change: impl Fn(&mut ProblemOptions)) -> (Run, Run
     (a, b, pairs)
 }
 
-/// Relative L2 differences of ‖f_c‖, ‖f_R‖, u_y and D between two runs with the same outputs.
-fn differences(a: &Run, b: &Run) -> [(&'static str, f64); 4] {
-    assert_eq!(a.curves.t.len(), b.curves.t.len(), "output count");
-    let n = a.curves.t.len();
-    let (x, y) = (&a.curves, &b.curves);
-    [
-        (
-            "|f_c|",
-            rel_l2(&x.contact_force_norm, &y.contact_force_norm, n),
-        ),
-        (
-            "|f_R|",
-            rel_l2(&x.friction_force_norm, &y.friction_force_norm, n),
-        ),
-        ("u_y", rel_l2(&x.master_uy, &y.master_uy, n)),
-        ("D", rel_l2(&x.dissipated, &y.dissipated, n)),
-    ]
-}
-
 #[test]
 fn screened_reduced_run_keeps_the_curves_and_evaluates_fewer_pairs() {
     // The friction bar refined 2× (173 pairs) over its first 20 ms: contact builds up under
@@ -113,7 +94,7 @@ fn stretch_states_keep_the_curves() {
             p.stretch = true;
             p.screen = screen;
         });
-        let diff = differences(&on, &off);
+        let diff = common::curve_differences(&on, &off);
         println!(
             "{case}: stretch{} vs slip states: {diff:?}; steps {} vs {}",
             if screen { " + screening" } else { "" },

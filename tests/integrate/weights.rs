@@ -10,7 +10,7 @@ use jointrom::integrate::{run, MechanicalOde, ProblemOptions, TransientOptions};
 use jointrom::reduction::{build_basis, BasisKind, BasisOptions};
 use jointrom::system::{FullSystem, ReducedSystem, Scene, SecondOrderSystem};
 
-use crate::common::{self, rel_l2};
+use crate::common;
 
 /// The friction bar's TVD model.
 fn friction_bar_rom() -> (jointrom::model::Model, ReducedSystem) {
@@ -113,27 +113,13 @@ fn untested_open_memory_keeps_the_curves() {
     tested.problem.open_slip_test = true;
     let a = run(rom.clone(), &scene, &default).expect("default run");
     let b = run(rom, &scene, &tested).expect("run testing every state");
-    assert_eq!(a.curves.t.len(), b.curves.t.len(), "output count");
-    let n = a.curves.t.len();
-    let (x, y) = (&a.curves, &b.curves);
-    let diff = [
-        (
-            "|f_c|",
-            rel_l2(&x.contact_force_norm, &y.contact_force_norm, n),
-        ),
-        (
-            "|f_R|",
-            rel_l2(&x.friction_force_norm, &y.friction_force_norm, n),
-        ),
-        ("u_y", rel_l2(&x.master_uy, &y.master_uy, n)),
-        ("D", rel_l2(&x.dissipated, &y.dissipated, n)),
-    ];
+    let diff = common::curve_differences(&a, &b);
     println!(
         "open memory untested vs tested: {diff:?}; steps {} vs {}",
         a.stats.steps, b.stats.steps
     );
     assert_ne!(
-        x.master_uy, y.master_uy,
+        a.curves.master_uy, b.curves.master_uy,
         "the weights changed nothing: the path is not taken"
     );
     for (what, e) in diff {
