@@ -99,8 +99,9 @@ pub struct TransientArgs {
     #[arg(long, value_enum)]
     stretch: Option<OnOff>,
     /// Reduced models: keep the slip memory of open pairs in the error test (on), or give it
-    /// zero weight, its value being slaved to the pair's tangential motion (off). The full
-    /// model tests every state. Default off
+    /// zero weight, its value being slaved to the pair's tangential motion (off: fewer steps,
+    /// but measured to stall on a tight tolerance model). The full model tests every state.
+    /// Default on
     #[arg(long, value_enum)]
     open_slip_test: Option<OnOff>,
     /// `--model full`: capacity of the exact low-rank update of the Newton factor at active-set
