@@ -93,7 +93,13 @@ pub(crate) fn sym_mul_compensated(
     out
 }
 
-/// One block of [`sym_mul_compensated`], written to `out` (n × x.ncols()).
+/// One block of [`sym_mul_compensated`], written to `out` (n × x.ncols(), at most
+/// [`COMPENSATED_BLOCK`] columns).
+///
+/// `s·x` (and `start`) are copied row-major, each row padded with zeros to whole chunks of
+/// [`LANES`], and every row's sums are held in registers over the row's stored entries
+/// ([`compensated_rows`]), instead of being loaded and stored around a call per stored entry:
+/// each entry gets the operations of [`product_sums`] in the column order of A, the same bits.
 fn sym_mul_compensated_block(
     a: &SymCsc,
     x: MatRef<'_, f64>,
@@ -103,33 +109,118 @@ fn sym_mul_compensated_block(
 ) {
     let n = a.n;
     let w = x.ncols();
-    // Row-major s·x.
-    let mut sx = vec![0.0; n * w];
+    let chunks = w.div_ceil(LANES);
+    assert!(
+        chunks * LANES <= COMPENSATED_BLOCK,
+        "a block of at most 32 columns"
+    );
+    let stride = chunks * LANES;
+    let mut sx = vec![0.0; n * stride];
     for c in 0..w {
-        for j in 0..n {
-            sx[j * w + c] = s * x[(j, c)];
+        for (j, v) in x.col(c).iter().enumerate() {
+            sx[j * stride + c] = s * v;
         }
     }
-    let mut hi = vec![0.0; w];
-    let mut lo = vec![0.0; w];
-    for i in 0..n {
+    let mut init = vec![0.0; n * stride];
+    if let Some(b) = start {
         for c in 0..w {
-            hi[c] = start.map_or(0.0, |b| b[(i, c)]);
-            lo[c] = 0.0;
+            for (j, v) in b.col(c).iter().enumerate() {
+                init[j * stride + c] = *v;
+            }
         }
-        for p in a.col_ptr[i]..a.col_ptr[i + 1] {
-            let j = a.row_idx[p];
-            product_sums(&mut hi, &mut lo, a.values[p], &sx[j * w..(j + 1) * w]);
-        }
-        for c in 0..w {
-            out[(i, c)] = hi[c] + lo[c];
+    }
+    let mut y = vec![0.0; n * stride];
+    compensated_rows_of(a, &sx, &init, &mut y, stride);
+    for c in 0..w {
+        for j in 0..n {
+            out[(j, c)] = y[j * stride + c];
         }
     }
 }
 
+/// [`compensated_rows`] for rows of `sx`, `init` and `y` of 8 to 32 values (whole chunks),
+/// compiled for AVX-512 / AVX2 as well as the baseline and dispatched at run time.
+#[multiversion::multiversion(targets(
+    "x86_64+avx512f+avx512vl+fma",
+    "x86_64+avx2+fma",
+    "x86_64+avx2"
+))]
+fn compensated_rows_of(a: &SymCsc, sx: &[f64], init: &[f64], y: &mut [f64], stride: usize) {
+    let fma = multiversion::target::target_cfg_f!(target_feature = "fma");
+    let args = (a, sx, init, y);
+    match stride {
+        0 => {}
+        8 => compensated_rows::<8>(args, fma),
+        16 => compensated_rows::<16>(args, fma),
+        24 => compensated_rows::<24>(args, fma),
+        _ => compensated_rows::<32>(args, fma),
+    }
+}
+
+/// Lanes of one chunk of accumulators in [`sym_mul_compensated_block`].
+const LANES: usize = 8;
+
+/// `y[i] = init[i] + Σ_p a_p sx[row(p)]` over column i of A for every row i (rows of W
+/// values), each lane accumulated in double-double ([`two_sum_product`]) in the column order of
+/// A and rounded once, the row's W lanes held in registers over its stored entries.
+#[inline(always)]
+fn compensated_rows<const W: usize>(
+    (a, sx, init, y): (&SymCsc, &[f64], &[f64], &mut [f64]),
+    fma: bool,
+) {
+    for i in 0..a.n {
+        let mut hi: [f64; W] = *lanes(init, i);
+        let mut lo = [0.0; W];
+        for p in a.col_ptr[i]..a.col_ptr[i + 1] {
+            two_sum_product(&mut hi, &mut lo, a.values[p], lanes(sx, a.row_idx[p]), fma);
+        }
+        let out = &mut y[i * W..(i + 1) * W];
+        for k in 0..W {
+            out[k] = hi[k] + lo[k];
+        }
+    }
+}
+
+/// `hi[k] + lo[k] += a · b[k]` for the lanes of one row: [`product_sums`]'s operations,
+/// inlined into its caller's target features.
+#[inline(always)]
+fn two_sum_product<const W: usize>(
+    hi: &mut [f64; W],
+    lo: &mut [f64; W],
+    a: f64,
+    b: &[f64; W],
+    fma: bool,
+) {
+    let (ah, al) = split(a);
+    for k in 0..W {
+        let prod = a * b[k];
+        let p_err = if fma {
+            a.mul_add(b[k], -prod)
+        } else {
+            let (bh, bl) = split(b[k]);
+            ((ah * bh - prod) + ah * bl + al * bh) + al * bl
+        };
+        let h = hi[k];
+        let sum = h + prod;
+        let z = sum - h;
+        let s_err = (h - (sum - z)) + (prod - z);
+        hi[k] = sum;
+        lo[k] += s_err + p_err;
+    }
+}
+
+/// Row `j` of a row-major array of rows of W values.
+#[inline(always)]
+fn lanes<const W: usize>(rows: &[f64], j: usize) -> &[f64; W] {
+    rows[j * W..(j + 1) * W]
+        .try_into()
+        .expect("rows of W values")
+}
+
 /// `hi[c] + lo[c] += a · b[c]` for every c: the error-free product and Knuth's TwoSum, the
-/// error terms summed into `lo` — the inner loop of [`sym_mul_compensated`],
-/// [`compensated_gram`] and the M-orthonormalization. Compiled for AVX-512 / AVX2 as well as
+/// error terms summed into `lo` — the inner loop of the M-orthonormalization, and the
+/// operations [`two_sum_product`] does on the lanes of [`sym_mul_compensated`] and
+/// [`compensated_gram`] held in registers. Compiled for AVX-512 / AVX2 as well as
 /// the baseline and dispatched at run time (`multiversion`).
 ///
 /// The product's rounding error `a·b − fl(a·b)` is exactly representable, and both ways of
@@ -243,38 +334,97 @@ pub(crate) fn compensated_gram(a: &SymCsc, phi: faer::MatRef<'_, f64>) -> Mat<f6
     let aphi = sym_mul_compensated(a, phi, 1.0, None);
     let r = phi.ncols();
     let n = phi.nrows();
-    // Row i of the upper triangle: hi and lo of the entries (i, j ≥ i).
+    // Row i of the upper triangle: hi and lo of the entries (i, j ≥ i), padded to whole
+    // chunks of LANES (the padding's sums are of zeros, and dropped).
     let mut rows: Vec<(Vec<f64>, Vec<f64>)> = (0..r)
-        .map(|i| (vec![0.0; r - i], vec![0.0; r - i]))
+        .map(|i| {
+            let len = (r - i).div_ceil(LANES) * LANES;
+            (vec![0.0; len], vec![0.0; len])
+        })
         .collect();
-    let mut b = vec![0.0; GRAM_ROWS.min(n) * r];
+    // Rows of A Φ padded with zeros, so that every row's last chunk reads within its row.
+    let stride = r + LANES;
+    let mut b = vec![0.0; GRAM_ROWS.min(n) * stride];
+    let mut phi_b = vec![vec![0.0; GRAM_ROWS.min(n)]; r];
     let mut k0 = 0;
     while k0 < n {
         let rows_b = GRAM_ROWS.min(n - k0);
         for j in 0..r {
             let col = aphi.col(j);
             for k in 0..rows_b {
-                b[k * r + j] = col[k0 + k];
+                b[k * stride + j] = col[k0 + k];
+            }
+            for (k, v) in phi_b[j][..rows_b].iter_mut().enumerate() {
+                *v = phi[(k0 + k, j)];
             }
         }
-        let b = &b;
+        let (b, phi_b) = (&b[..rows_b * stride], &phi_b);
         rows.par_iter_mut().enumerate().for_each(|(i, (hi, lo))| {
-            let phi_i = phi.col(i);
-            for k in 0..rows_b {
-                let row = k * r + i;
-                product_sums(hi, lo, phi_i[k0 + k], &b[row..row + r - i]);
-            }
+            gram_row_sums(hi, lo, &phi_b[i][..rows_b], b, (stride, i));
         });
         k0 += rows_b;
     }
     let mut g = Mat::<f64>::zeros(r, r);
     for (i, (hi, lo)) in rows.iter().enumerate() {
-        for (d, (h, l)) in hi.iter().zip(lo).enumerate() {
+        for (d, (h, l)) in hi.iter().zip(lo).take(r - i).enumerate() {
             g[(i, i + d)] = h + l;
             g[(i + d, i)] = h + l;
         }
     }
     g
+}
+
+/// `hi[d] + lo[d] += Σ_k phi[k] · b[k · stride + i + d]` for every lane d of `hi` and `lo`
+/// (whole chunks of [`LANES`]), k ascending: row i of [`compensated_gram`] over one block of
+/// rows of `A Φ`. The lanes go 32 at a time (the last group 8, 16 or 24), held in registers
+/// over the block's rows; each entry gets [`product_sums`]'s operations in the same order.
+#[multiversion::multiversion(targets(
+    "x86_64+avx512f+avx512vl+fma",
+    "x86_64+avx2+fma",
+    "x86_64+avx2"
+))]
+fn gram_row_sums(
+    hi: &mut [f64],
+    lo: &mut [f64],
+    phi: &[f64],
+    b: &[f64],
+    (stride, i): (usize, usize),
+) {
+    let fma = multiversion::target::target_cfg_f!(target_feature = "fma");
+    let mut d = 0;
+    while d < hi.len() {
+        let left = hi.len() - d;
+        let (h, l, j0) = (&mut hi[d..], &mut lo[d..], i + d);
+        match left {
+            8 => gram_lanes::<8>(h, l, phi, b, (stride, j0), fma),
+            16 => gram_lanes::<16>(h, l, phi, b, (stride, j0), fma),
+            24 => gram_lanes::<24>(h, l, phi, b, (stride, j0), fma),
+            _ => gram_lanes::<32>(h, l, phi, b, (stride, j0), fma),
+        }
+        d += 32;
+    }
+}
+
+/// W lanes of [`gram_row_sums`] from `hi[0]`, entry `j0` of the rows of `b` on.
+#[inline(always)]
+fn gram_lanes<const W: usize>(
+    hi: &mut [f64],
+    lo: &mut [f64],
+    phi: &[f64],
+    b: &[f64],
+    (stride, j0): (usize, usize),
+    fma: bool,
+) {
+    let mut h: [f64; W] = *lanes(hi, 0);
+    let mut l: [f64; W] = *lanes(lo, 0);
+    for (k, &a) in phi.iter().enumerate() {
+        let row: &[f64; W] = b[k * stride + j0..k * stride + j0 + W]
+            .try_into()
+            .expect("W entries");
+        two_sum_product(&mut h, &mut l, a, row, fma);
+    }
+    hi[..W].copy_from_slice(&h);
+    lo[..W].copy_from_slice(&l);
 }
 
 #[cfg(test)]
@@ -304,20 +454,30 @@ mod tests {
             row_idx,
             values,
         };
-        let r = 9;
-        let phi = Mat::from_fn(n, r, |k, c| {
-            ((k * (c + 3)) as f64 * 0.37).sin() * 10f64.powi(c as i32 - 4)
-        });
-        let g = compensated_gram(&a, phi.as_ref());
-        let aphi = sym_mul_compensated(&a, phi.as_ref(), 1.0, None);
-        for j in 0..r {
-            for i in 0..=j {
-                let mut acc = Dot2::new(0.0);
-                for k in 0..n {
-                    acc.add_product(phi[(k, i)], aphi[(k, j)]);
+        // Rows of the triangle of one to three chunks of lanes, one past a group of 32.
+        for r in [9, 41] {
+            let phi = Mat::from_fn(n, r, |k, c| {
+                ((k * (c + 3)) as f64 * 0.37).sin() * 10f64.powi(c as i32 % 9 - 4)
+            });
+            let g = compensated_gram(&a, phi.as_ref());
+            let aphi = sym_mul_compensated(&a, phi.as_ref(), 1.0, None);
+            for j in 0..r {
+                for i in 0..=j {
+                    let mut acc = Dot2::new(0.0);
+                    for k in 0..n {
+                        acc.add_product(phi[(k, i)], aphi[(k, j)]);
+                    }
+                    assert_eq!(
+                        g[(i, j)].to_bits(),
+                        acc.value().to_bits(),
+                        "r {r} ({i}, {j})"
+                    );
+                    assert_eq!(
+                        g[(j, i)].to_bits(),
+                        acc.value().to_bits(),
+                        "r {r} ({j}, {i})"
+                    );
                 }
-                assert_eq!(g[(i, j)].to_bits(), acc.value().to_bits(), "({i}, {j})");
-                assert_eq!(g[(j, i)].to_bits(), acc.value().to_bits(), "({j}, {i})");
             }
         }
     }
@@ -347,7 +507,7 @@ mod tests {
             row_idx,
             values,
         };
-        for w in [1, 31, 32, 33, 70] {
+        for w in [1, 5, 8, 9, 17, 24, 31, 32, 33, 70] {
             let x = Mat::from_fn(n, w, |i, c| ((i * 7 + c * 13) as f64).sin() * 1e3);
             let b = Mat::from_fn(n, w, |i, c| ((i + 3 * c) as f64).cos());
             let s = -0.7;
