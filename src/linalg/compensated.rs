@@ -36,15 +36,7 @@ impl Dot2 {
 
     /// `self += a·b`.
     pub(crate) fn add_product(&mut self, a: f64, b: f64) {
-        let p = a * b;
-        let (ah, al) = split(a);
-        let (bh, bl) = split(b);
-        let p_err = ((ah * bh - p) + ah * bl + al * bh) + al * bl;
-        let s = self.hi + p;
-        let z = s - self.hi;
-        let s_err = (self.hi - (s - z)) + (p - z);
-        self.hi = s;
-        self.lo += s_err + p_err;
+        product_sum(&mut self.hi, &mut self.lo, (a, split(a)), b, false);
     }
 
     pub(crate) fn value(self) -> f64 {
@@ -191,21 +183,9 @@ fn two_sum_product<const W: usize>(
     b: &[f64; W],
     fma: bool,
 ) {
-    let (ah, al) = split(a);
+    let halves = split(a);
     for k in 0..W {
-        let prod = a * b[k];
-        let p_err = if fma {
-            a.mul_add(b[k], -prod)
-        } else {
-            let (bh, bl) = split(b[k]);
-            ((ah * bh - prod) + ah * bl + al * bh) + al * bl
-        };
-        let h = hi[k];
-        let sum = h + prod;
-        let z = sum - h;
-        let s_err = (h - (sum - z)) + (prod - z);
-        hi[k] = sum;
-        lo[k] += s_err + p_err;
+        product_sum(&mut hi[k], &mut lo[k], (a, halves), b[k], fma);
     }
 }
 
@@ -237,21 +217,28 @@ fn lanes<const W: usize>(rows: &[f64], j: usize) -> &[f64; W] {
 ))]
 pub(crate) fn product_sums(hi: &mut [f64], lo: &mut [f64], a: f64, b: &[f64]) {
     let fma = multiversion::target::target_cfg_f!(target_feature = "fma");
-    let (ah, al) = split(a);
+    let halves = split(a);
     for ((h, l), &b) in hi.iter_mut().zip(lo.iter_mut()).zip(b) {
-        let prod = a * b;
-        let p_err = if fma {
-            a.mul_add(b, -prod)
-        } else {
-            let (bh, bl) = split(b);
-            ((ah * bh - prod) + ah * bl + al * bh) + al * bl
-        };
-        let sum = *h + prod;
-        let z = sum - *h;
-        let s_err = (*h - (sum - z)) + (prod - z);
-        *h = sum;
-        *l += s_err + p_err;
+        product_sum(h, l, (a, halves), b, fma);
     }
+}
+
+/// `h + l += a · b` for one entry: TwoProduct (FMA or Dekker's from the Veltkamp halves of
+/// `a` and `b`) and TwoSum, the errors summed into `l` ([`product_sums`]).
+#[inline(always)]
+fn product_sum(h: &mut f64, l: &mut f64, (a, (ah, al)): (f64, (f64, f64)), b: f64, fma: bool) {
+    let prod = a * b;
+    let p_err = if fma {
+        a.mul_add(b, -prod)
+    } else {
+        let (bh, bl) = split(b);
+        ((ah * bh - prod) + ah * bl + al * bh) + al * bl
+    };
+    let sum = *h + prod;
+    let z = sum - *h;
+    let s_err = (*h - (sum - z)) + (prod - z);
+    *h = sum;
+    *l += s_err + p_err;
 }
 
 /// Solves `A X = B` for all columns of `b` with the factorization `chol` of `a`, refined
