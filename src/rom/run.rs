@@ -173,6 +173,7 @@ fn run_tolerance(
         cpu_s,
         compression,
         force_atol,
+        friction_atol,
     } = tolerance_model(model, &topts)?;
     let frames = match (every, &rom.phi) {
         (Some(every), Some(phi)) => {
@@ -204,6 +205,7 @@ fn run_tolerance(
             rtol: transient.ode.rtol,
             atol: transient.ode.atol,
             force_atol,
+            friction_atol,
             compression,
         }),
     })

@@ -183,6 +183,41 @@ fn tolerance_force_floor_follows_the_joint_forces() {
     assert!(ranking > 1, "the ranking round was not repeated");
 }
 
+/// The whole rule is homogeneous in the load: with ‖f_c‖ and ‖f_R‖ controlled the rounds' atol
+/// is capped by both floors (`force_floor_atol`, `friction_floor_atol`), so the friction bar
+/// with its load scaled by 1/100 — 1/100 of every displacement and force, the laws being
+/// homogeneous of degree one — integrates at 1/100 of the unscaled bar's atol and ends at the
+/// same model, meeting the tolerance. (With the force floor alone its friction force was
+/// resolved 100× more coarsely than the unscaled bar's: ‖f_R‖ 1.3 % off, not met.)
+#[test]
+fn tolerance_model_is_homogeneous_in_the_load() {
+    let opts = ToleranceOptions::new(1e-2);
+    let m = model("friction_bar");
+    let unscaled = tolerance_model(&m, &opts).unwrap();
+    let mut small = model("friction_bar");
+    let l = &mut small.load.master;
+    for x in [
+        &mut l.fx, &mut l.fy, &mut l.fz, &mut l.mx, &mut l.my, &mut l.mz,
+    ] {
+        *x *= 1e-2;
+    }
+    let t = tolerance_model(&small, &opts).unwrap();
+    let floor = unscaled
+        .friction_atol
+        .expect("‖f_R‖ controlled: a friction floor");
+    let small_floor = t.friction_atol.expect("a friction floor");
+    assert!(
+        (floor / small_floor - 100.0).abs() < 5.0,
+        "friction floors {floor} / {small_floor}"
+    );
+    let ratio = unscaled.transient.ode.atol / t.transient.ode.atol;
+    assert!((ratio - 100.0).abs() < 5.0, "atol ratio {ratio}");
+    assert!(unscaled.met && t.met, "met: {} / {}", unscaled.met, t.met);
+    assert_eq!(t.pairs, unscaled.pairs);
+    assert_eq!(t.nu, unscaled.nu);
+    assert_eq!(t.rom.dim(), unscaled.rom.dim());
+}
+
 /// A tolerance model started at a ν the default truncated-mode set does not reach beyond
 /// (`--nu 40 --tolerance`) still gets its truncation checked: the estimate holds ν + 20 modes.
 #[test]

@@ -20,7 +20,9 @@
 //! ([`integration_looseness_for`]). With ‖f_c‖ controlled the rounds' atol is capped by the
 //! force floor ([`force_floor_atol`]): `k_n · atol ≤ θ·TOL·F`, F the first estimate's
 //! `(Σ_t ‖f_c*‖²)^{1/2}`, so that the force resolution follows the forces asked for, not a
-//! length fixed in mm (on a refined mesh more pairs share the load and F falls).
+//! length fixed in mm (on a refined mesh more pairs share the load and F falls); with ‖f_R‖
+//! controlled by the friction floor ([`friction_floor_atol`], the same with `k_t` and ‖f_R*‖).
+//! With both, a scene whose load is scaled gets its atol scaled alike.
 //!
 //! ## Why not the paper's w(g)
 //!
@@ -208,11 +210,17 @@ pub fn integration_looseness(tol: f64) -> f64 {
 /// correction is smooth where the run rings — and the rounds would add attachment modes and
 /// fixed-interface modes that remove nothing.
 pub fn integration_looseness_for(tol: f64, on: Quantities) -> f64 {
+    (tol / paper_level(on)).clamp(1.0, 1e4)
+}
+
+/// The tolerance at and below which the rounds start at the paper's integration tolerances
+/// (`s = 1` in [`integration_looseness_for`]): 1e-3 when ‖f_R‖ or D is controlled, else 1e-4.
+fn paper_level(on: Quantities) -> f64 {
     let friction = on.contains(Quantity::FrictionForce) || on.contains(Quantity::Dissipation);
     if friction {
-        (tol / 1e-3).clamp(1.0, 1e4)
+        1e-3
     } else {
-        integration_looseness(tol)
+        1e-4
     }
 }
 
@@ -240,6 +248,24 @@ pub fn force_floor_atol(tol: f64, corrected_norm2: f64, k_n: f64) -> Option<f64>
     (atol.is_finite() && atol > 0.0).then_some(atol)
 }
 
+/// The same floor for the friction force ([`force_floor_atol`] with the stick law): a sticking
+/// pair's force is `k_t` times an elastic stretch resolved to about atol, so one output's
+/// flicker moves the relative L2 error of ‖f_R‖(t) by `k_t · atol / F_R`, with
+/// `F_R = (Σ_t ‖f_R*(t)‖²)^{1/2}` from the first estimate's correction
+/// (`corrected_friction_norm2`, N²):
+///
+/// ```text
+/// atol_R = θ · TOL · F_R / k_t
+/// ```
+///
+/// With both floors the cap on atol is homogeneous of degree one in the load, like the penalty
+/// and Coulomb laws: a scene whose load is scaled by λ (zero initial gaps) gets its atol scaled
+/// by λ, and the same model. Without it a light load's friction force was resolved λ times more
+/// coarsely than the same scene's under the full load. `None` where nothing slides or sticks.
+pub fn friction_floor_atol(tol: f64, corrected_friction_norm2: f64, k_t: f64) -> Option<f64> {
+    force_floor_atol(tol, corrected_friction_norm2, k_t)
+}
+
 /// How many times the ranking round is repeated at most because its own run was coarser than
 /// [`RANKING_LOOSENING`]× the force floor it measured ([`force_floor_atol`]): a run whose force
 /// floor exceeds the joint forces measures its own noise, not their scale. It is repeated at
@@ -263,8 +289,15 @@ struct RoundTolerances {
     looseness: f64,
     /// Whether the force floor applies (‖f_c‖ controlled, tolerances from the tolerance).
     force_rule: bool,
+    /// Whether the friction floor applies (‖f_R‖ controlled, tolerances from the tolerance).
+    friction_rule: bool,
+    /// The tolerance the floors are taken at: TOL, but not below [`paper_level`] — where the
+    /// looseness stops at the paper's tolerances, so does the force resolution asked of them.
+    floor_tol: f64,
     /// The force floor's atol, once a ranking round has measured it.
     force_atol: Option<f64>,
+    /// The friction floor's atol ([`friction_floor_atol`]), once a ranking round has measured it.
+    friction_atol: Option<f64>,
     /// Ranking rounds repeated so far ([`FORCE_FLOOR_REPEATS`]).
     repeats: usize,
 }
@@ -279,7 +312,10 @@ impl RoundTolerances {
                 1.0
             },
             force_rule: from_tolerance && on.contains(Quantity::ContactForce),
+            friction_rule: from_tolerance && on.contains(Quantity::FrictionForce),
+            floor_tol: opts.tolerance.max(paper_level(on)),
             force_atol: None,
+            friction_atol: None,
             repeats: 0,
         }
     }
@@ -290,32 +326,39 @@ impl RoundTolerances {
         let factor = if ranking { RANKING_LOOSENING } else { 1.0 };
         capped(
             loosened(opts, self.looseness * factor),
-            self.force_atol.map(|a| a * factor),
+            self.cap().map(|a| a * factor),
         )
     }
 
-    /// Measures the force floor from a ranking round's estimate `d` (its run at `run_atol`) and
-    /// returns whether the ranking round is to be repeated: its run was coarser than
-    /// [`RANKING_LOOSENING`]× the floor, the floor moved by more than a factor 2 from the last
-    /// measurement, and repeats (and, `room`, rounds) are left.
-    fn measure(
-        &mut self,
-        model: &Model,
-        tol: f64,
-        d: &Estimate,
-        run_atol: f64,
-        room: bool,
-    ) -> bool {
-        if !self.force_rule {
+    /// The cap on atol: the tighter of the force and friction floors measured so far.
+    fn cap(&self) -> Option<f64> {
+        match (self.force_atol, self.friction_atol) {
+            (Some(a), Some(b)) => Some(a.min(b)),
+            (a, b) => a.or(b),
+        }
+    }
+
+    /// Measures the force and friction floors from a ranking round's estimate `d` (its run at
+    /// `run_atol`) and returns whether the ranking round is to be repeated: its run was coarser
+    /// than [`RANKING_LOOSENING`]× the floor, the floor moved by more than a factor 2 from the
+    /// last measurement, and repeats (and, `room`, rounds) are left.
+    fn measure(&mut self, model: &Model, d: &Estimate, run_atol: f64, room: bool) -> bool {
+        if !self.force_rule && !self.friction_rule {
             return false;
         }
-        let previous = self.force_atol;
-        let k_n = model.contact.normal_stiffness;
-        self.force_atol = force_floor_atol(tol, d.corrected_joint_norm2, k_n);
-        let coarse = self
-            .force_atol
-            .is_some_and(|a| run_atol > a * RANKING_LOOSENING * (1.0 + 1e-9));
-        let moved = match (previous, self.force_atol) {
+        let previous = self.cap();
+        if self.force_rule {
+            let k_n = model.contact.normal_stiffness;
+            self.force_atol = force_floor_atol(self.floor_tol, d.corrected_joint_norm2, k_n);
+        }
+        if self.friction_rule {
+            let k_t = model.contact.stick_stiffness;
+            let norm2 = d.corrected_joint_friction_norm2;
+            self.friction_atol = friction_floor_atol(self.floor_tol, norm2, k_t);
+        }
+        let cap = self.cap();
+        let coarse = cap.is_some_and(|a| run_atol > a * RANKING_LOOSENING * (1.0 + 1e-9));
+        let moved = match (previous, cap) {
             (Some(p), Some(a)) => (p / a).max(a / p) > 2.0,
             _ => true,
         };
@@ -482,9 +525,12 @@ pub struct ToleranceModel {
     pub cpu_s: f64,
     /// What the compression of the joint columns did (`None`: not tried).
     pub compression: Option<Compression>,
-    /// The force floor's atol ([`force_floor_atol`], mm): the cap on the rounds' atol (`None`:
+    /// The force floor's atol ([`force_floor_atol`], mm): a cap on the rounds' atol (`None`:
     /// no cap — ‖f_c‖ not controlled, `--rtol/--atol` given, or no contact).
     pub force_atol: Option<f64>,
+    /// The friction floor's atol ([`friction_floor_atol`], mm): the other cap (`None`: ‖f_R‖
+    /// not controlled, `--rtol/--atol` given, or no friction force).
+    pub friction_atol: Option<f64>,
 }
 
 /// What the tolerance model chose, as the outputs report it (`"tolerance"` in a run's JSON).
@@ -520,6 +566,9 @@ pub struct ToleranceChoice {
     /// [`force_floor_atol`]).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub force_atol: Option<f64>,
+    /// The friction floor's atol (mm), the other cap (absent: no cap; [`friction_floor_atol`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub friction_atol: Option<f64>,
     /// What the compression of the joint columns did (absent: not tried): how many compressed
     /// columns replaced how many per-pair ones, and whether that model is the result.
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -592,8 +641,7 @@ pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<Toleran
             on,
             tol,
         )?;
-        // The next round, if expected to be the result, is expected with its reduction part
-        // within its share.
+        // A next round expected to be the result: expected with its reduction part in its share.
         let expected = SELECTION_MARGIN * tol;
         separate = !combined_may_meet(expected, &estimate, tol, &transient);
         let eta = worst(&estimate.model_error(), on);
@@ -610,7 +658,7 @@ pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<Toleran
         // The force floor from the ranking round's correction, the ranking round again if
         // its own run was too coarse to measure it (RoundTolerances::measure).
         let room = rounds.len() < opts.max_rounds;
-        if ranking && tolerances.measure(model, tol, d, transient.ode.atol, room) {
+        if ranking && tolerances.measure(model, d, transient.ode.atol, room) {
             continue;
         }
         let mut changed = false;
@@ -676,6 +724,7 @@ pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<Toleran
                 cpu_s: f64::NAN,
                 compression: None,
                 force_atol: tolerances.force_atol,
+                friction_atol: tolerances.friction_atol,
             };
             compress::compress_result(model, &flex, (&chosen, &bases, &cb), opts, &mut result)?;
             result.cpu_s = process_cpu_s() - cpu_start;
