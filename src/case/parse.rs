@@ -30,10 +30,45 @@ pub(crate) fn parse_object<T: serde::de::DeserializeOwned>(
     let mut de = serde_json::Deserializer::from_str(text);
     let value: T = serde_path_to_error::deserialize(&mut de).map_err(|e| {
         let path = e.path().to_string();
-        serde_error(file, &path, e.into_inner())
+        let e = e.into_inner();
+        match typed_reason::<T>(text, &path, &e) {
+            Some(reason) => Error::Case {
+                file: file.to_string(),
+                path,
+                reason,
+                source: Some(Box::new(e)),
+            },
+            None => serde_error(file, &path, e),
+        }
     })?;
     de.end().map_err(|e| serde_error(file, ".", e))?;
     Ok(value)
+}
+
+/// The reason for a "syntax" error of serde_json's typed reader that is not one: an enum field
+/// (a name among fixed choices) given a number, `null`, `true` or an array makes the reader
+/// report `expected value`, as for text that is no JSON at all. If the whole text is valid JSON,
+/// the value is read again from its parsed form, whose reader says what it found and what it
+/// expected (`invalid type: integer `1`, expected string or map`); taken only where that reader
+/// stops at the same path (`path`), with the text's position.
+fn typed_reason<T: serde::de::DeserializeOwned>(
+    text: &str,
+    path: &str,
+    e: &serde_json::Error,
+) -> Option<String> {
+    if e.classify() != serde_json::error::Category::Syntax {
+        return None;
+    }
+    let parsed: serde_json::Value = serde_json::from_str(text).ok()?;
+    let typed = serde_path_to_error::deserialize::<_, T>(parsed).err()?;
+    (typed.path().to_string() == path).then(|| {
+        format!(
+            "{} (line {}, column {})",
+            typed.into_inner(),
+            e.line(),
+            e.column()
+        )
+    })
 }
 
 /// One serde_json error as [`Error::Case`]: the path as `serde_path_to_error` renders it (its

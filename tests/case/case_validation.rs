@@ -151,6 +151,15 @@ fn wrong_types() {
         "load.ramp.shape",
         "unknown variant",
     );
+    // A name field given a number or null is valid JSON of the wrong type, not "invalid JSON".
+    for v in [json!(1), json!(null), json!([true])] {
+        edited(|c| c["contact"]["slip"] = v, "contact.slip", "invalid type");
+    }
+    edited(
+        |c| c["load"]["ramp"]["shape"] = json!(2),
+        "load.ramp.shape",
+        "invalid type",
+    );
 }
 
 #[test]
