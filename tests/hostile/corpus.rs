@@ -303,7 +303,8 @@ fn per_area(fx: &Fixture) -> Vec<Hostile> {
     ]
 }
 
-/// Contact points inside the joint's faces: the contact block's `sampling`, a map's, the flag.
+/// Contact points inside the joint's faces: the contact block's `sampling`, a map's, the flag;
+/// the contact block's `slip`.
 fn sampling(fx: &Fixture) -> Vec<Hostile> {
     let (c, map, k, m) = (&fx.case, &fx.map, &fx.k, &fx.m);
     use Expect::Fails;
@@ -380,6 +381,18 @@ fn sampling(fx: &Fixture) -> Vec<Hostile> {
             Fails("--contact-sampling"),
         )
         .file("deck.bdf", deck_text()),
+        info_case(
+            "case-slip-number",
+            "where the slips are taken, given as a number",
+            edit(c, |v| v["contact"]["slip"] = json!(1)),
+            Fails("contact.slip`: invalid type: integer `1`, expected string"),
+        ),
+        info_case(
+            "case-slip-null",
+            "where the slips are taken, given as null",
+            edit(c, |v| v["contact"]["slip"] = json!(null)),
+            Fails("contact.slip`: invalid type: null, expected string"),
+        ),
     ]
 }
 
