@@ -31,17 +31,10 @@ pub(crate) fn parse_object<T: serde::de::DeserializeOwned>(
     let value: T = serde_path_to_error::deserialize(&mut de).map_err(|e| {
         let path = e.path().to_string();
         let e = e.into_inner();
-        match typed_reason::<T>(text, &path, &e) {
-            Some(reason) => Error::Case {
-                file: file.to_string(),
-                path,
-                reason,
-                source: Some(Box::new(e)),
-            },
-            None => serde_error(file, &path, e),
-        }
+        let typed = typed_reason::<T>(text, &path, &e);
+        serde_error(file, &path, e, typed)
     })?;
-    de.end().map_err(|e| serde_error(file, ".", e))?;
+    de.end().map_err(|e| serde_error(file, ".", e, None))?;
     Ok(value)
 }
 
@@ -50,7 +43,7 @@ pub(crate) fn parse_object<T: serde::de::DeserializeOwned>(
 /// report `expected value`, as for text that is no JSON at all. If the whole text is valid JSON,
 /// the value is read again from its parsed form, whose reader says what it found and what it
 /// expected (`invalid type: integer `1`, expected string or map`); taken only where that reader
-/// stops at the same path (`path`), with the text's position.
+/// stops at the same path (`path`).
 fn typed_reason<T: serde::de::DeserializeOwned>(
     text: &str,
     path: &str,
@@ -61,22 +54,18 @@ fn typed_reason<T: serde::de::DeserializeOwned>(
     }
     let parsed: serde_json::Value = serde_json::from_str(text).ok()?;
     let typed = serde_path_to_error::deserialize::<_, T>(parsed).err()?;
-    (typed.path().to_string() == path).then(|| {
-        format!(
-            "{} (line {}, column {})",
-            typed.into_inner(),
-            e.line(),
-            e.column()
-        )
-    })
+    (typed.path().to_string() == path).then(|| typed.into_inner().to_string())
 }
 
 /// One serde_json error as [`Error::Case`]: the path as `serde_path_to_error` renders it (its
 /// root `.` and an unknown top-level segment `?` are shown as `$`), extended by the field's name
-/// for a missing field; the reason is the message with its line and column.
-fn serde_error(file: &str, path: &str, e: serde_json::Error) -> Error {
+/// for a missing field; the reason is the message (or `typed`, [`typed_reason`]) with its line
+/// and column.
+fn serde_error(file: &str, path: &str, e: serde_json::Error, typed: Option<String>) -> Error {
     let full = e.to_string();
     let position = format!(" at line {} column {}", e.line(), e.column());
+    let is_typed = typed.is_some();
+    let full = typed.unwrap_or(full);
     let message = full.strip_suffix(&position).unwrap_or(&full);
     let missing = message
         .strip_prefix("missing field `")
@@ -96,7 +85,7 @@ fn serde_error(file: &str, path: &str, e: serde_json::Error) -> Error {
         _ if message.starts_with("number out of range") => {
             format!("not a finite number: {message}")
         }
-        serde_json::error::Category::Syntax | serde_json::error::Category::Eof => {
+        serde_json::error::Category::Syntax | serde_json::error::Category::Eof if !is_typed => {
             format!("invalid JSON: {message}")
         }
         _ => message,

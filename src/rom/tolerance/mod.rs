@@ -198,8 +198,14 @@ pub enum IntegrationTolerances {
 /// checks the choice: while its total misses TOL, `s` drops tenfold and the model is re-run,
 /// down to `s = 1`.
 pub fn integration_looseness(tol: f64) -> f64 {
-    (tol / 1e-4).clamp(1.0, 1e4)
+    (tol / PAPER_LEVEL).clamp(1.0, 1e4)
 }
+
+/// The tolerance at and below which [`integration_looseness`] is 1 (the paper's tolerances).
+const PAPER_LEVEL: f64 = 1e-4;
+
+/// The same with ‖f_R‖ or D controlled ([`integration_looseness_for`]): ten times higher.
+const PAPER_LEVEL_FRICTION: f64 = 1e-3;
 
 /// [`integration_looseness`] for the quantities `on`: ten times tighter when ‖f_R‖ or D is
 /// controlled, `s = clamp(tol / 1e-3, 1, 1e4)`. The friction force is the quantity most
@@ -218,9 +224,9 @@ pub fn integration_looseness_for(tol: f64, on: Quantities) -> f64 {
 fn paper_level(on: Quantities) -> f64 {
     let friction = on.contains(Quantity::FrictionForce) || on.contains(Quantity::Dissipation);
     if friction {
-        1e-3
+        PAPER_LEVEL_FRICTION
     } else {
-        1e-4
+        PAPER_LEVEL
     }
 }
 
