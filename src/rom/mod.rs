@@ -41,4 +41,6 @@ pub use compare::{relative_l2, JointCurves, ReferenceCurves, ReferenceErrors};
 pub use estimate::{run_estimated, RunEstimate};
 pub use run::{run_model, run_rom, Frames, ModelRun, RunSettings};
 pub use spec::{ModelFlags, ModelSpec};
-pub use tolerance::{tolerance_model, CompressJoint, ToleranceModel, ToleranceOptions};
+pub use tolerance::{
+    tolerance_model, CompressJoint, StoppedRound, ToleranceModel, ToleranceOptions,
+};

@@ -174,6 +174,7 @@ fn run_tolerance(
         compression,
         force_atol,
         friction_atol,
+        stopped,
     } = tolerance_model(model, &topts)?;
     let frames = match (every, &rom.phi) {
         (Some(every), Some(phi)) => {
@@ -207,6 +208,7 @@ fn run_tolerance(
             force_atol,
             friction_atol,
             compression,
+            stopped,
         }),
     })
 }

@@ -218,6 +218,58 @@ fn tolerance_model_is_homogeneous_in_the_load() {
     assert_eq!(t.rom.dim(), unscaled.rom.dim());
 }
 
+/// A richer round whose run stops (here on CVODE's step limit, set between the steps of the
+/// rounds before it, which made no re-runs, and its own) leaves the model of the round before
+/// it as the result, not met, with the stopped round reported — not an error that discards the
+/// offline work.
+#[test]
+fn a_stopped_round_leaves_the_model_before_it() {
+    use jointrom::rom::tolerance::Round;
+    let m = model("friction_bar");
+    let opts = ToleranceOptions::new(1e-3);
+    let free = tolerance_model(&m, &opts).unwrap();
+    let rounds = &free.rounds;
+    // The first round at the user's tolerances with more steps than every round before it,
+    // after one that could be the result and with no re-runs before it.
+    let k = (1..rounds.len())
+        .find(|&k| {
+            let before = &rounds[..k];
+            let most = before.iter().map(|r| r.steps).max().unwrap_or(0);
+            !rounds[k].ranking
+                && rounds[k].steps > most
+                && !before[k - 1].ranking
+                && before.iter().all(|r| r.checks == ReRuns::None)
+        })
+        .unwrap_or_else(|| {
+            panic!(
+                "no round to stop in this scene's search (ranking, steps, checks): {:?}",
+                rounds
+                    .iter()
+                    .map(|r| (r.ranking, r.steps, r.checks))
+                    .collect::<Vec<_>>()
+            )
+        });
+    let most = rounds[..k].iter().map(|r| r.steps).max().unwrap_or(0);
+    let mut limited = opts.clone();
+    limited.transient.ode.max_steps = ((most + rounds[k].steps) / 2) as usize;
+    let t = tolerance_model(&m, &limited).unwrap();
+    let stopped = t.stopped.as_ref().expect("a round stopped");
+    assert!(!t.met, "a stopped search is not met");
+    assert!(
+        stopped.reason.contains("CV_TOO_MUCH_WORK"),
+        "reason: {}",
+        stopped.reason
+    );
+    assert_eq!(stopped.basis_size, rounds[k].basis_size);
+    // The result is round k − 1's model and run, and the rounds up to it are the free
+    // search's, bit for bit.
+    assert_eq!(t.rounds.len(), k);
+    assert_eq!(t.rom.dim(), rounds[k - 1].basis_size);
+    assert!(t.run.failure.is_none() && t.run.stats.steps == rounds[k - 1].steps);
+    let key = |r: &Round| (r.basis_size, r.steps, r.estimate.map(f64::to_bits));
+    assert!(t.rounds.iter().zip(rounds).all(|(a, b)| key(a) == key(b)));
+}
+
 /// A tolerance model started at a ν the default truncated-mode set does not reach beyond
 /// (`--nu 40 --tolerance`) still gets its truncation checked: the estimate holds ν + 20 modes.
 #[test]

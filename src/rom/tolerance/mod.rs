@@ -106,7 +106,11 @@
 //! then misses TOL is dropped, and every estimate and model is the one the sequential order
 //! gives, bit for bit. When it does not — nothing left to add, or the integration error of the
 //! user's tolerances above TOL — the best model is returned with `met = false` (the CLI warns;
-//! tighter `--rtol/--atol` lower the integration floor).
+//! tighter `--rtol/--atol` lower the integration floor). So is the last model that could be the
+//! result when a richer round's run (or a check's re-run) stops before its end time — CVODE's
+//! step limit, a convergence failure, a stall, the wall-clock budget: the offline work up to it
+//! is a model with an estimate, and the stopped round is reported beside it (`stopped`); a
+//! request or model error is still an error.
 
 use std::collections::HashMap;
 use std::sync::Arc;
@@ -431,6 +435,8 @@ pub struct Round {
     pub combined_check: Option<f64>,
     /// Wall time of the round's run, s.
     pub wall_s: f64,
+    /// The integration steps of the round's run.
+    pub steps: u64,
     /// Wall time of the round's basis and reduced system, s.
     pub basis_s: f64,
     /// Wall time of the round's estimate, s.
@@ -444,13 +450,15 @@ pub struct Round {
 impl Round {
     /// The record of a round with the joint part `chosen`, ν and basis size `(nu, r)`, its
     /// estimate (its parts' largest over the quantities `on`), its combined check's part, where
-    /// it made its re-runs and whether it ranked, and its timings (run, basis, estimate; s).
+    /// it made its re-runs and whether it ranked, its run's steps and its timings (run, basis,
+    /// estimate; s).
     fn of(
         chosen: &Chosen,
         (nu, basis_size): (usize, usize),
         estimate: &RunEstimate,
         on: Quantities,
         (combined_check, checks, ranking): (Option<f64>, ReRuns, bool),
+        steps: u64,
         (wall_s, basis_s, estimate_s): (f64, f64, f64),
     ) -> Round {
         let d = &estimate.detail;
@@ -467,6 +475,7 @@ impl Round {
             truncation_check: estimate.truncation.map(|t| worst(&t, on)),
             combined_check,
             wall_s,
+            steps,
             basis_s,
             estimate_s,
             ranking,
@@ -537,6 +546,78 @@ pub struct ToleranceModel {
     /// The friction floor's atol ([`friction_floor_atol`], mm): the other cap (`None`: ‖f_R‖
     /// not controlled, `--rtol/--atol` given, or no friction force).
     pub friction_atol: Option<f64>,
+    /// A richer round whose run stopped before its end time (`None`: none did): the result is
+    /// then the model of the round before it, not met, its estimate as far as its round made
+    /// it.
+    pub stopped: Option<StoppedRound>,
+}
+
+impl ToleranceModel {
+    /// The model of a round with the joint part `chosen`, the quantities `on`, ν and the setup's
+    /// wall time, with its system, run and estimate; not met, no rounds, no offline time, the
+    /// run's transient options and no floors (the caller sets those).
+    fn of(
+        chosen: &Chosen,
+        (on, nu, setup_s): (Quantities, usize, f64),
+        (rom, run, estimate): (ReducedSystem, Run, RunEstimate),
+    ) -> ToleranceModel {
+        ToleranceModel {
+            pairs: chosen.pairs.clone(),
+            tangential: chosen.tangential.clone(),
+            quantities: on,
+            nu,
+            setup_s,
+            rom,
+            transient: TransientOptions::default(),
+            run,
+            met: false,
+            estimate,
+            estimate_s: 0.0,
+            rounds: Vec::new(),
+            offline_s: 0.0,
+            cpu_s: f64::NAN,
+            compression: None,
+            force_atol: None,
+            friction_atol: None,
+            stopped: None,
+        }
+    }
+}
+
+impl StoppedRound {
+    /// The record of a round with the joint part `chosen`, ν, system `rom` and transient
+    /// options `transient`, before it runs (no reason yet).
+    fn of(chosen: &Chosen, nu: usize, rom: &ReducedSystem, transient: &TransientOptions) -> Self {
+        StoppedRound {
+            pairs: chosen.pairs.len(),
+            tangential_pairs: chosen.tangential.len(),
+            nu,
+            basis_size: rom.dim(),
+            rtol: transient.ode.rtol,
+            atol: transient.ode.atol,
+            reason: String::new(),
+        }
+    }
+}
+
+/// A round of [`tolerance_model`] whose run (or a check's re-run) stopped before its end time
+/// (`"stopped"` of the tolerance JSON).
+#[derive(Clone, Debug, Serialize)]
+pub struct StoppedRound {
+    /// Pairs whose attachment modes its basis held.
+    pub pairs: usize,
+    /// Tangential attachment modes its basis held.
+    pub tangential_pairs: usize,
+    /// Fixed-interface modes ν of its basis.
+    pub nu: usize,
+    /// Its basis size r.
+    pub basis_size: usize,
+    /// Its integration tolerances: CVODE's rtol and atol (mm).
+    pub rtol: f64,
+    /// See `rtol`.
+    pub atol: f64,
+    /// What stopped it (the run's error: CVODE's flag and the time reached, a stall, ...).
+    pub reason: String,
 }
 
 /// What the tolerance model chose, as the outputs report it (`"tolerance"` in a run's JSON).
@@ -579,6 +660,10 @@ pub struct ToleranceChoice {
     /// columns replaced how many per-pair ones, and whether that model is the result.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub compression: Option<Compression>,
+    /// A richer round whose run stopped before its end time (absent: none did); the result is
+    /// then the round's before it, not met.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub stopped: Option<StoppedRound>,
 }
 
 /// Builds the smallest Craig–Bampton + pair-attachment-mode model whose estimated errors of the
@@ -589,11 +674,81 @@ pub struct ToleranceChoice {
 /// run cannot produce ([`RomError::ToleranceOnFriction`]), a failing basis, a run that does not
 /// finish or an estimate that cannot be made.
 pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<ToleranceModel, Error> {
+    let start = Instant::now();
+    let cpu_start = process_cpu_s();
+    let mut progress = Progress::default();
+    let mut result = match search(model, opts, start, &mut progress) {
+        Ok(result) => result,
+        Err(e) => progress.fall_back(e, start)?,
+    };
+    result.cpu_s = process_cpu_s() - cpu_start;
+    Ok(result)
+}
+
+/// What [`search`] leaves behind for a round that stops: the rounds so far, the last model
+/// that could be the result and the round being made.
+#[derive(Default)]
+struct Progress {
+    rounds: Vec<Round>,
+    /// The last completed round's model at the user's tolerances (not a ranking round), with
+    /// the number of rounds up to it.
+    best: Option<(ToleranceModel, usize)>,
+    /// The round being made: what [`StoppedRound`] reports if its runs stop.
+    current: Option<StoppedRound>,
+}
+
+impl Progress {
+    /// The result after [`search`] failed with `e`: when `e` is a run that stopped before its
+    /// end time (CVODE's step limit or a convergence failure, a stall, the wall-clock budget, an
+    /// overflow) in a round after a model that could be the result, that model, not met, with
+    /// the stopped round; any other error, or no such model, is `e`.
+    fn fall_back(self, e: Error, start: Instant) -> Result<ToleranceModel, Error> {
+        let (Some((mut best, upto)), Some(mut stopped)) = (self.best, self.current) else {
+            return Err(e);
+        };
+        if !stopped_in_time(&e) {
+            return Err(e);
+        }
+        stopped.reason = e.to_string();
+        let mut rounds = self.rounds;
+        rounds.truncate(upto);
+        best.rounds = rounds;
+        best.met = false;
+        best.offline_s = start.elapsed().as_secs_f64() - best.run.wall_s - best.estimate_s;
+        best.stopped = Some(stopped);
+        Ok(best)
+    }
+}
+
+/// Whether `e` is a time integration that stopped before its end time (as opposed to a
+/// request or model error): a SUNDIALS failure, a callback failure CVODE returned (the
+/// wall-clock budget among them), chattering events, a stall or an overflowing output.
+fn stopped_in_time(e: &Error) -> bool {
+    use crate::error::{CallbackOutcome, IntegrationError};
+    matches!(
+        e,
+        Error::Sundials { .. }
+            | Error::Callback {
+                outcome: CallbackOutcome::Returned { .. },
+                ..
+            }
+            | Error::Chatter { .. }
+            | Error::Integration(
+                IntegrationError::Stalled { .. } | IntegrationError::OutputNotFinite { .. }
+            )
+    )
+}
+
+/// The rounds of [`tolerance_model`] from `start`, recording them in `progress`.
+fn search(
+    model: &Model,
+    opts: &ToleranceOptions,
+    start: Instant,
+    progress: &mut Progress,
+) -> Result<ToleranceModel, Error> {
     let tol = opts.tolerance;
     check_tolerance(tol)?;
     let on = controlled_quantities(opts.quantities, opts.transient.problem.friction)?;
-    let start = Instant::now();
-    let cpu_start = process_cpu_s();
     let mut nu = opts.nu;
     let (flex, fixed, mut cb) = setup(model, nu)?;
     // A start ν given above the held set's default keeps modes beyond it checked too.
@@ -601,7 +756,7 @@ pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<Toleran
     let setup_s = start.elapsed().as_secs_f64();
     let mut chosen = Chosen::default();
     let mut bases = BasisCache::new(model);
-    let mut rounds = Vec::new();
+    let rounds = &mut progress.rounds;
     // The Craig–Bampton round only ranks the pairs: looser tolerances (module docs).
     let mut ranking = true;
     // Whether the round is expected to be the result (its checks then go beside its run).
@@ -615,6 +770,7 @@ pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<Toleran
         let rom = reduced_on(model, &cb, &flex, &chosen, &mut bases)?;
         let basis_s = round_start.elapsed().as_secs_f64();
         let transient = tolerances.transient(&opts.transient, ranking);
+        progress.current = (!ranking).then(|| StoppedRound::of(&chosen, nu, &rom, &transient));
         // A round expected to be the result makes its two checks beside its run (on a second
         // core); any other round makes them after its correction, only if it may be the result.
         let scene = Scene::of(model);
@@ -659,6 +815,7 @@ pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<Toleran
             &estimate,
             on,
             (combined, made, ranking),
+            run.stats.steps,
             (run.wall_s, basis_s, estimate_s),
         ));
         // The force floor from the ranking round's correction, the ranking round again if
@@ -689,9 +846,9 @@ pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<Toleran
                 expect_result = true;
             }
         }
-        let was_ranking = std::mem::replace(&mut ranking, false);
-        if !changed && was_ranking {
-            // A ranking run is never the result: the same model again at the user's tolerances.
+        if std::mem::replace(&mut ranking, false) {
+            // A ranking run is never the result: the same model again at the user's tolerances
+            // (or the one it enriched).
             continue;
         }
         if !changed && estimate.integration.is_none() && estimate.combined.is_none() {
@@ -709,33 +866,24 @@ pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<Toleran
         // again, ten times tighter (the reduction part is within its share, or the loop would
         // have enriched the basis).
         let total = worst(&estimate.total, on);
-        if !changed && estimate.integration.is_some() && total > tol && tolerances.tighten() {
+        let again =
+            changed || (estimate.integration.is_some() && total > tol && tolerances.tighten());
+        let mut result = ToleranceModel::of(&chosen, (on, nu, setup_s), (rom, run, estimate));
+        result.met = total <= tol;
+        result.estimate_s = rounds.last().map_or(0.0, |r| r.estimate_s);
+        result.offline_s = (round_start - start).as_secs_f64() + basis_s;
+        (result.transient, result.force_atol) = (transient, tolerances.force_atol);
+        result.friction_atol = tolerances.friction_atol;
+        if again {
+            // The model the next rounds fall back to if their runs stop (Progress::fall_back).
+            progress.best = Some((result, rounds.len()));
             continue;
         }
-        if !changed {
-            let mut result = ToleranceModel {
-                pairs: chosen.pairs.clone(),
-                tangential: chosen.tangential.clone(),
-                quantities: on,
-                nu,
-                setup_s,
-                rom,
-                run,
-                met: total <= tol,
-                estimate,
-                estimate_s: rounds.last().map_or(0.0, |r| r.estimate_s),
-                rounds,
-                offline_s: (round_start - start).as_secs_f64() + basis_s,
-                transient,
-                cpu_s: f64::NAN,
-                compression: None,
-                force_atol: tolerances.force_atol,
-                friction_atol: tolerances.friction_atol,
-            };
-            compress::compress_result(model, &flex, (&chosen, &bases, &cb), opts, &mut result)?;
-            result.cpu_s = process_cpu_s() - cpu_start;
-            return Ok(result);
-        }
+        // The result: what the compression does is its own (a failed attempt is no round's).
+        progress.current = None;
+        result.rounds = std::mem::take(rounds);
+        compress::compress_result(model, &flex, (&chosen, &bases, &cb), opts, &mut result)?;
+        return Ok(result);
     }
 }
 

@@ -198,6 +198,13 @@ pub fn run(a: TransientArgs) -> Result<(), Error> {
                 .collect::<Vec<_>>()
                 .join(", ")
         );
+        if let Some(s) = &t.stopped {
+            eprintln!(
+                "warning: the richer model after it ({} pairs, r = {}, rtol {:e}, atol {:e}) \
+                 stopped: {}",
+                s.pairs, s.basis_size, s.rtol, s.atol, s.reason
+            );
+        }
     }
     let total_s = t0.elapsed().as_secs_f64();
     let name = spec_name(&a, &spec);
