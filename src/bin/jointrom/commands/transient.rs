@@ -100,8 +100,8 @@ pub struct TransientArgs {
     stretch: Option<OnOff>,
     /// Reduced models: keep the slip memory of open pairs in the error test (on), or give it
     /// zero weight, its value being slaved to the pair's tangential motion (off: fewer steps,
-    /// but measured to stall on a tight tolerance model). The full model tests every state.
-    /// Default on
+    /// the same curves to the integration tolerance). The full model tests every state.
+    /// Default off
     #[arg(long, value_enum)]
     open_slip_test: Option<OnOff>,
     /// `--model full`: capacity of the exact low-rank update of the Newton factor at active-set
