@@ -140,12 +140,23 @@ impl SubsetLlt {
         }
         let keep: Vec<usize> = (0..n).filter(|&p| !gone[p]).collect();
         let m = keep.len();
-        let mut l = Mat::from_fn(m, m, |i, j| self.l[(keep[i], keep[j])]);
         // W: the removed columns at the kept rows; zero above row `first` (of the kept rows,
         // `first` of them precede the first removed position).
         let mut w = Mat::from_fn(m - first, removed.len(), |i, d| {
             self.l[(keep[first + i], removed[d])]
         });
+        // L': the kept rows and columns moved up and left in place (module docs, "Removing").
+        // Every source position is at or below and right of its destination, and the
+        // destinations are written in ascending order, so no source is overwritten before it
+        // is read. The first `first` columns keep their position; only their rows move.
+        let l = &mut self.l;
+        for (jj, &j) in keep.iter().enumerate() {
+            let from = if jj < first { first } else { jj };
+            for (ii, &i) in keep.iter().enumerate().skip(from) {
+                l[(ii, jj)] = l[(i, j)];
+            }
+        }
+        l.truncate(m, m);
         let mut alpha = Mat::<f64>::from_fn(removed.len(), 1, |_, _| 1.0);
         rank_r_update_clobber(
             l.as_mut().submatrix_mut(first, first, m - first, m - first),
@@ -159,7 +170,6 @@ impl SubsetLlt {
             ),
             source: Box::new(e),
         })?;
-        self.l = l;
         self.order = keep.iter().map(|&p| self.order[p]).collect();
         Ok(())
     }

@@ -221,6 +221,7 @@ fn a_runs_curves_csv_is_a_reference() {
         pair: ramp(0.0),
         external_work: ramp(0.0),
         dissipated: ramp(10.0),
+        closed_pairs: vec![0; t.len()],
         t: t.clone(),
     };
     let csv = jointrom::report::curves::curves_csv(&run).unwrap();

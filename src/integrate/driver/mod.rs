@@ -495,6 +495,7 @@ mod tests {
             pair: vec![0.0; 2],
             external_work: vec![0.0, work],
             dissipated: vec![0.0; 2],
+            closed_pairs: vec![0; 2],
         }
     }
 

@@ -29,6 +29,8 @@ pub struct Curves {
     pub external_work: Vec<f64>,
     /// Dissipated energy, N·mm.
     pub dissipated: Vec<f64>,
+    /// Pairs in contact (a non-zero normal force).
+    pub closed_pairs: Vec<usize>,
 }
 
 impl Curves {
@@ -42,6 +44,7 @@ impl Curves {
         self.pair.push(s.pair);
         self.external_work.push(s.external_work);
         self.dissipated.push(s.dissipated);
+        self.closed_pairs.push(s.closed_pairs);
     }
 
     /// The energy balance `E_kin + E_strain + E_pair + D − W` at each output minus its value at

@@ -848,7 +848,9 @@ impl<S: SecondOrderSystem> MechanicalOde<S> {
         let mut fc = 0.0;
         let mut fr = 0.0;
         let mut pair = 0.0;
+        let mut closed = 0;
         for k in 0..self.w {
+            closed += usize::from(self.p[3 * k] != 0.0);
             fc += self.p[3 * k].powi(2);
             fr += self.p[3 * k + 1].powi(2) + self.p[3 * k + 2].powi(2);
             let sk = if self.law.friction {
@@ -874,6 +876,7 @@ impl<S: SecondOrderSystem> MechanicalOde<S> {
             pair,
             external_work: self.e_scale * rest[0],
             dissipated: self.e_scale * rest[1],
+            closed_pairs: closed,
         }
     }
 }
@@ -899,6 +902,8 @@ pub struct EnergySample {
     pub external_work: f64,
     /// `∫ Σ p_t · ṡ dt`, N·mm.
     pub dissipated: f64,
+    /// Pairs in contact (a non-zero normal force: the gap closed).
+    pub closed_pairs: usize,
 }
 
 impl EnergySample {
