@@ -71,8 +71,8 @@ use crate::joint::{JointOperator, NORMAL, T1, T2};
 use crate::linalg::sparse::sym_mul_mat;
 use crate::model::Model;
 use crate::reduction::{
-    joint_pod, modal_rotation, JointFlexibility, JointPod, Orthonormalizer, Quantities,
-    DEFAULT_DROP_TOL,
+    joint_pod, modal_rotation, CurveErrors, JointFlexibility, JointPod, Orthonormalizer,
+    Quantities, DEFAULT_DROP_TOL,
 };
 use crate::rom::estimate::{run_estimated_parts, Checks, RunEstimate};
 use crate::system::{ReducedSystem, Scene};
@@ -110,6 +110,24 @@ pub struct CompressionAttempt {
     pub run_cpu_s: f64,
     /// Its integration steps.
     pub steps: u64,
+    /// Its estimate per quantity: the total and its reduction, truncation and integration
+    /// parts (as `"estimate"` of the tolerance JSON), to see which part a miss comes from.
+    pub parts: AttemptParts,
+}
+
+/// A compressed model's estimate per quantity and part (`"parts"` of an attempt).
+#[derive(Clone, Debug, Serialize)]
+pub struct AttemptParts {
+    /// The total estimate.
+    pub total: CurveErrors,
+    /// The reduction part.
+    pub reduction: CurveErrors,
+    /// The truncation part (`None`: not checked).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub truncation: Option<CurveErrors>,
+    /// The integration part (`None`: not checked).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub integration: Option<CurveErrors>,
 }
 
 /// What the compression of the joint columns did (`"compression"` of the tolerance JSON).
@@ -298,6 +316,12 @@ pub(super) fn compress(
             wall_s: start.elapsed().as_secs_f64(),
             run_cpu_s: run.cpu_s,
             steps: run.stats.steps,
+            parts: AttemptParts {
+                total: estimate.total,
+                reduction: estimate.reduction,
+                truncation: estimate.truncation,
+                integration: estimate.integration,
+            },
         });
         if total <= tol && rom.dim() < per_pair.basis_size {
             report.accepted = true;

@@ -137,7 +137,7 @@ use crate::system::{ReducedSystem, Scene};
 
 mod compress;
 pub use compress::{
-    Compression, CompressionAttempt, AUTO_COMPRESSION_SHRINK, COMPRESSION_ATTEMPTS,
+    AttemptParts, Compression, CompressionAttempt, AUTO_COMPRESSION_SHRINK, COMPRESSION_ATTEMPTS,
     COMPRESSION_TIGHTENING,
 };
 
