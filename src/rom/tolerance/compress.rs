@@ -157,6 +157,10 @@ pub struct Compression {
     pub accepted: bool,
     /// The compressed models tried, in order.
     pub attempts: Vec<CompressionAttempt>,
+    /// What stopped the run of the attempt after the last one (its error; absent: none
+    /// stopped): the attempts end there and the per-pair model stays the result.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub stopped: Option<String>,
 }
 
 /// With [`ToleranceOptions::compress`], compresses the joint columns of the per-pair `result`
@@ -257,6 +261,7 @@ pub(super) fn compress(
         kappa: [1.0; 2],
         accepted: false,
         attempts: Vec::new(),
+        stopped: None,
     };
     let normal = normal_columns(chosen);
     let tangential = tangential_columns(chosen);
@@ -304,8 +309,15 @@ pub(super) fn compress(
             true,
             |_, _| {},
         )?;
-        let run = run.into_result()?;
-        let estimate = estimate?;
+        // An attempt whose run (or a check's re-run) stops is no model: the per-pair one stays.
+        let (run, estimate) = match run.into_result().and_then(|r| Ok((r, estimate?))) {
+            Ok(done) => done,
+            Err(e) if super::stopped_in_time(&e) => {
+                report.stopped = Some(e.to_string());
+                break;
+            }
+            Err(e) => return Err(e),
+        };
         let total = worst(&estimate.total, on);
         report.attempts.push(CompressionAttempt {
             columns: rn,

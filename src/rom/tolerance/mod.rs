@@ -723,7 +723,7 @@ impl Progress {
 /// Whether `e` is a time integration that stopped before its end time (as opposed to a
 /// request or model error): a SUNDIALS failure, a callback failure CVODE returned (the
 /// wall-clock budget among them), chattering events, a stall or an overflowing output.
-fn stopped_in_time(e: &Error) -> bool {
+pub(super) fn stopped_in_time(e: &Error) -> bool {
     use crate::error::{CallbackOutcome, IntegrationError};
     matches!(
         e,
