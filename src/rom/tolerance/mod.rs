@@ -554,8 +554,8 @@ pub struct ToleranceModel {
 
 impl ToleranceModel {
     /// The model of a round with the joint part `chosen`, the quantities `on`, ν and the setup's
-    /// wall time, with its system, run and estimate; not met, no rounds, no offline time, the
-    /// run's transient options and no floors (the caller sets those).
+    /// wall time, with its system, run and estimate; not met, no rounds, no offline time,
+    /// default transient options and no floors (the caller sets those it knows).
     fn of(
         chosen: &Chosen,
         (on, nu, setup_s): (Quantities, usize, f64),
@@ -672,7 +672,8 @@ pub struct ToleranceChoice {
 /// # Errors
 /// A tolerance outside (0, 1) or not finite ([`RomError::Tolerance`] naming it), a quantity the
 /// run cannot produce ([`RomError::ToleranceOnFriction`]), a failing basis, a run that does not
-/// finish or an estimate that cannot be made.
+/// finish before a model that could be the result exists (later, the result is that model, not
+/// met: [`ToleranceModel::stopped`]) or an estimate that cannot be made.
 pub fn tolerance_model(model: &Model, opts: &ToleranceOptions) -> Result<ToleranceModel, Error> {
     let start = Instant::now();
     let cpu_start = process_cpu_s();
