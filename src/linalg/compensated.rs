@@ -97,9 +97,8 @@ fn sym_mul_compensated_block(
     x: MatRef<'_, f64>,
     s: f64,
     start: Option<MatRef<'_, f64>>,
-    mut out: faer::MatMut<'_, f64>,
+    out: faer::MatMut<'_, f64>,
 ) {
-    use faer::reborrow::ReborrowMut;
     let n = a.n;
     let w = x.ncols();
     let chunks = w.div_ceil(LANES);
@@ -116,7 +115,7 @@ fn sym_mul_compensated_block(
     }
     let mut y = vec![0.0; n * stride];
     compensated_rows_of(a, &sx, &init, &mut y, stride);
-    from_rows(&y, stride, out.rb_mut());
+    from_rows(&y, stride, out);
 }
 
 /// Rows of a tile of [`to_rows`] and [`from_rows`]: 64 rows of up to 32 columns are 16 KB on

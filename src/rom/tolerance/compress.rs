@@ -115,7 +115,8 @@ pub struct CompressionAttempt {
     pub parts: AttemptParts,
 }
 
-/// A compressed model's estimate per quantity and part (`"parts"` of an attempt).
+/// A compressed model's estimate per quantity and part (`"parts"` of an attempt): the parts of
+/// its [`RunEstimate`] without the estimate's detail, which the attempt does not keep.
 #[derive(Clone, Debug, Serialize)]
 pub struct AttemptParts {
     /// The total estimate.
@@ -310,7 +311,7 @@ pub(super) fn compress(
             |_, _| {},
         )?;
         // An attempt whose run (or a check's re-run) stops is no model: the per-pair one stays.
-        let (run, estimate) = match run.into_result().and_then(|r| Ok((r, estimate?))) {
+        let (run, estimate) = match run.into_result().and_then(|r| estimate.map(|e| (r, e))) {
             Ok(done) => done,
             Err(e) if super::stopped_in_time(&e) => {
                 report.stopped = Some(e.to_string());

@@ -554,12 +554,13 @@ pub struct ToleranceModel {
 
 impl ToleranceModel {
     /// The model of a round with the joint part `chosen`, the quantities `on`, ν and the setup's
-    /// wall time, with its system, run and estimate; not met, no rounds, no offline time,
-    /// default transient options and no floors (the caller sets those it knows).
+    /// wall time, with its system, run, estimate and transient options, and the floors of
+    /// `tolerances`; not met, no rounds and no timings yet (the caller sets those).
     fn of(
         chosen: &Chosen,
         (on, nu, setup_s): (Quantities, usize, f64),
-        (rom, run, estimate): (ReducedSystem, Run, RunEstimate),
+        (rom, run, estimate, transient): (ReducedSystem, Run, RunEstimate, TransientOptions),
+        tolerances: &RoundTolerances,
     ) -> ToleranceModel {
         ToleranceModel {
             pairs: chosen.pairs.clone(),
@@ -568,7 +569,7 @@ impl ToleranceModel {
             nu,
             setup_s,
             rom,
-            transient: TransientOptions::default(),
+            transient,
             run,
             met: false,
             estimate,
@@ -577,8 +578,8 @@ impl ToleranceModel {
             offline_s: 0.0,
             cpu_s: f64::NAN,
             compression: None,
-            force_atol: None,
-            friction_atol: None,
+            force_atol: tolerances.force_atol,
+            friction_atol: tolerances.friction_atol,
             stopped: None,
         }
     }
@@ -869,12 +870,11 @@ fn search(
         let total = worst(&estimate.total, on);
         let again =
             changed || (estimate.integration.is_some() && total > tol && tolerances.tighten());
-        let mut result = ToleranceModel::of(&chosen, (on, nu, setup_s), (rom, run, estimate));
+        let parts = (rom, run, estimate, transient);
+        let mut result = ToleranceModel::of(&chosen, (on, nu, setup_s), parts, &tolerances);
         result.met = total <= tol;
         result.estimate_s = rounds.last().map_or(0.0, |r| r.estimate_s);
         result.offline_s = (round_start - start).as_secs_f64() + basis_s;
-        (result.transient, result.force_atol) = (transient, tolerances.force_atol);
-        result.friction_atol = tolerances.friction_atol;
         if again {
             // The model the next rounds fall back to if their runs stop (Progress::fall_back).
             progress.best = Some((result, rounds.len()));
