@@ -173,6 +173,7 @@ fn run_tolerance(
         cpu_s,
         compression,
         force_atol,
+        sliding_friction_atol,
         friction_atol,
         stopped,
     } = tolerance_model(model, &topts)?;
@@ -206,6 +207,7 @@ fn run_tolerance(
             rtol: transient.ode.rtol,
             atol: transient.ode.atol,
             force_atol,
+            sliding_friction_atol,
             friction_atol,
             compression,
             stopped,

@@ -183,14 +183,17 @@ fn tolerance_force_floor_follows_the_joint_forces() {
     assert!(ranking > 1, "the ranking round was not repeated");
 }
 
-/// The whole rule is homogeneous in the load: with ‖f_c‖ and ‖f_R‖ controlled the rounds' atol
-/// is capped by both floors (`force_floor_atol`, `friction_floor_atol`), so the friction bar
-/// with its load scaled by 1/100 — 1/100 of every displacement and force, the laws being
-/// homogeneous of degree one — integrates at 1/100 of the unscaled bar's atol and ends at the
-/// same model, meeting the tolerance. (With the force floor alone its friction force was
-/// resolved 100× more coarsely than the unscaled bar's: ‖f_R‖ 1.3 % off, not met.)
+/// The rule follows the load: with ‖f_c‖ and ‖f_R‖ controlled the rounds' atol is capped by
+/// the force and sliding friction floors (`force_floor_atol`, `sliding_friction_floor_atol`)
+/// and a round that misses is tightened first to the stick floor (`friction_floor_atol`), so
+/// the friction bar with its load scaled by 1/100 — 1/100 of every displacement and force, the
+/// laws being homogeneous of degree one — gets floors 1/100 of the unscaled bar's, integrates at
+/// an atol at least as fine for its forces as the unscaled bar's (whose atol the tolerance's own
+/// length, 1e-5 mm, caps below its floors), and meets the tolerance. (With the force floor alone
+/// and no stick floor its friction force was resolved 3.45× more coarsely than the unscaled
+/// bar's: ‖f_R‖ 1.3 % off, not met.)
 #[test]
-fn tolerance_model_is_homogeneous_in_the_load() {
+fn tolerance_model_follows_the_load() {
     let opts = ToleranceOptions::new(1e-2);
     let m = model("friction_bar");
     let unscaled = tolerance_model(&m, &opts).unwrap();
@@ -203,19 +206,20 @@ fn tolerance_model_is_homogeneous_in_the_load() {
     }
     let t = tolerance_model(&small, &opts).unwrap();
     let floor = unscaled
-        .friction_atol
-        .expect("‖f_R‖ controlled: a friction floor");
-    let small_floor = t.friction_atol.expect("a friction floor");
+        .sliding_friction_atol
+        .expect("‖f_R‖ controlled: a sliding friction floor");
+    let small_floor = t.sliding_friction_atol.expect("a sliding friction floor");
     assert!(
         (floor / small_floor - 100.0).abs() < 5.0,
-        "friction floors {floor} / {small_floor}"
+        "sliding friction floors {floor} / {small_floor}"
     );
     let ratio = unscaled.transient.ode.atol / t.transient.ode.atol;
-    assert!((ratio - 100.0).abs() < 5.0, "atol ratio {ratio}");
+    assert!(ratio >= 95.0, "atol ratio {ratio}");
     assert!(unscaled.met && t.met, "met: {} / {}", unscaled.met, t.met);
-    assert_eq!(t.pairs, unscaled.pairs);
-    assert_eq!(t.nu, unscaled.nu);
-    assert_eq!(t.rom.dim(), unscaled.rom.dim());
+    // The scaled bar's first model at its floors missed on its integration: the stick floor.
+    let stick = t.friction_atol.expect("the stick floor applied");
+    assert!((t.transient.ode.atol / stick - 1.0).abs() < 1e-12);
+    assert!(stick < small_floor);
 }
 
 /// A richer round whose run stops (here on CVODE's step limit, set between the steps of the

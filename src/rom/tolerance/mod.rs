@@ -21,8 +21,14 @@
 //! force floor ([`force_floor_atol`]): `k_n · atol ≤ θ·TOL·F`, F the first estimate's
 //! `(Σ_t ‖f_c*‖²)^{1/2}`, so that the force resolution follows the forces asked for, not a
 //! length fixed in mm (on a refined mesh more pairs share the load and F falls); with ‖f_R‖
-//! controlled by the friction floor ([`friction_floor_atol`], the same with `k_t` and ‖f_R*‖).
-//! With both, a scene whose load is scaled gets its atol scaled alike.
+//! controlled also by the sliding friction floor ([`sliding_friction_floor_atol`], the same
+//! with `μ k_n` and ‖f_R*‖). A sticking pair's force is resolved through `k_t`, not `μ k_n`: the
+//! stick floor ([`friction_floor_atol`]) is not a cap from the start but the first tightening of
+//! a model that misses by its integration part. An a-priori stick floor put the refined meshes'
+//! runs below the atol at which their ringing joints' curves stop converging (their runs at
+//! tighter atol move further from each other, and from the full run), where the same models
+//! meet at the force floor; the friction bar under a light load needs it, and gets it from its
+//! integration check. A scene whose load is scaled gets floors scaled alike.
 //!
 //! ## Why not the paper's w(g)
 //!
@@ -188,7 +194,8 @@ pub enum CompressJoint {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum IntegrationTolerances {
     /// From the tolerance: the paper's Table 1 values loosened by [`integration_looseness`],
-    /// tightened tenfold while the estimate misses the tolerance.
+    /// tightened while the estimate misses the tolerance (first to the stick floor,
+    /// [`friction_floor_atol`], then tenfold).
     #[default]
     FromTolerance,
     /// The transient options' own rtol and atol (the user gave them).
@@ -258,9 +265,9 @@ pub fn force_floor_atol(tol: f64, corrected_norm2: f64, k_n: f64) -> Option<f64>
     (atol.is_finite() && atol > 0.0).then_some(atol)
 }
 
-/// The same floor for the friction force ([`force_floor_atol`] with the stick law): a sticking
-/// pair's force is `k_t` times an elastic stretch resolved to about atol, so one output's
-/// flicker moves the relative L2 error of ‖f_R‖(t) by `k_t · atol / F_R`, with
+/// The same floor for the friction force of a sticking pair ([`force_floor_atol`] with the
+/// stick law): its force is `k_t` times an elastic stretch resolved to about atol, so one
+/// output's flicker moves the relative L2 error of ‖f_R‖(t) by `k_t · atol / F_R`, with
 /// `F_R = (Σ_t ‖f_R*(t)‖²)^{1/2}` from the first estimate's correction
 /// (`corrected_friction_norm2`, N²):
 ///
@@ -268,12 +275,31 @@ pub fn force_floor_atol(tol: f64, corrected_norm2: f64, k_n: f64) -> Option<f64>
 /// atol_R = θ · TOL · F_R / k_t
 /// ```
 ///
-/// With both floors the cap on atol is homogeneous of degree one in the load, like the penalty
-/// and Coulomb laws: a scene whose load is scaled by λ (zero initial gaps) gets its atol scaled
-/// by λ, and the same model. Without it a light load's friction force was resolved λ times more
-/// coarsely than the same scene's under the full load. `None` where nothing slides or sticks.
+/// The rounds start without it, at the sliding floor ([`sliding_friction_floor_atol`]); a
+/// round that misses by its integration part is tightened to it first, where it is below the
+/// rounds' atol ([`tolerance_model`], module docs). The floors are homogeneous of degree one in
+/// the load, like the penalty and Coulomb laws: a scene whose load is scaled by λ (zero initial
+/// gaps) gets them scaled by λ. `None` where nothing slides or sticks.
 pub fn friction_floor_atol(tol: f64, corrected_friction_norm2: f64, k_t: f64) -> Option<f64> {
     force_floor_atol(tol, corrected_friction_norm2, k_t)
+}
+
+/// The friction floor of a sliding pair: its friction force `μ p_n` is resolved through its gap,
+/// to `μ k_n · atol`, so
+///
+/// ```text
+/// atol_S = θ · TOL · F_R / (μ k_n)
+/// ```
+///
+/// (`mu_k_n` = μ·k_n, N/mm). On a joint that slides (`F_R ≈ μ F`) it is the force floor. It caps
+/// every round's atol where ‖f_R‖ is controlled; the stick floor ([`friction_floor_atol`], `k_t`
+/// for `μ k_n`) is the first tightening. `None` where nothing slides or sticks, or `μ = 0`.
+pub fn sliding_friction_floor_atol(
+    tol: f64,
+    corrected_friction_norm2: f64,
+    mu_k_n: f64,
+) -> Option<f64> {
+    force_floor_atol(tol, corrected_friction_norm2, mu_k_n)
 }
 
 /// How many times the ranking round is repeated at most because its own run was coarser than
@@ -306,8 +332,14 @@ struct RoundTolerances {
     floor_tol: f64,
     /// The force floor's atol, once a ranking round has measured it.
     force_atol: Option<f64>,
-    /// The friction floor's atol ([`friction_floor_atol`]), once a ranking round has measured it.
+    /// The sliding friction floor's atol ([`sliding_friction_floor_atol`]), once a ranking
+    /// round has measured it.
+    sliding_atol: Option<f64>,
+    /// The stick friction floor's atol ([`friction_floor_atol`]), once a ranking round has
+    /// measured it.
     friction_atol: Option<f64>,
+    /// Whether a tightening has applied the stick floor ([`RoundTolerances::tighten`]).
+    stick_applied: bool,
     /// Ranking rounds repeated so far ([`FORCE_FLOOR_REPEATS`]).
     repeats: usize,
 }
@@ -325,7 +357,9 @@ impl RoundTolerances {
             friction_rule: from_tolerance && on.contains(Quantity::FrictionForce),
             floor_tol: opts.tolerance.max(paper_level(on)),
             force_atol: None,
+            sliding_atol: None,
             friction_atol: None,
+            stick_applied: false,
             repeats: 0,
         }
     }
@@ -340,12 +374,14 @@ impl RoundTolerances {
         )
     }
 
-    /// The cap on atol: the tighter of the force and friction floors measured so far.
+    /// The cap on atol: the tightest of the floors measured so far (the stick floor once a
+    /// tightening applied it).
     fn cap(&self) -> Option<f64> {
-        match (self.force_atol, self.friction_atol) {
-            (Some(a), Some(b)) => Some(a.min(b)),
-            (a, b) => a.or(b),
-        }
+        let stick = self.friction_atol.filter(|_| self.stick_applied);
+        [self.force_atol, self.sliding_atol, stick]
+            .into_iter()
+            .flatten()
+            .reduce(f64::min)
     }
 
     /// Measures the force and friction floors from a ranking round's estimate `d` (its run at
@@ -362,9 +398,11 @@ impl RoundTolerances {
             self.force_atol = force_floor_atol(self.floor_tol, d.corrected_joint_norm2, k_n);
         }
         if self.friction_rule {
-            let k_t = model.contact.stick_stiffness;
+            let c = &model.contact;
             let norm2 = d.corrected_joint_friction_norm2;
-            self.friction_atol = friction_floor_atol(self.floor_tol, norm2, k_t);
+            let mu_k_n = c.friction_coefficient * c.normal_stiffness;
+            self.sliding_atol = sliding_friction_floor_atol(self.floor_tol, norm2, mu_k_n);
+            self.friction_atol = friction_floor_atol(self.floor_tol, norm2, c.stick_stiffness);
         }
         let cap = self.cap();
         let coarse = cap.is_some_and(|a| run_atol > a * RANKING_LOOSENING * (1.0 + 1e-9));
@@ -377,8 +415,15 @@ impl RoundTolerances {
         repeat
     }
 
-    /// Ten times tighter, down to the user's (or the paper's) tolerances: whether it tightened.
-    fn tighten(&mut self) -> bool {
+    /// Tighter, for a round that missed (`opts` the user's transient options): first the stick
+    /// floor on atol where it is below the rounds' atol, then ten times tighter, down to the
+    /// user's (or the paper's) tolerances. Whether it tightened.
+    fn tighten(&mut self, opts: &TransientOptions) -> bool {
+        let atol = self.transient(opts, false).ode.atol;
+        if !self.stick_applied && self.friction_atol.is_some_and(|a| a < atol) {
+            self.stick_applied = true;
+            return true;
+        }
         let tightened = self.looseness > 1.0;
         self.looseness = (self.looseness / 10.0).max(1.0);
         tightened
@@ -543,8 +588,11 @@ pub struct ToleranceModel {
     /// The force floor's atol ([`force_floor_atol`], mm): a cap on the rounds' atol (`None`:
     /// no cap — ‖f_c‖ not controlled, `--rtol/--atol` given, or no contact).
     pub force_atol: Option<f64>,
-    /// The friction floor's atol ([`friction_floor_atol`], mm): the other cap (`None`: ‖f_R‖
-    /// not controlled, `--rtol/--atol` given, or no friction force).
+    /// The sliding friction floor's atol ([`sliding_friction_floor_atol`], mm): the other cap
+    /// (`None`: ‖f_R‖ not controlled, `--rtol/--atol` given, or no friction force).
+    pub sliding_friction_atol: Option<f64>,
+    /// The stick friction floor's atol ([`friction_floor_atol`], mm), where a tightening applied
+    /// it (`None`: no round missed by its integration, or as for the sliding floor).
     pub friction_atol: Option<f64>,
     /// A richer round whose run stopped before its end time (`None`: none did): the result is
     /// then the model of the round before it, not met, its estimate as far as its round made
@@ -579,7 +627,10 @@ impl ToleranceModel {
             cpu_s: f64::NAN,
             compression: None,
             force_atol: tolerances.force_atol,
-            friction_atol: tolerances.friction_atol,
+            sliding_friction_atol: tolerances.sliding_atol,
+            friction_atol: tolerances
+                .friction_atol
+                .filter(|_| tolerances.stick_applied),
             stopped: None,
         }
     }
@@ -654,7 +705,12 @@ pub struct ToleranceChoice {
     /// [`force_floor_atol`]).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub force_atol: Option<f64>,
-    /// The friction floor's atol (mm), the other cap (absent: no cap; [`friction_floor_atol`]).
+    /// The sliding friction floor's atol (mm), the other cap (absent: no cap;
+    /// [`sliding_friction_floor_atol`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sliding_friction_atol: Option<f64>,
+    /// The stick friction floor's atol (mm), where a missed round's tightening applied it
+    /// (absent: not applied; [`friction_floor_atol`]).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub friction_atol: Option<f64>,
     /// What the compression of the joint columns did (absent: not tried): how many compressed
@@ -868,8 +924,10 @@ fn search(
         // again, ten times tighter (the reduction part is within its share, or the loop would
         // have enriched the basis).
         let total = worst(&estimate.total, on);
-        let again =
-            changed || (estimate.integration.is_some() && total > tol && tolerances.tighten());
+        let again = changed
+            || (estimate.integration.is_some()
+                && total > tol
+                && tolerances.tighten(&opts.transient));
         let parts = (rom, run, estimate, transient);
         let mut result = ToleranceModel::of(&chosen, (on, nu, setup_s), parts, &tolerances);
         result.met = total <= tol;
