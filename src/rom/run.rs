@@ -176,6 +176,7 @@ fn run_tolerance(
         sliding_friction_atol,
         friction_atol,
         stopped,
+        integration_stall,
     } = tolerance_model(model, &topts)?;
     let frames = match (every, &rom.phi) {
         (Some(every), Some(phi)) => {
@@ -211,6 +212,7 @@ fn run_tolerance(
             friction_atol,
             compression,
             stopped,
+            integration_stall,
         }),
     })
 }

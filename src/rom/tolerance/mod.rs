@@ -117,6 +117,16 @@
 //! step limit, a convergence failure, a stall, the wall-clock budget: the offline work up to it
 //! is a model with an estimate, and the stopped round is reported beside it (`stopped`); a
 //! request or model error is still an error.
+//!
+//! **Tightening that does not converge.** A model that misses by its integration part is re-run
+//! tighter (first at the stick floor, then tenfold). Where a joint rings — sheets that knock
+//! together, a refined interface of stiff penalty pairs — the tighter run damps less of the
+//! ringing, and its curves move *away* from the looser run's instead of towards a limit
+//! (docs/performance/scale.md, "The friction floor and the ringing joint"). A re-run at least
+//! [`STALL_TIGHTENING`] tighter whose integration part is no smaller is an
+//! [`IntegrationStall`]: no round after it is tightened, and if that part alone is above TOL no
+//! model the rounds can build meets it, so the search ends there with the re-run as the result
+//! (`met = false`, the stall in the JSON and a CLI warning).
 
 use std::collections::HashMap;
 use std::sync::Arc;
@@ -125,6 +135,7 @@ use std::time::Instant;
 use serde::Serialize;
 
 use crate::error::{Error, RomError};
+use crate::integrate::problem::OdeOptions;
 use crate::integrate::{Run, TransientOptions};
 use crate::joint::statics::ContactOptions;
 use crate::model::Model;
@@ -340,6 +351,10 @@ struct RoundTolerances {
     friction_atol: Option<f64>,
     /// Whether a tightening has applied the stick floor ([`RoundTolerances::tighten`]).
     stick_applied: bool,
+    /// Whether the next round re-runs the last one's model tighter.
+    tightened: bool,
+    /// A tightening that did not converge ([`IntegrationStall`]): no more tightening after it.
+    stall: Option<IntegrationStall>,
     /// Ranking rounds repeated so far ([`FORCE_FLOOR_REPEATS`]).
     repeats: usize,
 }
@@ -360,6 +375,8 @@ impl RoundTolerances {
             sliding_atol: None,
             friction_atol: None,
             stick_applied: false,
+            tightened: false,
+            stall: None,
             repeats: 0,
         }
     }
@@ -415,10 +432,26 @@ impl RoundTolerances {
         repeat
     }
 
+    /// After a round (`rounds` so far): whether it re-ran the last model tighter and its
+    /// integration part stalled ([`IntegrationStall`], kept) above TOL — the search ends.
+    fn judge(&mut self, rounds: &[Round], tol: f64) -> bool {
+        if !std::mem::take(&mut self.tightened) {
+            return false;
+        }
+        let [.., before, after] = rounds else {
+            return false;
+        };
+        self.stall = IntegrationStall::of(before, after, tol);
+        self.stall.is_some_and(|s| s.ended)
+    }
+
     /// Tighter, for a round that missed (`opts` the user's transient options): first the stick
     /// floor on atol where it is below the rounds' atol, then ten times tighter, down to the
-    /// user's (or the paper's) tolerances. Whether it tightened.
+    /// user's (or the paper's) tolerances; never after a stall. Whether it tightened.
     fn tighten(&mut self, opts: &TransientOptions) -> bool {
+        if self.stall.is_some() {
+            return false;
+        }
         let atol = self.transient(opts, false).ode.atol;
         if !self.stick_applied && self.friction_atol.is_some_and(|a| a < atol) {
             self.stick_applied = true;
@@ -482,6 +515,15 @@ pub struct Round {
     pub wall_s: f64,
     /// The integration steps of the round's run.
     pub steps: u64,
+    /// The relative tolerance of the round's run.
+    pub rtol: f64,
+    /// The absolute tolerance of the round's run (mm).
+    pub atol: f64,
+    /// The integration check's part of the estimate (the re-run at other tolerances,
+    /// [`super::estimate::integration_errors`]): the largest over the controlled quantities
+    /// (`None`: not made, or made as the combined check).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub integration_check: Option<f64>,
     /// Wall time of the round's basis and reduced system, s.
     pub basis_s: f64,
     /// Wall time of the round's estimate, s.
@@ -495,15 +537,15 @@ pub struct Round {
 impl Round {
     /// The record of a round with the joint part `chosen`, ν and basis size `(nu, r)`, its
     /// estimate (its parts' largest over the quantities `on`), its combined check's part, where
-    /// it made its re-runs and whether it ranked, its run's steps and its timings (run, basis,
-    /// estimate; s).
+    /// it made its re-runs and whether it ranked, its run's steps and tolerances, and its
+    /// timings (run, basis, estimate; s).
     fn of(
         chosen: &Chosen,
         (nu, basis_size): (usize, usize),
         estimate: &RunEstimate,
         on: Quantities,
         (combined_check, checks, ranking): (Option<f64>, ReRuns, bool),
-        steps: u64,
+        (steps, ode): (u64, &OdeOptions),
         (wall_s, basis_s, estimate_s): (f64, f64, f64),
     ) -> Round {
         let d = &estimate.detail;
@@ -521,6 +563,9 @@ impl Round {
             combined_check,
             wall_s,
             steps,
+            rtol: ode.rtol,
+            atol: ode.atol,
+            integration_check: estimate.integration.map(|i| worst(&i, on)),
             basis_s,
             estimate_s,
             ranking,
@@ -598,6 +643,9 @@ pub struct ToleranceModel {
     /// then the model of the round before it, not met, its estimate as far as its round made
     /// it.
     pub stopped: Option<StoppedRound>,
+    /// A tightening of the integration that did not converge (`None`: none did); no round
+    /// after it was tightened again.
+    pub integration_stall: Option<IntegrationStall>,
 }
 
 impl ToleranceModel {
@@ -632,6 +680,7 @@ impl ToleranceModel {
                 .friction_atol
                 .filter(|_| tolerances.stick_applied),
             stopped: None,
+            integration_stall: tolerances.stall,
         }
     }
 }
@@ -649,6 +698,43 @@ impl StoppedRound {
             atol: transient.ode.atol,
             reason: String::new(),
         }
+    }
+}
+
+/// A tightening of the integration that did not converge ([`tolerance_model`], module docs):
+/// the same model re-run at tighter rtol or atol read an integration part no smaller than before
+/// (`"integration_stall"` of the tolerance JSON).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct IntegrationStall {
+    /// rtol of the runs before and after the tightening.
+    pub rtol: [f64; 2],
+    /// atol of the runs before and after the tightening (mm).
+    pub atol: [f64; 2],
+    /// Their integration parts (the largest over the controlled quantities).
+    pub part: [f64; 2],
+    /// Whether the search ended on it: the integration part alone was above the tolerance, so
+    /// no model the rounds can build meets it.
+    pub ended: bool,
+}
+
+/// The smallest tightening `f` (the smaller of the rtol and atol ratios) that
+/// [`IntegrationStall`] judges: a converging BDF run's error falls like `f^p`, `p` between 2/3
+/// and 1, so by at least a fifth here — more than the integration part's own scatter between
+/// runs. A smaller tightening (the stick floor a little below the rounds' atol) decides nothing.
+pub const STALL_TIGHTENING: f64 = 0.7;
+
+impl IntegrationStall {
+    /// The stall between a round `before` and the same model re-run tighter, `after` (`None`:
+    /// no stall, a tightening too small to judge, or a part not measured).
+    fn of(before: &Round, after: &Round, tol: f64) -> Option<IntegrationStall> {
+        let (b, a) = (before.integration_check?, after.integration_check?);
+        let f = (after.rtol / before.rtol).min(after.atol / before.atol);
+        (f <= STALL_TIGHTENING && a >= b).then_some(IntegrationStall {
+            rtol: [before.rtol, after.rtol],
+            atol: [before.atol, after.atol],
+            part: [b, a],
+            ended: a > tol,
+        })
     }
 }
 
@@ -721,6 +807,9 @@ pub struct ToleranceChoice {
     /// then the round's before it, not met.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub stopped: Option<StoppedRound>,
+    /// A tightening of the integration that did not converge (absent: none did).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub integration_stall: Option<IntegrationStall>,
 }
 
 /// Builds the smallest Craig–Bampton + pair-attachment-mode model whose estimated errors of the
@@ -873,7 +962,7 @@ fn search(
             &estimate,
             on,
             (combined, made, ranking),
-            run.stats.steps,
+            (run.stats.steps, &transient.ode),
             (run.wall_s, basis_s, estimate_s),
         ));
         // The force floor from the ranking round's correction, the ranking round again if
@@ -882,10 +971,13 @@ fn search(
         if ranking && tolerances.measure(model, d, transient.ode.atol, room) {
             continue;
         }
+        // A tightened re-run whose integration part did not converge: no more tightening, and
+        // no more rounds if that part alone misses (IntegrationStall).
+        let ended = tolerances.judge(rounds, tol);
         let mut changed = false;
         // The next round repeats this model or adds all the estimate asked for: the result?
         expect_result = true;
-        if eta > tol && rounds.len() < opts.max_rounds {
+        if eta > tol && !ended && rounds.len() < opts.max_rounds {
             let enriched = chosen.enrich(&estimate, on, tol, cb.ncols());
             changed = enriched.changed;
             expect_result = enriched.complete;
@@ -912,20 +1004,16 @@ fn search(
         if !changed && estimate.integration.is_none() && estimate.combined.is_none() {
             // The result, or the same model again if its integration misses: its integration
             // check (when the correction missed, no round made it).
-            let (rom, run, scene, opts) = recheck;
-            let checks = Checks::INTEGRATION;
-            add_checks(model, &mut estimate, run, rom.clone(), scene, opts, checks)?;
-            if let Some(last) = rounds.last_mut() {
-                last.estimate_s = round_start.elapsed().as_secs_f64() - basis_s - run.wall_s;
-                last.checks = ReRuns::AfterCorrection;
-            }
+            let last = rounds.last_mut();
+            result_integration_check(model, recheck, &mut estimate, on, last)?;
         }
         // The estimate misses the tolerance at loosened integration tolerances: the same model
         // again, ten times tighter (the reduction part is within its share, or the loop would
         // have enriched the basis).
         let total = worst(&estimate.total, on);
         let again = changed
-            || (estimate.integration.is_some()
+            || (!ended
+                && estimate.integration.is_some()
                 && total > tol
                 && tolerances.tighten(&opts.transient));
         let parts = (rom, run, estimate, transient);
@@ -934,6 +1022,7 @@ fn search(
         result.estimate_s = rounds.last().map_or(0.0, |r| r.estimate_s);
         result.offline_s = (round_start - start).as_secs_f64() + basis_s;
         if again {
+            tolerances.tightened = !changed;
             // The model the next rounds fall back to if their runs stop (Progress::fall_back).
             progress.best = Some((result, rounds.len()));
             continue;
@@ -944,6 +1033,33 @@ fn search(
         compress::compress_result(model, &flex, (&chosen, &bases, &cb), opts, &mut result)?;
         return Ok(result);
     }
+}
+
+/// The integration check of a round that may be the result and made none (`recheck` its
+/// system, run, scene and transient options), added to its `estimate` and its record `last`.
+fn result_integration_check(
+    model: &Model,
+    (rom, run, scene, opts): (&ReducedSystem, &Run, &Scene, &TransientOptions),
+    estimate: &mut RunEstimate,
+    on: Quantities,
+    last: Option<&mut Round>,
+) -> Result<(), Error> {
+    let start = Instant::now();
+    add_checks(
+        model,
+        estimate,
+        run,
+        rom.clone(),
+        scene,
+        opts,
+        Checks::INTEGRATION,
+    )?;
+    if let Some(last) = last {
+        last.estimate_s += start.elapsed().as_secs_f64();
+        last.checks = ReRuns::AfterCorrection;
+        last.integration_check = estimate.integration.map(|i| worst(&i, on));
+    }
+    Ok(())
 }
 
 /// The joint flexibility, the fixed-interface problem and Craig–Bampton with ν modes, the first
@@ -1597,6 +1713,54 @@ mod tests {
         assert!(force_floor_atol(1e-2, 0.0, k_n).is_none());
         assert!(force_floor_atol(1e-2, f64::NAN, k_n).is_none());
         assert_eq!(capped(opts.clone(), None).ode.atol, opts.ode.atol);
+    }
+
+    /// A round of the same model at `rtol`, `atol` with integration part `part`.
+    fn round_at(rtol: f64, atol: f64, part: Option<f64>) -> Round {
+        Round {
+            pairs: 13,
+            tangential_pairs: 9,
+            nu: 10,
+            basis_size: 38,
+            estimate: None,
+            friction_estimate: None,
+            joint: None,
+            joint_friction: None,
+            truncation: None,
+            truncation_check: None,
+            combined_check: None,
+            wall_s: 0.0,
+            steps: 1,
+            rtol,
+            atol,
+            integration_check: part,
+            basis_s: 0.0,
+            estimate_s: 0.0,
+            ranking: false,
+            checks: ReRuns::BesideRun,
+        }
+    }
+
+    #[test]
+    fn a_tightening_stalls_only_where_its_part_does_not_fall() {
+        let before = round_at(1e-7, 1e-5, Some(4.1e-2));
+        // The ringing joint: atol halved, the part grew — above the tolerance by itself.
+        let s = IntegrationStall::of(&before, &round_at(1e-7, 5.2e-6, Some(5.1e-2)), 1e-2);
+        let s = s.expect("a stall");
+        assert!(s.ended && s.part == [4.1e-2, 5.1e-2] && s.atol == [1e-5, 5.2e-6]);
+        // The same within the tolerance: a stall that does not end the search.
+        let low = round_at(1e-7, 1e-5, Some(4.1e-3));
+        let s = IntegrationStall::of(&low, &round_at(1e-8, 1e-6, Some(4.1e-3)), 1e-2);
+        assert!(!s.expect("a stall").ended);
+        // A part that fell, even by less than the tightening: converging.
+        let fell = round_at(1e-7, 2.5e-6, Some(1.0e-2));
+        assert!(IntegrationStall::of(&round_at(1e-7, 1e-5, Some(1.5e-2)), &fell, 1e-2).is_none());
+        // A tightening too small to judge (the stick floor just below the atol), or a part
+        // not measured (the combined check): no decision.
+        let small = round_at(1e-7, 8.6e-6, Some(5e-2));
+        assert!(IntegrationStall::of(&before, &small, 1e-2).is_none());
+        let combined = round_at(1e-8, 1e-6, None);
+        assert!(IntegrationStall::of(&before, &combined, 1e-2).is_none());
     }
 
     #[test]

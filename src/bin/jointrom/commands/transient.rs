@@ -184,28 +184,7 @@ pub fn run(a: TransientArgs) -> Result<(), Error> {
         .as_ref()
         .zip(o.estimate.as_ref().and_then(|e| e.as_ref().ok()))
         .map_or(f64::NAN, |(t, e)| worst(&e.total, t.quantities));
-    if let Some(t) = o.tolerance.as_ref().filter(|t| !t.met) {
-        eprintln!(
-            "warning: --tolerance {:e} not met: the best model ({} pairs, r = {}) estimates {:e} \
-             (the largest of {})",
-            t.tolerance,
-            t.pairs.len(),
-            o.basis_size,
-            worst_estimate,
-            t.quantities
-                .iter()
-                .map(|q| q.name())
-                .collect::<Vec<_>>()
-                .join(", ")
-        );
-        if let Some(s) = &t.stopped {
-            eprintln!(
-                "warning: the richer model after it ({} pairs, r = {}, rtol {:e}, atol {:e}) \
-                 stopped: {}",
-                s.pairs, s.basis_size, s.rtol, s.atol, s.reason
-            );
-        }
-    }
+    warn_tolerance(&o, worst_estimate);
     let total_s = t0.elapsed().as_secs_f64();
     let name = spec_name(&a, &spec);
     let c = &o.run.curves;
@@ -544,4 +523,48 @@ fn print_reference_errors(e: &ReferenceErrors) {
         pct(e.dissipated),
         pct(e.dissipated_end)
     );
+}
+
+/// The warnings of a tolerance model that misses (`worst_estimate` its largest estimate): the
+/// best model, the richer round that stopped, the tightening that did not converge.
+fn warn_tolerance(o: &ModelRun, worst_estimate: f64) {
+    if let Some(t) = o.tolerance.as_ref().filter(|t| !t.met) {
+        eprintln!(
+            "warning: --tolerance {:e} not met: the best model ({} pairs, r = {}) estimates {:e} \
+             (the largest of {})",
+            t.tolerance,
+            t.pairs.len(),
+            o.basis_size,
+            worst_estimate,
+            t.quantities
+                .iter()
+                .map(|q| q.name())
+                .collect::<Vec<_>>()
+                .join(", ")
+        );
+        if let Some(s) = &t.stopped {
+            eprintln!(
+                "warning: the richer model after it ({} pairs, r = {}, rtol {:e}, atol {:e}) \
+                 stopped: {}",
+                s.pairs, s.basis_size, s.rtol, s.atol, s.reason
+            );
+        }
+    }
+    if let Some(s) = o.tolerance.as_ref().and_then(|t| t.integration_stall) {
+        eprintln!(
+            "warning: the curves do not converge as the integration tightens: integration part \
+             {:.2e} at rtol {:.2e}, atol {:.2e} mm, {:.2e} at rtol {:.2e}, atol {:.2e} mm{}",
+            s.part[0],
+            s.rtol[0],
+            s.atol[0],
+            s.part[1],
+            s.rtol[1],
+            s.atol[1],
+            if s.ended {
+                " — above the tolerance by itself: no model meets it"
+            } else {
+                "; no tighter run was made"
+            }
+        );
+    }
 }
