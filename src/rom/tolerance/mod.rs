@@ -391,11 +391,15 @@ impl RoundTolerances {
         )
     }
 
+    /// The stick floor, once a tightening applied it.
+    fn stick(&self) -> Option<f64> {
+        self.friction_atol.filter(|_| self.stick_applied)
+    }
+
     /// The cap on atol: the tightest of the floors measured so far (the stick floor once a
     /// tightening applied it).
     fn cap(&self) -> Option<f64> {
-        let stick = self.friction_atol.filter(|_| self.stick_applied);
-        [self.force_atol, self.sliding_atol, stick]
+        [self.force_atol, self.sliding_atol, self.stick()]
             .into_iter()
             .flatten()
             .reduce(f64::min)
@@ -676,9 +680,7 @@ impl ToleranceModel {
             compression: None,
             force_atol: tolerances.force_atol,
             sliding_friction_atol: tolerances.sliding_atol,
-            friction_atol: tolerances
-                .friction_atol
-                .filter(|_| tolerances.stick_applied),
+            friction_atol: tolerances.stick(),
             stopped: None,
             integration_stall: tolerances.stall,
         }
