@@ -109,3 +109,64 @@ fn stretch_states_keep_the_curves() {
         }
     }
 }
+
+#[test]
+fn screened_run_leaves_the_untracked_memory_out_of_the_error_test() {
+    // The same screened run with the open pairs' memory tested (`--open-slip-test on`) and
+    // untested (the default, which with screening also frees the pairs outside the tracked
+    // set): the same curves to the integration tolerance, by a different path.
+    let (untested, _, _) = runs("cases/scale/friction_bar_x2.json", 0.02, |p| {
+        p.screen = true
+    });
+    let path = common::repo_path("cases/scale/friction_bar_x2.json");
+    let model = common::model(path.to_str().expect("path"));
+    let basis = build_basis(&model, BasisKind::Tvd, &BasisOptions::default()).expect("basis");
+    let rom = ReducedSystem::new(&model, basis.phi).expect("ROM");
+    let mut opts = common::until(0.02);
+    opts.problem.screen = true;
+    opts.problem.open_slip_test = true;
+    let tested = run(rom, &Scene::of(&model), &opts).expect("screened run testing every state");
+    let n = untested.curves.t.len();
+    assert_eq!(n, tested.curves.t.len(), "output count");
+    assert_ne!(
+        untested.curves.master_uy, tested.curves.master_uy,
+        "the weights changed nothing: the path is not taken"
+    );
+    let diffs = [
+        (
+            "|f_c|",
+            rel_l2(
+                &untested.curves.contact_force_norm,
+                &tested.curves.contact_force_norm,
+                n,
+            ),
+        ),
+        (
+            "|f_R|",
+            rel_l2(
+                &untested.curves.friction_force_norm,
+                &tested.curves.friction_force_norm,
+                n,
+            ),
+        ),
+        (
+            "u_y",
+            rel_l2(&untested.curves.master_uy, &tested.curves.master_uy, n),
+        ),
+        (
+            "D",
+            rel_l2(&untested.curves.dissipated, &tested.curves.dissipated, n),
+        ),
+    ];
+    println!(
+        "screened, untracked memory untested vs tested: {diffs:?}; steps {} vs {}, error-test \
+         failures {} vs {}",
+        untested.stats.steps,
+        tested.stats.steps,
+        untested.stats.error_test_failures,
+        tested.stats.error_test_failures
+    );
+    for (what, e) in diffs {
+        assert!(e < 2e-3, "{what}(t) moved by {e:.2e}");
+    }
+}

@@ -126,9 +126,10 @@
 //! **Why it is not the default.** A thin lap joint is pressed nearly shut: its open pairs' gaps
 //! are 1e-4–1e-3 of the structure's motion in coordinate space, so within a few steps the bound
 //! `‖B_{n,z}‖ ‖Δ‖` exceeds most gaps and half the untracked pairs need their exact product,
-//! and the set changes (late entries, joins and leaves at builds) cost error-test failures.
-//! On the refined friction bars the screened run evaluates a fraction of the pairs but takes
-//! more steps (docs/performance/speed.md, *Pair screening*).
+//! and the set changes (late entries, joins and leaves at builds) cost error-test failures —
+//! fewer since the untracked pairs' memory left the error test (previous section), but on a
+//! joint of few pairs still more than the products it saves. It pays where the products of
+//! thousands of pairs are most of a step (docs/performance/speed.md, *Pair screening*).
 //! The full model does not screen (its sparse `B q` costs a few entries per pair); screening
 //! is off with events on (the root functions need every pair). Curves with and without
 //! screening agree to the integration tolerance (`tests/integrate/screen.rs`).
@@ -237,9 +238,12 @@
 //! switch keep their test: they hover at round-off around `g = 0` under the load ramp's start,
 //! and switching their weights on and off with every sign change made that phase take ~1.8×
 //! the steps. The Newton matrix treats an open pair's memory exactly (`D_s = I/τ`), so the
-//! Newton convergence test, which uses the same weights, loses nothing either. The full model
-//! keeps every state in its test (its bits are unchanged); so do screening and the stretch
-//! states, whose memory states are not the slip of every pair.
+//! Newton convergence test, which uses the same weights, loses nothing either. With screening
+//! the pairs outside the tracked set get zero weight as well: every right-hand side proves them
+//! open (their gaps of the last one are not computed), and their memory runs at its frozen
+//! rate, so the set's changes — a pair leaving or joining it — no longer reach the error test
+//! through those states. The full model keeps every state in its test (its bits are
+//! unchanged); so do the stretch states, whose memory states are not the slip of every pair.
 //!
 //! ## Running
 //!
@@ -333,8 +337,9 @@ pub struct ProblemOptions {
     /// Pair screening (module docs, *Pair screening*): a system that offers it (the reduced
     /// model) evaluates only the pairs that may be in contact within the step; the others are
     /// proved open by a bound. Ignored with events on and by the full model. Off by default:
-    /// on the refined friction bars the set changes cost more steps than the pairs it skips
-    /// save (docs/performance/speed.md, *Pair screening*).
+    /// on a joint of few pairs the set changes cost more steps than the pairs it skips save;
+    /// it pays on interfaces of thousands of pairs (docs/performance/speed.md, *Pair
+    /// screening*).
     pub screen: bool,
     /// The slip memory as elastic stretch (module docs, *The slip memory as elastic
     /// stretch*): the memory states of a system that offers screening (the reduced model) hold
@@ -346,8 +351,9 @@ pub struct ProblemOptions {
     /// *The error test of the open pairs' slip memory*). Off (the default): a reduced model's
     /// step gives the memory states of the pairs open by more than the refresh margin zero
     /// error weight, every other state the weights of the tolerances — fewer steps, the same
-    /// curves to the integration tolerance. On: every state is tested. The full model, and a
-    /// reduced model with screening or the stretch states, always test every state.
+    /// curves to the integration tolerance (with screening, also those of the pairs outside
+    /// the tracked set). On: every state is tested. The full model, and a reduced model with
+    /// the stretch states, always test every state.
     pub open_slip_test: bool,
 }
 
@@ -518,7 +524,6 @@ impl<S: SecondOrderSystem> MechanicalOde<S> {
         let free_open_slip = opts.friction
             && !opts.open_slip_test
             && sys.joint_normal_row_norms().is_some()
-            && !opts.screen
             && !stretch;
         let screen = if opts.screen && !opts.events {
             sys.joint_normal_row_norms()
@@ -1081,8 +1086,12 @@ impl<S: SecondOrderSystem> OdeProblem for MechanicalOde<S> {
             &self.ewt_u
         };
         let slip = &mut ewt[2 * self.n..2 * self.n + 2 * self.w];
-        for (wk, uk) in slip.chunks_exact_mut(2).zip(u.chunks_exact(3)) {
-            if uk[0] > self.open_margin {
+        let screen = self.screen.as_ref();
+        for (k, (wk, uk)) in slip.chunks_exact_mut(2).zip(u.chunks_exact(3)).enumerate() {
+            // An untracked pair is proven open at every right-hand side (its gap of the last
+            // one was not computed) and its memory runs at its frozen rate.
+            let untracked = screen.is_some_and(|sc| !sc.tracks(k));
+            if untracked || uk[0] > self.open_margin {
                 wk.fill(0.0);
             }
         }

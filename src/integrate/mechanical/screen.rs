@@ -67,6 +67,11 @@ pub(super) struct ScreenStats {
 }
 
 impl PairScreen {
+    /// Whether pair `z` is tracked.
+    pub(super) fn tracks(&self, z: usize) -> bool {
+        self.is_tracked[z]
+    }
+
     /// A screen of w pairs with the normal-row norms `row_norm`, tracking every pair until its
     /// first build.
     pub(super) fn new(row_norm: Vec<f64>, n: usize) -> PairScreen {
