@@ -1062,8 +1062,9 @@ impl<S: SecondOrderSystem> OdeProblem for MechanicalOde<S> {
 
     /// Zero weight for the memory states of the pairs open by more than the margin
     /// (`g > open_margin`) at the last right-hand side — the step just accepted, at its last
-    /// Newton iterate — or at `y` before any; every other weight as given (module docs,
-    /// *The error test of the open pairs' slip memory*).
+    /// Newton iterate — or at `y` before any, and with screening for those of the pairs
+    /// outside the tracked set; every other weight as given (module docs, *The error test of
+    /// the open pairs' slip memory*).
     fn adjust_error_weights(&mut self, y: &[f64], ewt: &mut [f64]) -> Result<(), CallbackError> {
         if !self.free_open_slip {
             return Ok(());
