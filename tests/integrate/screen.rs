@@ -11,13 +11,19 @@ use jointrom::system::{ReducedSystem, Scene, SecondOrderSystem};
 
 use crate::common::{self, rel_l2};
 
-/// The TVD model of `case` over `[0, end]` run with `change` applied to the default problem
-/// options, and with the defaults; and its number of pairs.
-fn runs(case: &str, end: f64, change: impl Fn(&mut ProblemOptions)) -> (Run, Run, usize) {
+/// The model of `case` and its TVD reduced model.
+fn tvd_model(case: &str) -> (jointrom::model::Model, ReducedSystem) {
     let path = common::repo_path(case);
     let model = common::model(path.to_str().expect("path"));
     let basis = build_basis(&model, BasisKind::Tvd, &BasisOptions::default()).expect("basis");
     let rom = ReducedSystem::new(&model, basis.phi).expect("ROM");
+    (model, rom)
+}
+
+/// The TVD model of `case` over `[0, end]` run with `change` applied to the default problem
+/// options, and with the defaults; and its number of pairs.
+fn runs(case: &str, end: f64, change: impl Fn(&mut ProblemOptions)) -> (Run, Run, usize) {
+    let (model, rom) = tvd_model(case);
     let pairs = rom.pairs();
     let scene = Scene::of(&model);
     let off = common::until(end);
@@ -115,49 +121,22 @@ fn screened_run_leaves_the_untracked_memory_out_of_the_error_test() {
     // The same screened run with the open pairs' memory tested (`--open-slip-test on`) and
     // untested (the default, which with screening also frees the pairs outside the tracked
     // set): the same curves to the integration tolerance, by a different path.
-    let (untested, _, _) = runs("cases/scale/friction_bar_x2.json", 0.02, |p| {
-        p.screen = true
-    });
-    let path = common::repo_path("cases/scale/friction_bar_x2.json");
-    let model = common::model(path.to_str().expect("path"));
-    let basis = build_basis(&model, BasisKind::Tvd, &BasisOptions::default()).expect("basis");
-    let rom = ReducedSystem::new(&model, basis.phi).expect("ROM");
+    let (model, rom) = tvd_model("cases/scale/friction_bar_x2.json");
+    let scene = Scene::of(&model);
     let mut opts = common::until(0.02);
     opts.problem.screen = true;
+    assert!(
+        !opts.problem.open_slip_test,
+        "the open memory is untested by default"
+    );
+    let untested = run(rom.clone(), &scene, &opts).expect("screened run");
     opts.problem.open_slip_test = true;
-    let tested = run(rom, &Scene::of(&model), &opts).expect("screened run testing every state");
-    let n = untested.curves.t.len();
-    assert_eq!(n, tested.curves.t.len(), "output count");
+    let tested = run(rom, &scene, &opts).expect("screened run testing every state");
     assert_ne!(
         untested.curves.master_uy, tested.curves.master_uy,
         "the weights changed nothing: the path is not taken"
     );
-    let diffs = [
-        (
-            "|f_c|",
-            rel_l2(
-                &untested.curves.contact_force_norm,
-                &tested.curves.contact_force_norm,
-                n,
-            ),
-        ),
-        (
-            "|f_R|",
-            rel_l2(
-                &untested.curves.friction_force_norm,
-                &tested.curves.friction_force_norm,
-                n,
-            ),
-        ),
-        (
-            "u_y",
-            rel_l2(&untested.curves.master_uy, &tested.curves.master_uy, n),
-        ),
-        (
-            "D",
-            rel_l2(&untested.curves.dissipated, &tested.curves.dissipated, n),
-        ),
-    ];
+    let diffs = common::curve_differences(&untested, &tested);
     println!(
         "screened, untracked memory untested vs tested: {diffs:?}; steps {} vs {}, error-test \
          failures {} vs {}",
