@@ -177,6 +177,7 @@ fn run_tolerance(
         friction_atol,
         stopped,
         integration_stall,
+        discarded,
     } = tolerance_model(model, &topts)?;
     let frames = match (every, &rom.phi) {
         (Some(every), Some(phi)) => {
@@ -213,6 +214,7 @@ fn run_tolerance(
             compression,
             stopped,
             integration_stall,
+            discarded_rounds: discarded,
         }),
     })
 }

@@ -118,6 +118,20 @@
 //! is a model with an estimate, and the stopped round is reported beside it (`stopped`); a
 //! request or model error is still an error.
 //!
+//! **At the integration floor.** The selection leaves the model's error θ·TOL and so the
+//! integration part the rest, but a round's model error is only held below TOL: at the
+//! tolerances' floor (the user's or the paper's, or after a stall below TOL) a model error
+//! between θ·TOL and TOL beside an integration part that cannot fall may still miss. Such a
+//! round grows its model where its parts exceed their shares (the attachment modes the joint
+//! parts ask for, else ν), as a round that misses by its model error does — but only while the
+//! integration part leaves room, `e_int ≤ √(1 − θ²)·TOL` (the parts add in quadrature): with a
+//! larger one no model meets TOL and the best is returned as above. Growth there is a trial: a
+//! later round whose estimated total (with its checks) is no better than the model it grew from
+//! ends the search with that model, not met, and the rounds after it are reported as
+//! `discarded`. On a joint that rings, richer models can estimate worse — their truncation
+//! check's richer run and their integration check both ring more — and the rounds' rules
+//! would otherwise follow that into ever larger ν.
+//!
 //! **Tightening that does not converge.** A model that misses by its integration part is re-run
 //! tighter (first at the stick floor, then tenfold). Where a joint rings — sheets that knock
 //! together, a refined interface of stiff penalty pairs — the tighter run damps less of the
@@ -650,6 +664,9 @@ pub struct ToleranceModel {
     /// A tightening of the integration that did not converge (`None`: none did); no round
     /// after it was tightened again.
     pub integration_stall: Option<IntegrationStall>,
+    /// The rounds grown at the integration floor whose estimate came out no better than the
+    /// model they grew from, which is then the result (empty: none were dropped).
+    pub discarded: Vec<Round>,
 }
 
 impl ToleranceModel {
@@ -683,6 +700,7 @@ impl ToleranceModel {
             friction_atol: tolerances.stick(),
             stopped: None,
             integration_stall: tolerances.stall,
+            discarded: Vec::new(),
         }
     }
 }
@@ -812,6 +830,10 @@ pub struct ToleranceChoice {
     /// A tightening of the integration that did not converge (absent: none did).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub integration_stall: Option<IntegrationStall>,
+    /// The rounds grown at the integration floor that estimated no better than the model they
+    /// grew from — the result, not met (absent: none).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub discarded_rounds: Vec<Round>,
 }
 
 /// Builds the smallest Craig–Bampton + pair-attachment-mode model whose estimated errors of the
@@ -844,6 +866,26 @@ struct Progress {
     best: Option<(ToleranceModel, usize)>,
     /// The round being made: what [`StoppedRound`] reports if its runs stop.
     current: Option<StoppedRound>,
+    /// The model a growth at the integration floor started from, with the number of rounds up
+    /// to it and its estimated total (the largest over the controlled quantities).
+    floor: Option<(ToleranceModel, usize, f64)>,
+}
+
+/// The model a growth at the integration floor started from (`floor`, with the number of rounds
+/// up to it and its estimated total), as the result — not met, the rounds after it `discarded`
+/// — if its total is below `total`; `rounds` are the search's rounds so far.
+fn floor_result(
+    floor: &mut Option<(ToleranceModel, usize, f64)>,
+    rounds: &mut Vec<Round>,
+    total: f64,
+    start: Instant,
+) -> Option<ToleranceModel> {
+    let (mut model, upto, _) = floor.take_if(|f| f.2 < total)?;
+    model.discarded = rounds.split_off(upto.min(rounds.len()));
+    model.rounds = std::mem::take(rounds);
+    model.met = false;
+    model.offline_s = start.elapsed().as_secs_f64() - model.run.wall_s - model.estimate_s;
+    Some(model)
 }
 
 impl Progress {
@@ -852,7 +894,8 @@ impl Progress {
     /// overflow) in a round after a model that could be the result, that model, not met, with
     /// the stopped round; any other error, or no such model, is `e`.
     fn fall_back(self, e: Error, start: Instant) -> Result<ToleranceModel, Error> {
-        let (Some((mut best, upto)), Some(mut stopped)) = (self.best, self.current) else {
+        let best = self.floor.map(|(m, upto, _)| (m, upto)).or(self.best);
+        let (Some((mut best, upto)), Some(mut stopped)) = (best, self.current) else {
             return Err(e);
         };
         if !stopped_in_time(&e) {
@@ -860,7 +903,7 @@ impl Progress {
         }
         stopped.reason = e.to_string();
         let mut rounds = self.rounds;
-        rounds.truncate(upto);
+        best.discarded = rounds.split_off(upto.min(rounds.len()));
         best.rounds = rounds;
         best.met = false;
         best.offline_s = start.elapsed().as_secs_f64() - best.run.wall_s - best.estimate_s;
@@ -914,44 +957,24 @@ fn search(
     let mut separate = false;
     // The integration tolerances: the user's, or the paper's times s, capped by the force floor.
     let mut tolerances = RoundTolerances::new(opts, on);
+    let search = Search {
+        model,
+        fixed: &fixed,
+        flex: &flex,
+        on,
+        tol,
+    };
     loop {
         let round_start = Instant::now();
         let rom = reduced_on(model, &cb, &flex, &chosen, &mut bases)?;
         let basis_s = round_start.elapsed().as_secs_f64();
         let transient = tolerances.transient(&opts.transient, ranking);
         progress.current = (!ranking).then(|| StoppedRound::of(&chosen, nu, &rom, &transient));
-        // A round expected to be the result makes its two checks beside its run (on a second
-        // core); any other round makes them after its correction, only if it may be the result.
-        let scene = Scene::of(model);
         let speculate = !ranking && expect_result;
-        let checks = match (speculate, separate) {
-            (false, _) => Checks::NONE,
-            (true, true) => Checks::BOTH,
-            (true, false) => Checks::COMBINED,
-        };
-        // The ranking round's estimate only ranks the pairs: its joint part alone.
-        let (run, estimate) = run_estimated_parts(
-            model,
-            &flex,
-            rom.clone(),
-            &scene,
-            &transient,
-            checks,
-            !ranking,
-            |_, _| {},
-        )?;
-        let run = run.into_result()?;
-        let mut estimate = estimate?;
-        let candidate = !ranking && worst(&estimate.reduction, on) <= tol;
+        let flags = (ranking, speculate, separate);
+        let (scene, run, mut estimate, made, combined) =
+            search.run_round(&rom, &transient, flags)?;
         let recheck = (&rom, &run, &scene, &transient);
-        let (made, combined) = round_checks(
-            model,
-            recheck,
-            &mut estimate,
-            (speculate, candidate),
-            on,
-            tol,
-        )?;
         // A next round expected to be the result: expected with its reduction part in its share.
         let expected = SELECTION_MARGIN * tol;
         separate = !combined_may_meet(expected, &estimate, tol, &transient);
@@ -976,27 +999,15 @@ fn search(
         // A tightened re-run whose integration part did not converge: no more tightening, and
         // no more rounds if that part alone misses (IntegrationStall).
         let ended = tolerances.judge(rounds, tol);
+        // This round's own model (the result, or the fall-back of later rounds).
+        let own = (chosen.clone(), nu);
         let mut changed = false;
         // The next round repeats this model or adds all the estimate asked for: the result?
         expect_result = true;
-        if eta > tol && !ended && rounds.len() < opts.max_rounds {
-            let enriched = chosen.enrich(&estimate, on, tol, cb.ncols());
-            changed = enriched.changed;
-            expect_result = enriched.complete;
-            // The truncated modes are driven by the run's contact forces: while those are wrong
-            // the truncation part is too, so ν grows only once the joint part is within its share.
-            let part = SELECTION_MARGIN * tol;
-            let truncated = d
-                .truncation
-                .unwrap_or(0.0)
-                .max(estimate.truncation.map_or(0.0, |t| worst(&t, on)));
-            if !changed && truncated > part && nu + NU_STEP <= max_nu(model) {
-                nu += NU_STEP;
-                cb = craig_bampton_with(model, nu, &fixed)?;
-                flex.hold_truncation_modes(truncated_modes_for(nu));
-                changed = true;
-                expect_result = true;
-            }
+        if eta > tol && !ended && room {
+            let grown = search.grow(&mut chosen, (&mut nu, &mut cb), &estimate)?;
+            changed = grown.changed;
+            expect_result = grown.complete;
         }
         if std::mem::replace(&mut ranking, false) {
             // A ranking run is never the result: the same model again at the user's tolerances
@@ -1009,31 +1020,153 @@ fn search(
             let last = rounds.last_mut();
             result_integration_check(model, recheck, &mut estimate, on, last)?;
         }
+        // After a growth at the integration floor, a round whose estimate is no better than
+        // that of the model it grew from ends the search with that model.
+        let total = worst(&estimate.total, on);
+        let checked = estimate.integration.is_some() || estimate.combined.is_some();
+        if let Some(floor) = checked
+            .then(|| floor_result(&mut progress.floor, rounds, total, start))
+            .flatten()
+        {
+            progress.current = None;
+            return Ok(floor);
+        }
         // The estimate misses the tolerance at loosened integration tolerances: the same model
         // again, ten times tighter (the reduction part is within its share, or the loop would
         // have enriched the basis).
-        let total = worst(&estimate.total, on);
-        let again = changed
-            || (!ended
-                && estimate.integration.is_some()
-                && total > tol
-                && tolerances.tighten(&opts.transient));
+        let misses = !ended && estimate.integration.is_some() && total > tol;
+        let mut again = changed || (misses && tolerances.tighten(&opts.transient));
+        let mut at_floor = false;
+        if !again && misses && room && room_for_the_model(&estimate, on, tol) {
+            // At the integration floor (the tolerances can tighten no further): the model's
+            // error into its share, where the integration part leaves room for it.
+            let grown = search.grow(&mut chosen, (&mut nu, &mut cb), &estimate)?;
+            (changed, again, expect_result) = (grown.changed, grown.changed, grown.complete);
+            at_floor = grown.changed;
+        }
         let parts = (rom, run, estimate, transient);
-        let mut result = ToleranceModel::of(&chosen, (on, nu, setup_s), parts, &tolerances);
+        let mut result = ToleranceModel::of(&own.0, (on, own.1, setup_s), parts, &tolerances);
         result.met = total <= tol;
         result.estimate_s = rounds.last().map_or(0.0, |r| r.estimate_s);
         result.offline_s = (round_start - start).as_secs_f64() + basis_s;
         if again {
             tolerances.tightened = !changed;
-            // The model the next rounds fall back to if their runs stop (Progress::fall_back).
-            progress.best = Some((result, rounds.len()));
+            // The model the next rounds fall back to if their runs stop (Progress::fall_back),
+            // or are read against if they grew at the floor.
+            if at_floor {
+                progress.floor = Some((result, rounds.len(), total));
+            } else {
+                progress.best = Some((result, rounds.len()));
+            }
             continue;
         }
         // The result: what the compression does is its own (a failed attempt is no round's).
         progress.current = None;
+        if !result.met {
+            if let Some(floor) = floor_result(&mut progress.floor, rounds, total, start) {
+                return Ok(floor);
+            }
+        }
         result.rounds = std::mem::take(rounds);
         compress::compress_result(model, &flex, (&chosen, &bases, &cb), opts, &mut result)?;
         return Ok(result);
+    }
+}
+
+/// Whether a model whose error is within its share θ·TOL would meet `tol` beside the integration
+/// part of `estimate` (largest over the quantities `on`): the parts add in quadrature, so the
+/// integration part must be at most `√(1 − θ²)·TOL`. A round at the integration floor — its
+/// tolerances can tighten no further — that misses grows its model only then
+/// ([`tolerance_model`]); with a larger integration part no model the rounds can build meets TOL.
+fn room_for_the_model(estimate: &RunEstimate, on: Quantities, tol: f64) -> bool {
+    let share = (1.0 - SELECTION_MARGIN * SELECTION_MARGIN).sqrt() * tol;
+    estimate.integration.is_some_and(|i| worst(&i, on) <= share)
+}
+
+/// The fixed parts of a [`tolerance_model`] search: the model, its fixed-interface problem and
+/// joint flexibility, the controlled quantities and the tolerance.
+struct Search<'a> {
+    model: &'a Model,
+    fixed: &'a FixedInterface,
+    flex: &'a JointFlexibility,
+    on: Quantities,
+    tol: f64,
+}
+
+impl Search<'_> {
+    /// A round's run of `rom` at `transient` and its estimate with the re-runs it makes (module
+    /// docs), given whether it ranks (its estimate then its joint part alone), speculates (its
+    /// checks beside its run) and makes the two separate checks rather than the combined one.
+    /// Returns the scene, the run, the estimate, where the re-runs were made and the combined
+    /// part as made ([`round_checks`]).
+    fn run_round(
+        &self,
+        rom: &ReducedSystem,
+        transient: &TransientOptions,
+        (ranking, speculate, separate): (bool, bool, bool),
+    ) -> Result<(Scene, Run, RunEstimate, ReRuns, Option<f64>), Error> {
+        let (model, on, tol) = (self.model, self.on, self.tol);
+        let scene = Scene::of(model);
+        // A round expected to be the result makes its two checks beside its run (on a second
+        // core); any other round makes them after its correction, only if it may be the result.
+        let checks = match (speculate, separate) {
+            (false, _) => Checks::NONE,
+            (true, true) => Checks::BOTH,
+            (true, false) => Checks::COMBINED,
+        };
+        let (run, estimate) = run_estimated_parts(
+            model,
+            self.flex,
+            rom.clone(),
+            &scene,
+            transient,
+            checks,
+            !ranking,
+            |_, _| {},
+        )?;
+        let run = run.into_result()?;
+        let mut estimate = estimate?;
+        let candidate = !ranking && worst(&estimate.reduction, on) <= tol;
+        let recheck = (rom, &run, &scene, transient);
+        let flags = (speculate, candidate);
+        let (made, combined) = round_checks(model, recheck, &mut estimate, flags, on, tol)?;
+        Ok((scene, run, estimate, made, combined))
+    }
+
+    /// Grows a round's model where its estimate's parts exceed their shares: the attachment
+    /// modes the joint parts ask for ([`Chosen::enrich`]), else ν by [`NU_STEP`] where the
+    /// truncation part (the correction's, or the truncation check's over the controlled
+    /// quantities) exceeds θ·TOL. The truncated modes are driven by the run's contact forces:
+    /// while those are wrong the truncation part is too, so ν grows only once the joint parts
+    /// are within their shares. `nu` and the Craig–Bampton base `cb` grow together, and the
+    /// estimator then holds the modes beyond the new ν.
+    fn grow(
+        &self,
+        chosen: &mut Chosen,
+        (nu, cb): (&mut usize, &mut faer::Mat<f64>),
+        estimate: &RunEstimate,
+    ) -> Result<Enriched, Error> {
+        let (on, tol) = (self.on, self.tol);
+        let enriched = chosen.enrich(estimate, on, tol, cb.ncols());
+        if enriched.changed {
+            return Ok(enriched);
+        }
+        let part = SELECTION_MARGIN * tol;
+        let truncated = estimate
+            .detail
+            .truncation
+            .unwrap_or(0.0)
+            .max(estimate.truncation.map_or(0.0, |t| worst(&t, on)));
+        if truncated > part && *nu + NU_STEP <= max_nu(self.model) {
+            *nu += NU_STEP;
+            *cb = craig_bampton_with(self.model, *nu, self.fixed)?;
+            self.flex.hold_truncation_modes(truncated_modes_for(*nu));
+            return Ok(Enriched {
+                changed: true,
+                complete: true,
+            });
+        }
+        Ok(enriched)
     }
 }
 
