@@ -873,14 +873,14 @@ struct Progress {
 
 /// The model a growth at the integration floor started from (`floor`, with the number of rounds
 /// up to it and its estimated total), as the result — not met, the rounds after it `discarded`
-/// — if its total is below `total`; `rounds` are the search's rounds so far.
+/// — if its total is at most `total`; `rounds` are the search's rounds so far.
 fn floor_result(
     floor: &mut Option<(ToleranceModel, usize, f64)>,
     rounds: &mut Vec<Round>,
     total: f64,
     start: Instant,
 ) -> Option<ToleranceModel> {
-    let (mut model, upto, _) = floor.take_if(|f| f.2 < total)?;
+    let (mut model, upto, _) = floor.take_if(|f| f.2 <= total)?;
     model.discarded = rounds.split_off(upto.min(rounds.len()));
     model.rounds = std::mem::take(rounds);
     model.met = false;
