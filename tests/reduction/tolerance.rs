@@ -357,7 +357,10 @@ fn tolerance_model_meets_the_lap_joint_reference() {
 /// 221 pairs) at TOL 1e-2: a round at the paper's integration tolerances misses by a model error
 /// between θ·TOL and TOL beside an integration part that cannot fall; there the rounds grow the
 /// model instead of returning it, and the result meets the tolerance — every true error within
-/// it against the stored full run, every estimate above half of it.
+/// it against the stored full run, the estimates of ‖f_c‖, ‖f_R‖, u_y and D within 0.5–10× of
+/// theirs. D(T)'s true error (5e-4, 20× below the tolerance) is not asserted against: whether
+/// the stored run resolves it could not be checked (the full model at rtol 1e-9 stops on CVODE's
+/// step limit at t = 0.018 s).
 #[test]
 fn tolerance_model_grows_at_the_integration_floor() {
     let (path, _) = reference_json("stepped_stack_full_friction_on");
