@@ -124,6 +124,12 @@ pub trait SecondOrderSystem {
         self.joint_apply_into(q, &mut u);
         [u[3 * z], u[3 * z + 1], u[3 * z + 2]]
     }
+    /// Pair z's tangential kinematics `[(B q)_{3z+1}, (B q)_{3z+2}]` (slip x, slip z; mm), the
+    /// same values as those entries of [`SecondOrderSystem::joint_pair`].
+    fn joint_pair_tangential(&self, q: &[f64], z: usize) -> [f64; 2] {
+        let [_, t1, t2] = self.joint_pair(q, z);
+        [t1, t2]
+    }
     /// `out[3z..3z+3] = (B q)_{3z..3z+3}` for the pairs z in `pairs` (other entries untouched).
     fn joint_apply_pairs_into(&self, q: &[f64], pairs: &[usize], out: &mut [f64]) {
         for &z in pairs {

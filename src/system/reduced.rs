@@ -513,6 +513,10 @@ impl SecondOrderSystem for ReducedSystem {
         let r = self.r;
         [0, 1, 2].map(|i| kernels::dot(&self.b_rows[(3 * z + i) * r..(3 * z + i + 1) * r], q))
     }
+    fn joint_pair_tangential(&self, q: &[f64], z: usize) -> [f64; 2] {
+        let r = self.r;
+        [1, 2].map(|i| kernels::dot(&self.b_rows[(3 * z + i) * r..(3 * z + i + 1) * r], q))
+    }
     fn joint_transpose_add_pairs(&self, p: &[f64], pairs: &[usize], out: &mut [f64]) {
         let r = self.r;
         for &z in pairs {

@@ -203,12 +203,24 @@ impl<S: SecondOrderSystem> MechanicalOde<S> {
         Ok(())
     }
 
-    /// `u = B a` for the slip states' corrections ([`MechanicalOde::slip_corrections`]): on
-    /// the live pairs, or, where the system offers it and neither screening nor the stretch
-    /// states are on, the tangential rows of every pair and the normal rows of the sliding
-    /// ones only — the normal row enters through `∂ṡ/∂g` and `∂d/∂g`, zero on the open and
-    /// stuck branches (their entries are set to 0). The same values.
+    /// `u = B a` for the slip states' corrections ([`MechanicalOde::slip_corrections`]): the
+    /// tangential rows and the normal rows of the sliding pairs only — the normal row enters
+    /// through `∂ṡ/∂g` and `∂d/∂g`, zero on the open and stuck branches (their entries are set
+    /// to 0). With screening, on the live pairs; without it, where the system offers it, for
+    /// every pair; with the stretch states, all rows of the live pairs. The same values.
     fn apply_for_corrections(&mut self, a: &[f64]) {
+        if self.screen.is_some() && !self.stretch {
+            for &k in &self.live {
+                if self.branch[k] == PairState::Slip {
+                    let u = self.sys.joint_pair(a, k);
+                    self.u[3 * k..3 * k + 3].copy_from_slice(&u);
+                } else {
+                    let [t1, t2] = self.sys.joint_pair_tangential(a, k);
+                    self.u[3 * k..3 * k + 3].copy_from_slice(&[0.0, t1, t2]);
+                }
+            }
+            return;
+        }
         if self.rows_selectable() {
             let mut rows = std::mem::take(&mut self.rows);
             rows.clear();
