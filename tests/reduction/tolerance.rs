@@ -52,6 +52,22 @@ fn contract(truth: &ReferenceErrors, est: &CurveErrors) -> [(&'static str, f64, 
     .map(|(what, t, e)| (what, t.expect("a true error"), e.expect("an estimate")))
 }
 
+/// The 1 % contract on a `transient --tolerance 1e-2 --reference … --json` document: each of the
+/// `quantities` (its JSON names) within 1e-2 of the stored full run, its estimate within 0.5–10×
+/// of that true error.
+fn assert_json_contract(run: &Value, quantities: &[&str]) {
+    for what in quantities {
+        let truth = run["reference_error"][what].as_f64().unwrap();
+        let est = run["error_estimate"][what].as_f64().unwrap();
+        assert!(truth <= 1e-2, "true {what} error {truth}");
+        let eff = est / truth;
+        assert!(
+            (0.5..=10.0).contains(&eff),
+            "{what} effectivity {eff} ({est} / {truth})"
+        );
+    }
+}
+
 /// The pair-space contact statics (one factorization of K, the joint flexibility) reproduce the
 /// full model's contact forces: the static estimate is exact.
 #[test]
@@ -386,16 +402,8 @@ fn tolerance_model_grows_at_the_integration_floor() {
             && at(&w[1], "basis_size") > at(&w[0], "basis_size")
     });
     assert!(grew, "no round grew at the floor: {rounds:?}");
-    for what in ["contact_force", "friction_force", "master_uy", "dissipated"] {
-        let truth = run["reference_error"][what].as_f64().unwrap();
-        let est = run["error_estimate"][what].as_f64().unwrap();
-        assert!(truth <= 1e-2, "true {what} error {truth}");
-        let eff = est / truth;
-        assert!(
-            (0.5..=10.0).contains(&eff),
-            "{what} effectivity {eff} ({est} / {truth})"
-        );
-    }
+    let quantities = ["contact_force", "friction_force", "master_uy", "dissipated"];
+    assert_json_contract(&run, &quantities);
 }
 
 /// Compressed joint columns (`ToleranceOptions::compress`) on the friction bar at TOL 1e-2:
@@ -514,22 +522,16 @@ fn tolerance_contract_holds_on_contact_points() {
             .is_empty(),
         "no tangential attachment modes"
     );
-    for what in [
-        "contact_force",
-        "friction_force",
-        "master_uy",
-        "dissipated",
-        "dissipated_end",
-    ] {
-        let truth = run["reference_error"][what].as_f64().unwrap();
-        let est = run["error_estimate"][what].as_f64().unwrap();
-        assert!(truth <= 1e-2, "true {what} error {truth}");
-        let eff = est / truth;
-        assert!(
-            (0.5..=10.0).contains(&eff),
-            "{what} effectivity {eff} ({est} / {truth})"
-        );
-    }
+    assert_json_contract(
+        &run,
+        &[
+            "contact_force",
+            "friction_force",
+            "master_uy",
+            "dissipated",
+            "dissipated_end",
+        ],
+    );
 }
 
 /// The dissipated energy's estimate where the model's joint forces are a few per cent off
