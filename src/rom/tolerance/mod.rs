@@ -881,11 +881,20 @@ fn floor_result(
     start: Instant,
 ) -> Option<ToleranceModel> {
     let (mut model, upto, _) = floor.take_if(|f| f.2 <= total)?;
-    model.discarded = rounds.split_off(upto.min(rounds.len()));
-    model.rounds = std::mem::take(rounds);
-    model.met = false;
-    model.offline_s = start.elapsed().as_secs_f64() - model.run.wall_s - model.estimate_s;
+    model.unmet_after(std::mem::take(rounds), upto, start);
     Some(model)
+}
+
+impl ToleranceModel {
+    /// This model of an earlier round as the result of a search that went on: not met, its
+    /// `rounds` the search's up to it (the first `upto`), the rest `discarded`, and its offline
+    /// time everything since `start` but its own run and estimate.
+    fn unmet_after(&mut self, mut rounds: Vec<Round>, upto: usize, start: Instant) {
+        self.discarded = rounds.split_off(upto.min(rounds.len()));
+        self.rounds = rounds;
+        self.met = false;
+        self.offline_s = start.elapsed().as_secs_f64() - self.run.wall_s - self.estimate_s;
+    }
 }
 
 impl Progress {
@@ -902,11 +911,7 @@ impl Progress {
             return Err(e);
         }
         stopped.reason = e.to_string();
-        let mut rounds = self.rounds;
-        best.discarded = rounds.split_off(upto.min(rounds.len()));
-        best.rounds = rounds;
-        best.met = false;
-        best.offline_s = start.elapsed().as_secs_f64() - best.run.wall_s - best.estimate_s;
+        best.unmet_after(self.rounds, upto, start);
         best.stopped = Some(stopped);
         Ok(best)
     }
@@ -1062,11 +1067,6 @@ fn search(
         }
         // The result: what the compression does is its own (a failed attempt is no round's).
         progress.current = None;
-        if !result.met {
-            if let Some(floor) = floor_result(&mut progress.floor, rounds, total, start) {
-                return Ok(floor);
-            }
-        }
         result.rounds = std::mem::take(rounds);
         compress::compress_result(model, &flex, (&chosen, &bases, &cb), opts, &mut result)?;
         return Ok(result);
